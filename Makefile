@@ -1,0 +1,92 @@
+# frac — build, test, sanitizer pass, goldens, gallery, benchmarks.
+#
+#   make            build build/frac (optimised)
+#   make test       build and run every test (unit, language, REPL, golden)
+#   make asan       the whole suite under AddressSanitizer + UBSan (build-asan/)
+#   make golden     regenerate tests/golden/ from examples/ (review the diff!)
+#   make gallery    render every example into gallery/index.html
+#   make bench      build and run the benchmarks in bench/
+#
+# Floating point must give identical results at every optimisation level and
+# under the sanitizers (goldens are compared exactly): no -ffast-math, no
+# -march=native, and FP contraction off so no fused multiply-add is formed.
+
+CC      ?= cc
+BUILD   ?= build
+OPT     ?= -O2
+SAN     ?=
+CFLAGS_BASE = -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Werror -Wshadow \
+              -Wstrict-prototypes -Wmissing-prototypes -ffp-contract=off -fno-fast-math \
+              -fno-strict-aliasing -g
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iruntime -Iinterp -I$(BUILD)
+LDLIBS  = -lm -lpthread
+
+RT_SRC  := $(sort $(wildcard runtime/*.c))
+IN_SRC  := $(sort $(wildcard interp/*.c))
+STDLIB  := $(sort $(wildcard stdlib/*.frac))
+UNIT_SRC:= $(sort $(wildcard tests/unit/test_*.c))
+
+RT_OBJ  := $(RT_SRC:%.c=$(BUILD)/%.o)
+IN_OBJ  := $(IN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/stdlib_gen.o
+UNIT_BIN:= $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+
+.PHONY: all test asan golden gallery bench clean unit
+all: $(BUILD)/frac
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/libfracrt.a: $(RT_OBJ)
+	rm -f $@
+	ar rcs $@ $^
+
+# stdlib/*.frac are compiled into the binary (see tools/embed.c).
+$(BUILD)/embed: tools/embed.c
+	@mkdir -p $(BUILD)
+	$(CC) -std=c11 -O1 -Wall -Wextra -Werror $< -o $@
+
+$(BUILD)/stdlib_gen.c: $(BUILD)/embed $(STDLIB)
+	$(BUILD)/embed $@ $(STDLIB)
+
+$(BUILD)/stdlib_gen.o: $(BUILD)/stdlib_gen.c
+	$(CC) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/frac: $(IN_OBJ) $(BUILD)/libfracrt.a
+	$(CC) $(CFLAGS) $(IN_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+$(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libfracrt.a tests/unit/check.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+$(BUILD)/runner: tests/runner.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+unit: $(UNIT_BIN)
+
+test: $(BUILD)/frac $(UNIT_BIN) $(BUILD)/runner
+	$(BUILD)/runner --frac $(BUILD)/frac --unit $(BUILD)/tests
+
+asan:
+	$(MAKE) BUILD=build-asan OPT=-O1 SAN="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" test
+
+golden: $(BUILD)/frac $(BUILD)/runner
+	$(BUILD)/runner --frac $(BUILD)/frac --update-golden
+
+gallery: $(BUILD)/frac
+	bash tools/gallery.sh $(BUILD)/frac
+
+BENCH_SRC := $(sort $(wildcard bench/*.c))
+BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
+$(BUILD)/bench/%: bench/%.c $(BUILD)/libfracrt.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+bench: $(BUILD)/frac $(BENCH_BIN)
+	bash bench/run.sh $(BUILD)
+
+clean:
+	rm -rf build build-asan gallery
+
+-include $(RT_OBJ:.o=.d) $(IN_OBJ:.o=.d)

@@ -1,0 +1,37 @@
+/* camera.h — a perspective pinhole camera shared by every renderer
+ * (ray marcher, textured objects, IFS 3-D views, the rasteriser).
+ *
+ * World space is right-handed with +y up. The camera looks from `eye` toward
+ * `target`; `fov` is the vertical field of view in degrees. Pixel (px, py)
+ * with py = 0 at the top maps to normalised device coordinates
+ * ndc_x = (2(px+0.5)/w - 1) * aspect * tan(fov/2), ndc_y = (1 - 2(py+0.5)/h) * tan(fov/2).
+ */
+#ifndef CAMERA_H
+#define CAMERA_H
+
+typedef struct camera {
+    double eye[3], target[3], up[3];
+    double fov; /* degrees, vertical */
+    /* derived by camera_setup: */
+    double fwd[3], right[3], upv[3];
+    double tan_half;
+} camera;
+
+/* Compute the orthonormal frame. Returns 0 on success, -1 if eye == target
+ * or up is parallel to the view direction. */
+int camera_setup(camera *c);
+
+/* Orbit camera: looking at target from distance dist, azimuth az (degrees,
+ * around +y, 0 = looking along -z from +z) and elevation el (degrees). */
+void camera_orbit(camera *c, const double target[3], double dist, double az, double el, double fov);
+
+/* Unit ray direction through pixel centre (px + 0.5 offset applied by caller
+ * via sx, sy in pixel units: sx = px + 0.5 for the centre). */
+void camera_ray(const camera *c, int w, int h, double sx, double sy, double dir[3]);
+
+/* Project world point p to pixel coordinates (sx, sy) and view depth z
+ * (distance along the view direction). Returns 0 if the point is in front of
+ * the camera (z > 1e-9), -1 otherwise. */
+int camera_project(const camera *c, int w, int h, const double p[3], double *sx, double *sy, double *z);
+
+#endif

@@ -1,0 +1,39 @@
+/* image.c — allocation of the float RGBA image. Codecs live in png.c, pnm.c;
+ * image_save/image_load dispatch by extension in image_io.c. */
+#include "image.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+rt_code image_init(image *im, int w, int h, rt_error *e)
+{
+    im->w = im->h = 0;
+    im->px = NULL;
+    if (w < 1 || h < 1)
+        return rt_fail(e, RT_EINVAL, "image size %d×%d is empty", w, h);
+    size_t n = rt_mul_size(rt_mul_size((size_t)w, (size_t)h), 4 * sizeof(float));
+    if (n == 0)
+        return rt_fail(e, RT_ENOMEM, "image size %d×%d is too large", w, h);
+    im->px = calloc(1, n);
+    if (!im->px)
+        return rt_fail(e, RT_ENOMEM, "out of memory for a %d×%d image", w, h);
+    im->w = w;
+    im->h = h;
+    return RT_OK;
+}
+
+void image_free(image *im)
+{
+    free(im->px);
+    im->px = NULL;
+    im->w = im->h = 0;
+}
+
+rt_code image_copy(image *dst, const image *src, rt_error *e)
+{
+    rt_code c = image_init(dst, src->w, src->h, e);
+    if (c)
+        return c;
+    memcpy(dst->px, src->px, (size_t)src->w * (size_t)src->h * 4 * sizeof(float));
+    return RT_OK;
+}

@@ -1,0 +1,43 @@
+/* image.h — the image type every engine renders into.
+ *
+ * Pixels are float RGBA, 4 floats per pixel, row-major, top row first
+ * (y = 0 is the top of the picture). Colour values are nominally in [0, 1]
+ * and linear in the sense that no transfer function is applied on save:
+ * a value v is written to an 8-bit file as round(clamp(v) * 255). Values
+ * outside [0, 1] are kept (PFM saves them) and clamped on integer output.
+ */
+#ifndef IMAGE_H
+#define IMAGE_H
+
+#include <stddef.h>
+
+#include "rt.h"
+
+typedef struct image {
+    int w, h;
+    float *px; /* w * h * 4 floats */
+} image;
+
+/* Allocate a w×h image filled with transparent black. w, h >= 1. */
+rt_code image_init(image *im, int w, int h, rt_error *e);
+void image_free(image *im);
+/* Deep copy. */
+rt_code image_copy(image *dst, const image *src, rt_error *e);
+
+static inline float *image_at(const image *im, int x, int y)
+{
+    return im->px + ((size_t)y * (size_t)im->w + (size_t)x) * 4;
+}
+
+/* Save by file extension: .png (8-bit RGBA unless opts say otherwise),
+ * .ppm, .pgm, .pfm. Written to a temporary file beside path, then renamed. */
+typedef struct image_save_opts {
+    int bits;      /* 8 or 16 (PNG, PGM/PPM); 0 = 8 */
+    int channels;  /* 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA (PNG); 0 = 4 for PNG, 3 for PPM */
+} image_save_opts;
+
+rt_code image_save(const image *im, const char *path, const image_save_opts *opts, rt_error *e);
+/* Load .png, .ppm/.pgm (P5/P6, 8 or 16 bit) and .pfm by content. */
+rt_code image_load(image *im, const char *path, rt_error *e);
+
+#endif

@@ -1,0 +1,91 @@
+/* par.c — parallel-for over fixed chunks with POSIX threads. */
+#define _POSIX_C_SOURCE 200809L
+#include "par.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <unistd.h>
+
+#include "progress.h"
+
+typedef struct job {
+    par_fn fn;
+    void *ctx;
+    size_t nchunks;
+    atomic_size_t next;
+    volatile sig_atomic_t *cancel;
+    atomic_int cancelled;
+    progress prog;
+} job;
+
+typedef struct worker_arg {
+    job *j;
+    int id;
+} worker_arg;
+
+static void run_worker(job *j, int id)
+{
+    for (;;) {
+        if (j->cancel && *j->cancel) {
+            atomic_store(&j->cancelled, 1);
+            return;
+        }
+        size_t c = atomic_fetch_add(&j->next, 1);
+        if (c >= j->nchunks)
+            return;
+        j->fn(j->ctx, c, id);
+        progress_step(&j->prog, 1);
+    }
+}
+
+static void *thread_main(void *p)
+{
+    worker_arg *a = p;
+    run_worker(a->j, a->id);
+    return NULL;
+}
+
+int par_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+int par_workers(const rt_run *run, size_t nchunks)
+{
+    int t = run && run->threads > 0 ? run->threads : 1;
+    if (t > 256)
+        t = 256;
+    if ((size_t)t > nchunks)
+        t = nchunks ? (int)nchunks : 1;
+    return t;
+}
+
+rt_code par_for(const rt_run *run, const char *label, size_t nchunks, par_fn fn, void *ctx)
+{
+    job j;
+    j.fn = fn;
+    j.ctx = ctx;
+    j.nchunks = nchunks;
+    atomic_init(&j.next, 0);
+    atomic_init(&j.cancelled, 0);
+    j.cancel = run ? run->cancel : NULL;
+    progress_begin(&j.prog, label, nchunks, run ? run->progress : 0);
+
+    int nt = par_workers(run, nchunks);
+    pthread_t th[256];
+    worker_arg args[256];
+    int started = 0;
+    for (int i = 1; i < nt; i++) {
+        args[i].j = &j;
+        args[i].id = i;
+        if (pthread_create(&th[i], NULL, thread_main, &args[i]) != 0)
+            break; /* fewer threads is still correct */
+        started = i;
+    }
+    run_worker(&j, 0);
+    for (int i = 1; i <= started; i++)
+        pthread_join(th[i], NULL);
+    progress_end(&j.prog);
+    return atomic_load(&j.cancelled) ? RT_ECANCEL : RT_OK;
+}

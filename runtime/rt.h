@@ -1,0 +1,64 @@
+/* rt.h — what every runtime engine shares: error reporting and small helpers.
+ *
+ * The runtime knows engines and file formats and nothing about the language.
+ * Engines report failure by returning a non-zero rt_code and filling an
+ * rt_error (a code and a one-line message without position: the interpreter
+ * adds file:line:col). Engines never print and never exit.
+ *
+ * Memory: engines allocate with malloc/free. The interpreter checks every
+ * user-controlled size against its limits *before* calling an engine, so an
+ * engine only has to handle malloc returning NULL (RT_ENOMEM), never to
+ * decide how much is too much.
+ */
+#ifndef RT_H
+#define RT_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <signal.h>
+
+typedef enum rt_code {
+    RT_OK = 0,
+    RT_ENOMEM,   /* allocation failed */
+    RT_EIO,      /* a file could not be read or written */
+    RT_EFORMAT,  /* a file is not in the expected format, or is corrupt */
+    RT_EINVAL,   /* invalid parameters (validation failed) */
+    RT_ECANCEL,  /* interrupted by the user (Ctrl-C) */
+} rt_code;
+
+typedef struct rt_error {
+    rt_code code;
+    char msg[512];
+} rt_error;
+
+/* Fill e (if not NULL) with code and a printf-style message; returns code. */
+rt_code rt_fail(rt_error *e, rt_code code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+
+    ;
+
+/* Settings an evaluation runs under. Passed by pointer to engines that loop
+ * over many points; NULL means: one thread, no cancel, no progress. */
+typedef struct rt_run {
+    int threads;                        /* >= 1 */
+    volatile sig_atomic_t *cancel;      /* non-zero: stop soon, RT_ECANCEL */
+    int progress;                       /* show a progress bar on stderr if it is a tty */
+} rt_run;
+
+/* Size of a * b * c ... with overflow check; returns 0 on overflow. */
+size_t rt_mul_size(size_t a, size_t b);
+
+
+
+/* The universal way one engine asks another for values of a scalar field:
+ * evaluate at n points given as separate coordinate arrays (a block, n is at
+ * most a few hundred) and write n values to out. Must be reentrant: it is
+ * called from several threads at once with the same ctx. Engines that sample
+ * a field (textured objects, ray marching, iso-surfaces, volumes) take one of
+ * these, so they work with any field graph, volume or hand-written C. */
+typedef void (*rt_field_fn)(const void *ctx, size_t n, const double *x, const double *y,
+                            const double *z, double *out);
+
+#define RT_BLOCK 256 /* the usual block size for field evaluation */
+#endif
