@@ -35,7 +35,7 @@ typedef struct rt_error {
 rt_code rt_fail(rt_error *e, rt_code code, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
-
+#endif
     ;
 
 /* Settings an evaluation runs under. Passed by pointer to engines that loop
@@ -48,8 +48,6 @@ typedef struct rt_run {
 
 /* Size of a * b * c ... with overflow check; returns 0 on overflow. */
 size_t rt_mul_size(size_t a, size_t b);
-
-
 
 /* The universal way one engine asks another for values of a scalar field:
  * evaluate at n points given as separate coordinate arrays (a block, n is at
