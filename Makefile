@@ -35,13 +35,14 @@ all: $(BUILD)/frac
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+	@echo "CC $<"
+	@$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/libfracrt.a: $(RT_OBJ)
 	rm -f $@
 	ar rcs $@ $^
 
-# stdlib/*.frac are compiled into the binary (see tools/embed.c).
+# The stdlib/ .frac files are compiled into the binary (see tools/embed.c).
 $(BUILD)/embed: tools/embed.c
 	@mkdir -p $(BUILD)
 	$(CC) -std=c11 -O1 -Wall -Wextra -Werror $< -o $@

@@ -1,4 +1,4 @@
-/* stdlib_embed.h — the stdlib/*.frac modules compiled into the binary. */
+/* stdlib_embed.h — the stdlib/ modules (.frac files) compiled into the binary. */
 #ifndef STDLIB_EMBED_H
 #define STDLIB_EMBED_H
 

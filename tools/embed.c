@@ -1,4 +1,4 @@
-/* embed.c — turn stdlib/*.frac into a C file of string constants, so the
+/* embed.c — turn the stdlib/ .frac files into a C file of string constants, so the
  * frac binary carries its standard library and needs no install step.
  * Usage: embed OUT.c FILE.frac... ; module name = file name without .frac. */
 #include <stdio.h>

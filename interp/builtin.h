@@ -1,0 +1,65 @@
+/* builtin.h — native functions callable from scripts.
+ *
+ * Each builtin declares its parameters (name, accepted types, default) in a
+ * table, so argument matching, type checks, error messages ("chaos: argument
+ * 'points' must be a number, got string") and `:help NAME` come from one
+ * place. Types are '|'-separated names: num, int, str, bool, list, vec (list
+ * of numbers), rec, func, any, or an engine class name (image, ifs, …).
+ * A default is literal text ("512", "[0, 0, 0]", "\"png\"", "true", "nil");
+ * NULL means required. A builtin with variadic = 1 receives all positional
+ * arguments as given (named ones still matched by name).
+ */
+#ifndef BUILTIN_H
+#define BUILTIN_H
+
+#include "state.h"
+#include "value.h"
+
+typedef struct bparam {
+    const char *name;
+    const char *type;
+    const char *def;
+} bparam;
+
+#define MAX_ARGS 32
+
+/* args: one slot per declared parameter, in declaration order (defaults
+ * filled in; borrowed). For variadic builtins, args[0..nargs-1] are the
+ * positional arguments followed by the named parameters. Write the result
+ * (a new reference) to *out; return 0, or -1 after recording an error. */
+typedef int (*builtin_fn)(interp *I, value *args, int nargs, value *out);
+
+typedef struct builtin {
+    const char *name;
+    builtin_fn fn;
+    const bparam *params;
+    int nparams;
+    int variadic;
+    const char *doc; /* one paragraph for :help */
+} builtin;
+
+#define BUILTIN(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 0, doc}
+#define BUILTIN_VAR(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 1, doc}
+
+/* Register a table of builtins (static storage) as globals. */
+int builtins_register(interp *I, const builtin *b, int n);
+/* All modules' registration functions, called by interp setup. */
+int builtins_core_init(interp *I);
+int builtins_image_init(interp *I);
+/* Engine bindings (interp/bind_*.c), registered by bindings.c. */
+int bindings_init(interp *I);
+
+/* Call any function value with positional arguments (borrowed). */
+int call_value(interp *I, value fn, const value *args, int nargs, value *out);
+
+/* Helpers for builtins. */
+int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* Check that v is a list of n numbers (n = 0: any length); copy to out. */
+int get_vec(interp *I, value v, double *out, size_t n, const char *what);
+int get_int(interp *I, value v, long lo, long hi, long *out, const char *what);
+/* Signature text "name(a, b: num = 2)" for help. */
+void builtin_signature(const builtin *b, struct bytebuf *out);
+const builtin *builtin_find(interp *I, const char *name);
+
+#endif

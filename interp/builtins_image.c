@@ -1,0 +1,372 @@
+/* builtins_image.c — the image type in the language, and generic save/load. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "eval.h"
+#include "fileio.h"
+#include "image.h"
+#include "lexer.h"
+#include "lang_image.h"
+
+static void image_destroy(void *p)
+{
+    image *im = p;
+    image_free(im);
+    free(im);
+}
+
+static void image_summary(const void *p, bytebuf *out)
+{
+    const image *im = p;
+    bytebuf_printf(out, "image %d×%d RGBA", im->w, im->h);
+}
+
+static int image_get(interp *I, const void *p, const char *name, value *out)
+{
+    const image *im = p;
+    (void)I;
+    if (strcmp(name, "width") == 0)
+        *out = val_num(im->w);
+    else if (strcmp(name, "height") == 0)
+        *out = val_num(im->h);
+    else
+        return 1;
+    return 0;
+}
+
+static int image_arith(interp *I, int op, value a, value b, value *out);
+static int image_save_hook(interp *I, const void *p, const char *path, value opts);
+
+const obj_class image_class = {
+    .name = "image",
+    .destroy = image_destroy,
+    .summary = image_summary,
+    .arith = image_arith,
+    .get = image_get,
+    .show = NULL,
+    .save = image_save_hook,
+};
+
+int lang_image_new(interp *I, int w, int h, image **out)
+{
+    *out = NULL;
+    if (w < 1 || h < 1)
+        return err_at(I, NULL, ERR_VALUE, "image size %d×%d must be at least 1×1", w, h);
+    if ((double)w * (double)h > I->lim.max_pixels)
+        return err_at(I, NULL, ERR_LIMIT,
+                      "image of %d×%d pixels exceeds the limit of %.0f pixels (raise it with --max-pixels)",
+                      w, h, I->lim.max_pixels);
+    image *im = malloc(sizeof *im);
+    if (!im)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    rt_error e;
+    if (image_init(im, w, h, &e)) {
+        free(im);
+        return err_at(I, NULL, ERR_MEMORY, "%s", e.msg);
+    }
+    *out = im;
+    return 0;
+}
+
+int lang_image_value(interp *I, image *im, value *out)
+{
+    *out = val_obj(I, &image_class, im);
+    return out->k == V_NIL ? -1 : 0;
+}
+
+image *lang_as_image(value v)
+{
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &image_class ? AS_OBJ(v)->payload : NULL;
+}
+
+int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
+{
+    if (v.k == V_NUM) {
+        rgba[0] = rgba[1] = rgba[2] = (float)v.u.n;
+        rgba[3] = 1;
+        return 0;
+    }
+    if (v.k == V_LIST && (AS_LIST(v)->n == 3 || AS_LIST(v)->n == 4)) {
+        double c[4] = {0, 0, 0, 1};
+        if (get_vec(I, v, c, AS_LIST(v)->n, what))
+            return -1;
+        for (int i = 0; i < 4; i++)
+            rgba[i] = (float)c[i];
+        return 0;
+    }
+    if (v.k == V_STR && AS_STR(v)->s[0] == '#' && (AS_STR(v)->len == 7 || AS_STR(v)->len == 9)) {
+        unsigned x[4] = {0, 0, 0, 255};
+        int n = (int)(AS_STR(v)->len - 1) / 2;
+        for (int i = 0; i < n; i++) {
+            char hex[3] = {AS_STR(v)->s[1 + 2 * i], AS_STR(v)->s[2 + 2 * i], 0};
+            char *end;
+            x[i] = (unsigned)strtoul(hex, &end, 16);
+            if (*end)
+                return err_at(I, NULL, ERR_VALUE, "%s: \"%s\" is not a colour like \"#ff8800\"", what,
+                              AS_STR(v)->s);
+        }
+        for (int i = 0; i < 4; i++)
+            rgba[i] = (float)x[i] / 255.0f;
+        return 0;
+    }
+    return err_at(I, NULL, ERR_TYPE,
+                  "%s must be a colour: a grey level, [r, g, b], [r, g, b, a] or \"#rrggbb\", got %s", what,
+                  val_type_name(v));
+}
+
+/* ---- arithmetic: element-wise on pixels (all four channels) --------------------- */
+
+static float fop(int op, float x, float y)
+{
+    switch (op) {
+    case T_PLUS: return x + y;
+    case T_MINUS: return x - y;
+    case T_STAR: return x * y;
+    case T_SLASH: return x / y;
+    case T_CARET: return powf(x, y);
+    case 512: return x > y ? x : y;
+    case 513: return x < y ? x : y;
+    default: return x;
+    }
+}
+
+static int image_arith(interp *I, int op, value a, value b, value *out)
+{
+    image *x = lang_as_image(a), *y = lang_as_image(b);
+    int binary = op == T_PLUS || op == T_MINUS || op == T_STAR || op == T_SLASH || op == T_CARET ||
+                 op == 512 || op == 513;
+    if (op == '-' && x && b.k == V_NIL) {
+        b = val_num(-1);
+        op = T_STAR;
+        binary = 1;
+    }
+    if (!binary)
+        return 0;
+    if ((x && !y && b.k != V_NUM) || (y && !x && a.k != V_NUM))
+        return 0;
+    if (x && y && (x->w != y->w || x->h != y->h))
+        return err_at(I, NULL, ERR_VALUE, "images of different sizes (%d×%d and %d×%d)", x->w, x->h,
+                      y->w, y->h);
+    image *r;
+    const image *shape = x ? x : y;
+    if (lang_image_new(I, shape->w, shape->h, &r))
+        return -1;
+    size_t n = (size_t)shape->w * (size_t)shape->h * 4;
+    for (size_t i = 0; i < n; i++) {
+        float p = x ? x->px[i] : (float)a.u.n;
+        float q = y ? y->px[i] : (float)b.u.n;
+        r->px[i] = fop(op, p, q);
+    }
+    return lang_image_value(I, r, out) ? -1 : 1;
+}
+
+/* ---- builtins ---------------------------------------------------------------------- */
+
+static int get_size(interp *I, value v, int *w, int *h, const char *what)
+{
+    double s[2];
+    if (v.k == V_NUM) {
+        s[0] = s[1] = v.u.n;
+    } else if (get_vec(I, v, s, 2, what)) {
+        return -1;
+    }
+    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
+        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
+                      what, s[0], s[1]);
+    *w = (int)s[0];
+    *h = (int)s[1];
+    return 0;
+}
+
+static int b_image(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    int w, h;
+    float c[4];
+    image *im;
+    if (get_size(I, a[0], &w, &h, "image: size") || lang_get_colour(I, a[1], c, "image: colour") ||
+        lang_image_new(I, w, h, &im))
+        return -1;
+    for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+        memcpy(im->px + 4 * i, c, sizeof c);
+    return lang_image_value(I, im, out);
+}
+
+/* gradient(size, from, to, angle): linear blend along the direction `angle`
+ * (degrees, 0 = left to right, 90 = bottom to top), from pixel centres. */
+static int b_gradient(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    int w, h;
+    float c0[4], c1[4];
+    image *im;
+    if (get_size(I, a[0], &w, &h, "gradient: size") || lang_get_colour(I, a[1], c0, "gradient: from") ||
+        lang_get_colour(I, a[2], c1, "gradient: to"))
+        return -1;
+    double ang = a[3].u.n * 3.14159265358979323846 / 180.0;
+    double dx = cos(ang), dy = sin(ang);
+    /* project the corners to find the range of t */
+    double tmin = 1e300, tmax = -1e300;
+    for (int k = 0; k < 4; k++) {
+        double x = (k & 1) ? w - 0.5 : 0.5, y = (k & 2) ? h - 0.5 : 0.5;
+        double t = x * dx - y * dy;
+        tmin = t < tmin ? t : tmin;
+        tmax = t > tmax ? t : tmax;
+    }
+    if (lang_image_new(I, w, h, &im))
+        return -1;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double t = tmax > tmin ? ((x + 0.5) * dx - (y + 0.5) * dy - tmin) / (tmax - tmin) : 0;
+            float *p = image_at(im, x, y);
+            for (int c = 0; c < 4; c++)
+                p[c] = (float)(c0[c] + (c1[c] - c0[c]) * t);
+        }
+    return lang_image_value(I, im, out);
+}
+
+static int b_checker(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    int w, h;
+    long cell;
+    float c0[4], c1[4];
+    image *im;
+    if (get_size(I, a[0], &w, &h, "checker: size") || get_int(I, a[1], 1, 1000000, &cell, "checker: cell") ||
+        lang_get_colour(I, a[2], c0, "checker: a") || lang_get_colour(I, a[3], c1, "checker: b") ||
+        lang_image_new(I, w, h, &im))
+        return -1;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            memcpy(image_at(im, x, y), ((x / cell + y / cell) & 1) ? c1 : c0, sizeof c0);
+    return lang_image_value(I, im, out);
+}
+
+static int b_pixel(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    image *im = lang_as_image(a[0]);
+    long x, y;
+    if (get_int(I, a[1], 0, im->w - 1, &x, "pixel: x") || get_int(I, a[2], 0, im->h - 1, &y, "pixel: y"))
+        return -1;
+    const float *p = image_at(im, (int)x, (int)y);
+    value l = val_list(I, 4);
+    if (l.k == V_NIL)
+        return -1;
+    for (int c = 0; c < 4; c++)
+        if (list_push(I, AS_LIST(l), val_num(p[c]))) {
+            val_unref(I, l);
+            return -1;
+        }
+    *out = l;
+    return 0;
+}
+
+static int b_load(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    image *im = malloc(sizeof *im);
+    if (!im)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    char path[4096];
+    const char *p = AS_STR(a[0])->s;
+    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
+    if (p[0] == '/' || strcmp(dir, ".") == 0)
+        snprintf(path, sizeof path, "%s", p);
+    else
+        snprintf(path, sizeof path, "%s/%s", dir, p);
+    rt_error e;
+    if (image_load(im, path, &e)) {
+        free(im);
+        return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "load: %s", e.msg);
+    }
+    if ((double)im->w * im->h > I->lim.max_pixels) {
+        image_destroy(im);
+        return err_at(I, NULL, ERR_LIMIT, "load: image exceeds the pixel limit (raise it with --max-pixels)");
+    }
+    return lang_image_value(I, im, out);
+}
+
+int lang_output_path(interp *I, const char *path, char *buf, size_t size)
+{
+    if (path[0] == 0)
+        return err_at(I, NULL, ERR_VALUE, "save: the file name is empty");
+    if (path[0] == '/' || !I->out_dir)
+        snprintf(buf, size, "%s", path);
+    else
+        snprintf(buf, size, "%s/%s", I->out_dir, path);
+    return 0;
+}
+
+static int b_save(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    value v = a[0];
+    if (v.k != V_OBJ || !AS_OBJ(v)->cls->save)
+        return err_at(I, NULL, ERR_TYPE, "save: cannot save %s (images, volumes, meshes… can be saved)",
+                      val_type_name(v));
+    char path[4096];
+    if (lang_output_path(I, AS_STR(a[1])->s, path, sizeof path))
+        return -1;
+    if (AS_OBJ(v)->cls->save(I, AS_OBJ(v)->payload, path, a[2]))
+        return -1;
+    if (!I->quiet && !I->is_repl)
+        fprintf(stderr, "wrote %s\n", path);
+    *out = a[0];
+    val_ref(*out);
+    return 0;
+}
+
+static int image_save_hook(interp *I, const void *p, const char *path, value opts)
+{
+    image_save_opts o = {0, 0};
+    if (opts.k == V_REC) {
+        const char *kb = intern(I, "bits", 4), *kc = intern(I, "channels", 8);
+        value *bits = rec_get(AS_REC(opts), kb), *ch = rec_get(AS_REC(opts), kc);
+        long x;
+        if (bits) {
+            if (get_int(I, *bits, 8, 16, &x, "save: bits") || (x != 8 && x != 16))
+                return I->err.active ? -1 : err_at(I, NULL, ERR_VALUE, "save: bits must be 8 or 16");
+            o.bits = (int)x;
+        }
+        if (ch) {
+            if (get_int(I, *ch, 1, 4, &x, "save: channels"))
+                return -1;
+            o.channels = (int)x;
+        }
+    } else if (opts.k != V_NIL) {
+        return err_at(I, NULL, ERR_TYPE, "save: options must be a record like {bits: 16}, got %s",
+                      val_type_name(opts));
+    }
+    rt_error e;
+    if (image_save(p, path, &o, &e))
+        return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+    return 0;
+}
+
+static const bparam p_image[] = {{"size", "vec|num", NULL}, {"colour", "any", "0"}};
+static const bparam p_gradient[] = {{"size", "vec|num", NULL}, {"from", "any", "0"}, {"to", "any", "1"},
+                                    {"angle", "num", "0"}};
+static const bparam p_checker[] = {{"size", "vec|num", NULL}, {"cell", "int", "8"}, {"a", "any", "0"},
+                                   {"b", "any", "1"}};
+static const bparam p_pixel[] = {{"image", "image", NULL}, {"x", "int", NULL}, {"y", "int", NULL}};
+static const bparam p_load[] = {{"path", "str", NULL}};
+static const bparam p_save[] = {{"value", "any", NULL}, {"path", "str", NULL}, {"options", "rec", "nil"}};
+
+static const builtin image_builtins[] = {
+    BUILTIN("image", b_image, p_image, "A new image of size [w, h] (or n for n×n) filled with a colour."),
+    BUILTIN("gradient", b_gradient, p_gradient,
+            "A linear colour gradient across an image; angle in degrees (0: left to right, 90: bottom to top)."),
+    BUILTIN("checker", b_checker, p_checker, "A checkerboard of two colours with square cells of `cell` pixels."),
+    BUILTIN("pixel", b_pixel, p_pixel, "The [r, g, b, a] of pixel (x, y); (0, 0) is the top-left."),
+    BUILTIN("load", b_load, p_load, "Load an image (PNG, PPM/PGM, PFM), relative to the script's folder."),
+    BUILTIN("save", b_save, p_save,
+            "Save an image (.png .ppm .pgm .pfm), volume or mesh; the extension picks the format. Relative paths go under --out-dir. Options: {bits: 16, channels: 3}."),
+};
+
+int builtins_image_init(interp *I)
+{
+    return builtins_register(I, image_builtins, (int)(sizeof image_builtins / sizeof image_builtins[0]));
+}

@@ -1,0 +1,20 @@
+/* lang_image.h — images as language values (shared by engine bindings). */
+#ifndef LANG_IMAGE_H
+#define LANG_IMAGE_H
+
+#include "image.h"
+#include "state.h"
+
+extern const obj_class image_class;
+
+/* Allocate an image after checking the pixel limit. */
+int lang_image_new(interp *I, int w, int h, image **out);
+/* Wrap (takes ownership). */
+int lang_image_value(interp *I, image *im, value *out);
+image *lang_as_image(value v);
+/* A colour from a grey number, [r,g,b], [r,g,b,a] or "#rrggbb[aa]". */
+int lang_get_colour(interp *I, value v, float rgba[4], const char *what);
+/* Join a relative output path with --out-dir. */
+int lang_output_path(interp *I, const char *path, char *buf, size_t size);
+
+#endif

@@ -1,0 +1,1143 @@
+/* parser.c — recursive descent for statements, precedence climbing (a table
+ * with one row per binary operator) for expressions.
+ *
+ * Newlines end statements and separate table rows; they are skipped inside
+ * (), [] and record braces. In a table row, entries are separated by white
+ * space: a '+' or '-' with space before it and none after starts a new entry
+ * (`0.5 -0.5` is two entries, `0.5 - 0.5` is one), and a call's '(' must
+ * follow the name directly.
+ */
+#include "parser.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "lexer.h"
+
+typedef struct parser {
+    interp *I;
+    token_list tl;
+    size_t pos;
+    int skip_nl;    /* newlines are insignificant here */
+    int table_mode; /* parsing an entry of a table row */
+    int failed;
+} parser;
+
+/* ---- token access ---------------------------------------------------------- */
+
+static token *peek_raw(parser *p) { return &p->tl.toks[p->pos]; }
+
+static token *peek(parser *p)
+{
+    if (p->skip_nl)
+        while (p->tl.toks[p->pos].type == T_NEWLINE)
+            p->pos++;
+    return &p->tl.toks[p->pos];
+}
+
+static token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
+{
+    size_t save = p->pos;
+    peek(p);
+    size_t i = p->pos + 1;
+    p->pos = save;
+    if (p->tl.toks[i - 1].type == T_EOF)
+        return &p->tl.toks[i - 1];
+    if (p->skip_nl)
+        while (p->tl.toks[i].type == T_NEWLINE)
+            i++;
+    return &p->tl.toks[i];
+}
+
+static token *next(parser *p)
+{
+    token *t = peek(p);
+    if (t->type != T_EOF)
+        p->pos++;
+    return t;
+}
+
+static int check(parser *p, tok_type t) { return peek(p)->type == t; }
+
+static int match(parser *p, tok_type t)
+{
+    if (check(p, t)) {
+        next(p);
+        return 1;
+    }
+    return 0;
+}
+
+static void skip_newlines(parser *p)
+{
+    while (peek_raw(p)->type == T_NEWLINE || peek_raw(p)->type == T_SEMI)
+        p->pos++;
+}
+
+static int syntax_error(parser *p, const token *t, const char *fmt, const char *a)
+{
+    if (p->failed)
+        return -1;
+    p->failed = 1;
+    if (t->type == T_ERROR) {
+        err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, "%s", t->err);
+        return -1;
+    }
+    err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, fmt, a);
+    if (t->type == T_EOF)
+        p->I->err.incomplete = 1;
+    return -1;
+}
+
+static const char *tok_desc(const token *t, char *buf, size_t n)
+{
+    if (t->type == T_IDENT || t->type == T_NUMBER || t->type == T_STRING)
+        snprintf(buf, n, "'%.*s'", t->len > 40 ? 40 : t->len, t->start);
+    else
+        snprintf(buf, n, "%s", lex_name(t->type));
+    return buf;
+}
+
+/* Expect token type t; `what` describes the context for the message. */
+static int expect(parser *p, tok_type t, const char *what)
+{
+    token *k = peek(p);
+    if (k->type == t) {
+        next(p);
+        return 0;
+    }
+    char buf[64], msg[256];
+    snprintf(msg, sizeof msg, "expected %s %s, found %%s", lex_name(t), what);
+    return syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
+}
+
+/* Expect a closing bracket; on failure note where it was opened. */
+static int expect_close(parser *p, tok_type t, const token *open)
+{
+    token *k = peek(p);
+    if (k->type == t) {
+        next(p);
+        return 0;
+    }
+    char buf[64], msg[256];
+    snprintf(msg, sizeof msg, "expected %s to close %s opened at line %d, found %%s", lex_name(t),
+             lex_name(open->type), open->line);
+    syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
+    err_state *e = &p->I->err;
+    snprintf(e->note, sizeof e->note, "%s opened here", lex_name(open->type));
+    e->note_src = open->src;
+    e->note_line = open->line;
+    e->note_col = open->col;
+    return -1;
+}
+
+/* ---- node construction --------------------------------------------------- */
+
+static node *mk(parser *p, node_kind k, const token *at)
+{
+    node *n = arena_alloc(p->I, sizeof(node));
+    if (!n) {
+        p->failed = 1;
+        return NULL;
+    }
+    n->kind = k;
+    n->src = at->src;
+    n->line = at->line;
+    n->col = at->col;
+    return n;
+}
+
+typedef struct nodevec {
+    node **v;
+    const char **names;
+    int n, cap;
+} nodevec;
+
+static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
+{
+    if (nv->n == nv->cap) {
+        int nc = nv->cap ? nv->cap * 2 : 8;
+        node **a = arena_alloc(p->I, (size_t)nc * sizeof *a);
+        const char **b = arena_alloc(p->I, (size_t)nc * sizeof *b);
+        if (!a || !b) {
+            p->failed = 1;
+            return -1;
+        }
+        if (nv->n) {
+            memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
+            memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
+        }
+        nv->v = a;
+        nv->names = b;
+        nv->cap = nc;
+    }
+    nv->v[nv->n] = n;
+    nv->names[nv->n] = name;
+    nv->n++;
+    return 0;
+}
+
+static const char *tok_name(parser *p, const token *t)
+{
+    const char *s = intern(p->I, t->start, (size_t)t->len);
+    if (!s)
+        p->failed = 1;
+    return s;
+}
+
+/* Decode a string literal's escapes into the arena. */
+static node *string_node(parser *p, const token *t)
+{
+    node *n = mk(p, N_STR, t);
+    if (!n)
+        return NULL;
+    char *s = arena_alloc(p->I, (size_t)t->len + 1);
+    if (!s)
+        return NULL;
+    size_t k = 0;
+    for (int i = 1; i < t->len - 1; i++) {
+        char c = t->start[i];
+        if (c == '\\') {
+            char e = t->start[++i];
+            switch (e) {
+            case 'n': c = '\n'; break;
+            case 't': c = '\t'; break;
+            case 'r': c = '\r'; break;
+            case '0': c = '\0'; break;
+            case '\\': c = '\\'; break;
+            case '"': c = '"'; break;
+            case '{': c = '{'; break;
+            default: {
+                token bad = *t;
+                bad.col += i - 1;
+                bad.type = T_STRING;
+                syntax_error(p, &bad, "unknown escape sequence '\\%s' in string",
+                             (char[2]){e, 0});
+                return NULL;
+            }
+            }
+        }
+        s[k++] = c;
+    }
+    s[k] = 0;
+    n->str = s;
+    n->slen = k;
+    return n;
+}
+
+/* ---- expressions ----------------------------------------------------------- */
+
+static node *parse_expr(parser *p);
+static node *parse_block_until(parser *p, const token *open, int allow_else);
+static node *parse_lambda_rest(parser *p, const token *at, const char *name);
+
+/* Binary operators, one row each: precedence (higher binds tighter) and
+ * right-associativity. */
+static const struct {
+    tok_type tok;
+    int prec, right;
+} binops[] = {
+    {T_PIPE, 1, 0},  {T_OR, 2, 0},    {T_AND, 3, 0},    {T_EQ, 5, 0},   {T_NE, 5, 0},
+    {T_LT, 5, 0},    {T_LE, 5, 0},    {T_GT, 5, 0},     {T_GE, 5, 0},   {T_PLUS, 6, 0},
+    {T_MINUS, 6, 0}, {T_STAR, 7, 0},  {T_SLASH, 7, 0},  {T_PERCENT, 7, 0}, {T_CARET, 9, 1},
+};
+enum { PREC_NOT = 4, PREC_UNARY = 8 };
+
+static int binop_prec(parser *p, const token *t, int *right)
+{
+    for (size_t i = 0; i < sizeof binops / sizeof binops[0]; i++) {
+        if (binops[i].tok == t->type) {
+            *right = binops[i].right;
+            if (p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
+                const token *after = t + 1;
+                if (!after->space_before && after->type != T_NEWLINE)
+                    return -1; /* `1 -2`: a new entry starts */
+            }
+            return binops[i].prec;
+        }
+    }
+    return -1;
+}
+
+/* args -> '(' [arg {',' arg}] ')' ; arg -> [NAME ':'] expr */
+static int parse_args(parser *p, nodevec *args)
+{
+    token *open = next(p); /* '(' */
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 1;
+    p->table_mode = 0;
+    int named_seen = 0;
+    while (!check(p, T_RPAREN) && !check(p, T_EOF)) {
+        const char *name = NULL;
+        if (check(p, T_IDENT) && peek2(p)->type == T_COLON) {
+            name = tok_name(p, next(p));
+            next(p);
+            named_seen = 1;
+        } else if (named_seen) {
+            syntax_error(p, peek(p), "%s", "positional argument after a named argument");
+            break;
+        }
+        node *a = parse_expr(p);
+        if (!a || nv_push(p, args, a, name))
+            break;
+        if (!match(p, T_COMMA))
+            break;
+    }
+    if (!p->failed)
+        expect_close(p, T_RPAREN, open);
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return p->failed ? -1 : 0;
+}
+
+static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
+{
+    node *c = mk(p, N_CALL, at);
+    if (!c)
+        return NULL;
+    /* report calls at the callee's name, which is what the reader looks for */
+    if (callee->kind == N_NAME || callee->kind == N_FIELD) {
+        c->src = callee->src;
+        c->line = callee->line;
+        c->col = callee->col;
+    }
+    c->nkids = args->n + 1;
+    c->kids = arena_alloc(p->I, (size_t)c->nkids * sizeof(node *));
+    c->names = arena_alloc(p->I, (size_t)c->nkids * sizeof(char *));
+    if (!c->kids || !c->names)
+        return NULL;
+    c->kids[0] = callee;
+    for (int i = 0; i < args->n; i++) {
+        c->kids[i + 1] = args->v[i];
+        c->names[i + 1] = args->names[i];
+    }
+    return c;
+}
+
+static node *parse_brace(parser *p);
+
+/* postfix -> primary { '(' args ')' | '[' expr ']' | '.' NAME | NAME '{' … '}' } */
+static node *parse_postfix(parser *p, node *e)
+{
+    for (;;) {
+        token *t = peek_raw(p);
+        if (p->skip_nl && t->type == T_NEWLINE)
+            t = peek(p);
+        if (p->table_mode && t->space_before)
+            return e;
+        if (t->type == T_LPAREN) {
+            nodevec args = {0};
+            if (parse_args(p, &args))
+                return NULL;
+            e = make_call(p, e, &args, t);
+        } else if (t->type == T_LBRACKET) {
+            token *open = next(p);
+            int save_nl = p->skip_nl, save_tm = p->table_mode;
+            p->skip_nl = 1;
+            p->table_mode = 0;
+            node *ix = parse_expr(p);
+            if (ix)
+                expect_close(p, T_RBRACKET, open);
+            p->skip_nl = save_nl;
+            p->table_mode = save_tm;
+            if (p->failed)
+                return NULL;
+            node *n = mk(p, N_INDEX, open);
+            if (!n)
+                return NULL;
+            n->nkids = 2;
+            n->kids = arena_alloc(p->I, 2 * sizeof(node *));
+            if (!n->kids)
+                return NULL;
+            n->kids[0] = e;
+            n->kids[1] = ix;
+            e = n;
+        } else if (t->type == T_DOT) {
+            next(p);
+            token *name = peek(p);
+            if (name->type != T_IDENT) {
+                char buf[64];
+                syntax_error(p, name, "expected a field name after '.', found %s",
+                             tok_desc(name, buf, sizeof buf));
+                return NULL;
+            }
+            next(p);
+            node *n = mk(p, N_FIELD, t);
+            if (!n)
+                return NULL;
+            n->nkids = 1;
+            n->kids = arena_alloc(p->I, sizeof(node *));
+            if (!n->kids)
+                return NULL;
+            n->kids[0] = e;
+            n->str = tok_name(p, name);
+            e = n;
+        } else if (t->type == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)) {
+            /* `ifs { rows }` is `ifs({ rows })` */
+            node *arg = parse_brace(p);
+            if (!arg)
+                return NULL;
+            nodevec args = {0};
+            if (nv_push(p, &args, arg, NULL))
+                return NULL;
+            e = make_call(p, e, &args, t);
+        } else {
+            return e;
+        }
+        if (!e)
+            return NULL;
+    }
+}
+
+/* params -> '(' [NAME ['=' expr] {',' NAME ['=' expr]}] ')' */
+static int parse_params(parser *p, nodevec *params)
+{
+    token *open = peek(p);
+    if (expect(p, T_LPAREN, "to start the parameter list"))
+        return -1;
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 1;
+    p->table_mode = 0;
+    while (!check(p, T_RPAREN)) {
+        token *t = peek(p);
+        if (t->type != T_IDENT) {
+            char buf[64];
+            syntax_error(p, t, "expected a parameter name, found %s", tok_desc(t, buf, sizeof buf));
+            break;
+        }
+        next(p);
+        const char *name = tok_name(p, t);
+        for (int i = 0; i < params->n; i++)
+            if (params->names[i] == name) {
+                syntax_error(p, t, "duplicate parameter '%s'", name);
+                break;
+            }
+        node *def = NULL;
+        if (match(p, T_ASSIGN)) {
+            def = parse_expr(p);
+            if (!def)
+                break;
+        } else if (params->n && params->v[params->n - 1]) {
+            syntax_error(p, t, "parameter '%s' without a default follows one with a default", name);
+            break;
+        }
+        if (p->failed || nv_push(p, params, def, name))
+            break;
+        if (!match(p, T_COMMA))
+            break;
+    }
+    if (!p->failed)
+        expect_close(p, T_RPAREN, open);
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return p->failed ? -1 : 0;
+}
+
+static node *make_lambda(parser *p, const token *at, nodevec *params, node *body, const char *name)
+{
+    node *l = mk(p, N_LAMBDA, at);
+    if (!l)
+        return NULL;
+    l->nparams = params->n;
+    l->nkids = params->n;
+    l->kids = params->v;
+    l->names = params->names;
+    l->body = body;
+    l->str = name;
+    return l;
+}
+
+/* lambda body -> '=' expr | 'do' block 'end' | '=>' expr */
+static node *parse_lambda_rest(parser *p, const token *at, const char *name)
+{
+    nodevec params = {0};
+    if (parse_params(p, &params))
+        return NULL;
+    node *body;
+    token *t = peek(p);
+    if (t->type == T_ASSIGN || t->type == T_ARROW) {
+        next(p);
+        body = parse_expr(p);
+    } else if (t->type == T_DO) {
+        next(p);
+        body = parse_block_until(p, t, 0);
+        if (body && expect_close(p, T_END, t))
+            return NULL;
+    } else {
+        char buf[64];
+        syntax_error(p, t, "expected '=' or 'do' after the parameter list, found %s",
+                     tok_desc(t, buf, sizeof buf));
+        return NULL;
+    }
+    if (!body)
+        return NULL;
+    return make_lambda(p, at, &params, body, name);
+}
+
+/* Is the '(' at pos the start of `(a, b) => …`? */
+static int is_paren_lambda(parser *p)
+{
+    size_t i = p->pos;
+    int depth = 0;
+    for (;; i++) {
+        tok_type t = p->tl.toks[i].type;
+        if (t == T_EOF)
+            return 0;
+        if (t == T_LPAREN || t == T_LBRACKET || t == T_LBRACE)
+            depth++;
+        else if (t == T_RPAREN || t == T_RBRACKET || t == T_RBRACE) {
+            if (--depth == 0)
+                break;
+        }
+    }
+    i++;
+    while (p->tl.toks[i].type == T_NEWLINE && p->skip_nl)
+        i++;
+    return p->tl.toks[i].type == T_ARROW;
+}
+
+/* brace -> '{' '}' | '{' NAME ':' expr {',' NAME ':' expr} '}' | '{' rows '}' */
+static node *parse_brace(parser *p)
+{
+    token *open = next(p);
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->table_mode = 0;
+    /* look past newlines to decide between record and table */
+    size_t i = p->pos;
+    while (p->tl.toks[i].type == T_NEWLINE)
+        i++;
+    tok_type first = p->tl.toks[i].type;
+    int is_record = first == T_RBRACE || (first == T_IDENT && p->tl.toks[i + 1].type == T_COLON) ||
+                    (first == T_STRING && p->tl.toks[i + 1].type == T_COLON);
+    node *n;
+    if (is_record) {
+        p->skip_nl = 1;
+        n = mk(p, N_RECORD, open);
+        nodevec fields = {0};
+        while (n && !check(p, T_RBRACE)) {
+            token *k = peek(p);
+            const char *key;
+            if (k->type == T_IDENT) {
+                key = tok_name(p, k);
+            } else if (k->type == T_STRING) {
+                node *s = string_node(p, k);
+                key = s ? intern(p->I, s->str, s->slen) : NULL;
+            } else {
+                char buf[64];
+                syntax_error(p, k, "expected a field name in record, found %s", tok_desc(k, buf, sizeof buf));
+                break;
+            }
+            next(p);
+            if (expect(p, T_COLON, "after the field name"))
+                break;
+            node *v = parse_expr(p);
+            if (!v)
+                break;
+            for (int j = 0; j < fields.n; j++)
+                if (fields.names[j] == key) {
+                    syntax_error(p, k, "duplicate field '%s' in record", key);
+                    break;
+                }
+            if (p->failed || nv_push(p, &fields, v, key))
+                break;
+            if (!match(p, T_COMMA))
+                break;
+        }
+        if (n && !p->failed) {
+            expect_close(p, T_RBRACE, open);
+            n->kids = fields.v;
+            n->names = fields.names;
+            n->nkids = fields.n;
+        }
+    } else {
+        /* table: rows separated by newlines or ';', entries by white space or ',' */
+        p->skip_nl = 0;
+        n = mk(p, N_TABLE, open);
+        nodevec rows = {0};
+        skip_newlines(p);
+        while (n && !p->failed && !check(p, T_RBRACE) && !check(p, T_EOF)) {
+            token *rt = peek(p);
+            node *row = mk(p, N_ROW, rt);
+            nodevec entries = {0};
+            while (row && !p->failed) {
+                tok_type t = peek_raw(p)->type;
+                if (t == T_NEWLINE || t == T_SEMI || t == T_RBRACE || t == T_EOF)
+                    break;
+                p->table_mode = 1;
+                node *e = parse_expr(p);
+                p->table_mode = 0;
+                if (!e || nv_push(p, &entries, e, NULL))
+                    break;
+                match(p, T_COMMA);
+            }
+            if (p->failed || !row)
+                break;
+            row->kids = entries.v;
+            row->nkids = entries.n;
+            if (nv_push(p, &rows, row, NULL))
+                break;
+            skip_newlines(p);
+        }
+        if (n && !p->failed) {
+            expect_close(p, T_RBRACE, open);
+            n->kids = rows.v;
+            n->nkids = rows.n;
+        }
+    }
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return p->failed ? NULL : n;
+}
+
+/* list -> '[' ']' | '[' expr {',' expr} [','] ']' | '[' expr 'for' NAME 'in' expr ['if' expr] ']' */
+static node *parse_list(parser *p)
+{
+    token *open = next(p);
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 1;
+    p->table_mode = 0;
+    node *n = mk(p, N_LIST, open);
+    nodevec items = {0};
+    while (n && !check(p, T_RBRACKET) && !check(p, T_EOF)) {
+        node *e = parse_expr(p);
+        if (!e)
+            break;
+        if (items.n == 0 && check(p, T_FOR)) {
+            /* comprehension */
+            next(p);
+            token *var = peek(p);
+            if (var->type != T_IDENT) {
+                char buf[64];
+                syntax_error(p, var, "expected a variable name after 'for', found %s",
+                             tok_desc(var, buf, sizeof buf));
+                break;
+            }
+            next(p);
+            if (expect(p, T_IN, "after the loop variable"))
+                break;
+            node *it = parse_expr(p);
+            if (!it)
+                break;
+            node *cond = NULL;
+            if (match(p, T_IF) && !(cond = parse_expr(p)))
+                break;
+            n->kind = N_COMP;
+            n->str = tok_name(p, var);
+            n->nkids = 3;
+            n->kids = arena_alloc(p->I, 3 * sizeof(node *));
+            if (!n->kids)
+                break;
+            n->kids[0] = e;
+            n->kids[1] = it;
+            n->kids[2] = cond;
+            break;
+        }
+        if (nv_push(p, &items, e, NULL))
+            break;
+        if (!match(p, T_COMMA))
+            break;
+    }
+    if (!p->failed && n) {
+        expect_close(p, T_RBRACKET, open);
+        if (n->kind == N_LIST) {
+            n->kids = items.v;
+            n->nkids = items.n;
+        }
+    }
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return p->failed ? NULL : n;
+}
+
+/* if -> 'if' expr 'then' expr {'elif' expr 'then' expr} ['else' expr] */
+static node *parse_if(parser *p, token *at)
+{
+    node *n = mk(p, N_IF, at);
+    if (!n)
+        return NULL;
+    n->nkids = 3;
+    n->kids = arena_alloc(p->I, 3 * sizeof(node *));
+    if (!n->kids)
+        return NULL;
+    int save_tm = p->table_mode;
+    p->table_mode = 0;
+    n->kids[0] = parse_expr(p);
+    if (!n->kids[0] || expect(p, T_THEN, "after the condition of 'if'"))
+        return NULL;
+    n->kids[1] = parse_expr(p);
+    if (!n->kids[1])
+        return NULL;
+    /* 'else' may start the next line */
+    size_t save = p->pos;
+    while (peek_raw(p)->type == T_NEWLINE)
+        p->pos++;
+    token *t = peek_raw(p);
+    if (t->type == T_ELIF) {
+        next(p);
+        n->kids[2] = parse_if(p, t);
+        if (!n->kids[2])
+            return NULL;
+    } else if (t->type == T_ELSE) {
+        next(p);
+        n->kids[2] = parse_expr(p);
+        if (!n->kids[2])
+            return NULL;
+    } else {
+        p->pos = save;
+    }
+    p->table_mode = save_tm;
+    return n;
+}
+
+static node *parse_primary(parser *p)
+{
+    token *t = peek(p);
+    char buf[64];
+    switch (t->type) {
+    case T_NUMBER: {
+        next(p);
+        node *n = mk(p, N_NUM, t);
+        if (n)
+            n->num = t->num;
+        return n;
+    }
+    case T_STRING:
+        next(p);
+        return string_node(p, t);
+    case T_TRUE:
+    case T_FALSE: {
+        next(p);
+        node *n = mk(p, N_BOOL, t);
+        if (n)
+            n->num = t->type == T_TRUE;
+        return n;
+    }
+    case T_NIL:
+        next(p);
+        return mk(p, N_NIL, t);
+    case T_IDENT: {
+        if (peek2(p)->type == T_ARROW && !p->table_mode) {
+            /* x => expr */
+            next(p);
+            next(p);
+            nodevec params = {0};
+            if (nv_push(p, &params, NULL, tok_name(p, t)))
+                return NULL;
+            node *body = parse_expr(p);
+            return body ? make_lambda(p, t, &params, body, NULL) : NULL;
+        }
+        next(p);
+        node *n = mk(p, N_NAME, t);
+        if (n)
+            n->str = tok_name(p, t);
+        return n;
+    }
+    case T_LPAREN: {
+        if (is_paren_lambda(p)) {
+            node *l = NULL;
+            nodevec params = {0};
+            if (parse_params(p, &params))
+                return NULL;
+            if (expect(p, T_ARROW, "after the parameter list"))
+                return NULL;
+            node *body = parse_expr(p);
+            if (body)
+                l = make_lambda(p, t, &params, body, NULL);
+            return l;
+        }
+        next(p);
+        int save_nl = p->skip_nl, save_tm = p->table_mode;
+        p->skip_nl = 1;
+        p->table_mode = 0;
+        node *e = parse_expr(p);
+        if (e)
+            expect_close(p, T_RPAREN, t);
+        p->skip_nl = save_nl;
+        p->table_mode = save_tm;
+        return p->failed ? NULL : e;
+    }
+    case T_LBRACKET:
+        return parse_list(p);
+    case T_LBRACE:
+        return parse_brace(p);
+    case T_IF:
+        next(p);
+        return parse_if(p, t);
+    case T_DO: {
+        next(p);
+        int save_nl = p->skip_nl, save_tm = p->table_mode;
+        p->skip_nl = 0;
+        p->table_mode = 0;
+        node *b = parse_block_until(p, t, 0);
+        p->skip_nl = save_nl;
+        p->table_mode = save_tm;
+        if (b && expect_close(p, T_END, t))
+            return NULL;
+        return b;
+    }
+    case T_FN: {
+        next(p);
+        int save_nl = p->skip_nl, save_tm = p->table_mode;
+        p->skip_nl = 0;
+        p->table_mode = 0;
+        node *l = parse_lambda_rest(p, t, NULL);
+        p->skip_nl = save_nl;
+        p->table_mode = save_tm;
+        return l;
+    }
+    case T_EOF:
+        syntax_error(p, t, "expected an expression, found %s", "end of input");
+        return NULL;
+    default:
+        syntax_error(p, t, "expected an expression, found %s", tok_desc(t, buf, sizeof buf));
+        return NULL;
+    }
+}
+
+static node *parse_unary(parser *p);
+
+static node *parse_binary(parser *p, int min_prec)
+{
+    node *left;
+    token *t = peek(p);
+    if (t->type == T_NOT && min_prec <= PREC_NOT) {
+        next(p);
+        node *a = parse_binary(p, PREC_NOT);
+        if (!a)
+            return NULL;
+        left = mk(p, N_UNARY, t);
+        if (!left)
+            return NULL;
+        left->op = 'n';
+        left->nkids = 1;
+        left->kids = arena_alloc(p->I, sizeof(node *));
+        if (!left->kids)
+            return NULL;
+        left->kids[0] = a;
+    } else {
+        left = parse_unary(p);
+    }
+    while (left) {
+        /* a pipe may start the next line */
+        token *op = peek_raw(p);
+        if (op->type == T_NEWLINE && !p->table_mode) {
+            size_t i = p->pos;
+            while (p->tl.toks[i].type == T_NEWLINE)
+                i++;
+            if (p->tl.toks[i].type == T_PIPE)
+                p->pos = i;
+        }
+        op = peek(p);
+        int right;
+        int prec = binop_prec(p, op, &right);
+        if (prec < 0 || prec < min_prec)
+            break;
+        next(p);
+        /* operands may continue on the next line after an operator */
+        while (peek_raw(p)->type == T_NEWLINE)
+            p->pos++;
+        if (op->type == T_PIPE) {
+            /* x |> f(a) means f(x, a); x |> f means f(x) */
+            node *rhs = parse_binary(p, prec + 1);
+            if (!rhs)
+                return NULL;
+            nodevec args = {0};
+            if (nv_push(p, &args, left, NULL))
+                return NULL;
+            if (rhs->kind == N_CALL) {
+                for (int i = 1; i < rhs->nkids; i++)
+                    if (nv_push(p, &args, rhs->kids[i], rhs->names[i]))
+                        return NULL;
+                left = make_call(p, rhs->kids[0], &args, op);
+            } else {
+                left = make_call(p, rhs, &args, op);
+            }
+            continue;
+        }
+        node *r = parse_binary(p, right ? prec : prec + 1);
+        if (!r)
+            return NULL;
+        node *b = mk(p, op->type == T_AND ? N_AND : op->type == T_OR ? N_OR : N_BINARY, op);
+        if (!b)
+            return NULL;
+        b->op = op->type;
+        b->nkids = 2;
+        b->kids = arena_alloc(p->I, 2 * sizeof(node *));
+        if (!b->kids)
+            return NULL;
+        b->kids[0] = left;
+        b->kids[1] = r;
+        if (prec == 5) {
+            /* comparisons do not chain: a < b < c is an error */
+            int r2;
+            token *again = peek(p);
+            if (binop_prec(p, again, &r2) == 5) {
+                syntax_error(p, again, "%s", "comparisons cannot be chained; use 'and'");
+                return NULL;
+            }
+        }
+        left = b;
+    }
+    return left;
+}
+
+/* unary -> ('-' | '+') unary | power ; power -> postfix ['^' unary] */
+static node *parse_unary(parser *p)
+{
+    token *t = peek(p);
+    if (t->type == T_MINUS || t->type == T_PLUS) {
+        next(p);
+        node *a = parse_unary(p);
+        if (!a)
+            return NULL;
+        node *n = mk(p, N_UNARY, t);
+        if (!n)
+            return NULL;
+        n->op = t->type == T_MINUS ? '-' : '+';
+        n->nkids = 1;
+        n->kids = arena_alloc(p->I, sizeof(node *));
+        if (!n->kids)
+            return NULL;
+        n->kids[0] = a;
+        return n;
+    }
+    node *base = parse_primary(p);
+    if (!base)
+        return NULL;
+    base = parse_postfix(p, base);
+    if (!base)
+        return NULL;
+    token *op = peek(p);
+    if (op->type == T_CARET) {
+        next(p);
+        node *e = parse_unary(p);
+        if (!e)
+            return NULL;
+        node *b = mk(p, N_BINARY, op);
+        if (!b)
+            return NULL;
+        b->op = T_CARET;
+        b->nkids = 2;
+        b->kids = arena_alloc(p->I, 2 * sizeof(node *));
+        if (!b->kids)
+            return NULL;
+        b->kids[0] = base;
+        b->kids[1] = e;
+        return b;
+    }
+    return base;
+}
+
+static node *parse_expr(parser *p) { return parse_binary(p, 1); }
+
+/* ---- statements ------------------------------------------------------------ */
+
+static node *one_kid(parser *p, node_kind k, const token *at, node *kid, const char *str)
+{
+    node *n = mk(p, k, at);
+    if (!n)
+        return NULL;
+    n->nkids = 1;
+    n->kids = arena_alloc(p->I, sizeof(node *));
+    if (!n->kids)
+        return NULL;
+    n->kids[0] = kid;
+    n->str = str;
+    return n;
+}
+
+static const char *expect_name(parser *p, const char *what)
+{
+    token *t = peek(p);
+    if (t->type != T_IDENT) {
+        char buf[64], msg[128];
+        snprintf(msg, sizeof msg, "expected %s, found %%s", what);
+        syntax_error(p, t, msg, tok_desc(t, buf, sizeof buf));
+        return NULL;
+    }
+    next(p);
+    return tok_name(p, t);
+}
+
+/* Trailing comment on the line of token t (for param docs). */
+static const char *trailing_comment(parser *p, const token *t)
+{
+    const char *s = t->start;
+    while (*s && *s != '\n' && *s != '#')
+        s++;
+    if (*s != '#')
+        return NULL;
+    s++;
+    while (*s == ' ')
+        s++;
+    const char *e = s;
+    while (*e && *e != '\n')
+        e++;
+    char *d = arena_alloc(p->I, (size_t)(e - s) + 1);
+    if (d)
+        memcpy(d, s, (size_t)(e - s));
+    return d;
+}
+
+static node *parse_statement(parser *p)
+{
+    token *t = peek(p);
+    switch (t->type) {
+    case T_LET: {
+        next(p);
+        const char *name = expect_name(p, "a name after 'let'");
+        if (!name || expect(p, T_ASSIGN, "after the name in 'let'"))
+            return NULL;
+        node *v = parse_expr(p);
+        if (v && v->kind == N_LAMBDA && !v->str)
+            v->str = name;
+        return v ? one_kid(p, N_LET, t, v, name) : NULL;
+    }
+    case T_PARAM: {
+        next(p);
+        const char *name = expect_name(p, "a name after 'param'");
+        if (!name || expect(p, T_ASSIGN, "after the name in 'param' (a default value is required)"))
+            return NULL;
+        node *v = parse_expr(p);
+        node *n = v ? one_kid(p, N_PARAM, t, v, name) : NULL;
+        if (n)
+            n->doc = trailing_comment(p, t);
+        return n;
+    }
+    case T_FN: {
+        if (peek2(p)->type != T_IDENT)
+            break; /* an anonymous fn expression */
+        next(p);
+        const char *name = expect_name(p, "a function name");
+        if (!name)
+            return NULL;
+        node *l = parse_lambda_rest(p, t, name);
+        return l ? one_kid(p, N_FNDEF, t, l, name) : NULL;
+    }
+    case T_IMPORT: {
+        next(p);
+        token *s = peek(p);
+        if (s->type != T_STRING) {
+            char buf[64];
+            syntax_error(p, s, "expected a module name in quotes after 'import', found %s",
+                         tok_desc(s, buf, sizeof buf));
+            return NULL;
+        }
+        next(p);
+        node *sn = string_node(p, s);
+        if (!sn)
+            return NULL;
+        node *n = mk(p, N_IMPORT, t);
+        if (!n)
+            return NULL;
+        n->str = sn->str;
+        n->slen = sn->slen;
+        n->names = arena_alloc(p->I, sizeof(char *));
+        if (!n->names)
+            return NULL;
+        if (match(p, T_AS)) {
+            n->names[0] = expect_name(p, "a name after 'as'");
+            if (!n->names[0])
+                return NULL;
+        }
+        return n;
+    }
+    case T_FOR: {
+        next(p);
+        const char *var = expect_name(p, "a variable name after 'for'");
+        if (!var || expect(p, T_IN, "after the loop variable"))
+            return NULL;
+        node *it = parse_expr(p);
+        if (!it)
+            return NULL;
+        token *d = peek(p);
+        if (expect(p, T_DO, "to start the body of 'for'"))
+            return NULL;
+        node *body = parse_block_until(p, d, 0);
+        if (!body || expect_close(p, T_END, d))
+            return NULL;
+        node *n = mk(p, N_FOR, t);
+        if (!n)
+            return NULL;
+        n->str = var;
+        n->nkids = 2;
+        n->kids = arena_alloc(p->I, 2 * sizeof(node *));
+        if (!n->kids)
+            return NULL;
+        n->kids[0] = it;
+        n->kids[1] = body;
+        return n;
+    }
+    case T_IDENT:
+        if (peek2(p)->type == T_ASSIGN) {
+            next(p);
+            next(p);
+            node *v = parse_expr(p);
+            return v ? one_kid(p, N_ASSIGN, t, v, tok_name(p, t)) : NULL;
+        }
+        break;
+    default:
+        break;
+    }
+    node *e = parse_expr(p);
+    return e ? one_kid(p, N_EXPR, t, e, NULL) : NULL;
+}
+
+/* block -> { statement (NEWLINE | ';') } up to 'end' (or 'else' if allowed)
+ * or end of input. */
+static node *parse_block_until(parser *p, const token *open, int allow_else)
+{
+    (void)allow_else;
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 0;
+    p->table_mode = 0;
+    node *b = mk(p, N_BLOCK, open ? open : &p->tl.toks[0]);
+    nodevec stmts = {0};
+    for (;;) {
+        skip_newlines(p);
+        tok_type t = peek_raw(p)->type;
+        if (t == T_EOF || (open && t == T_END))
+            break;
+        if (!open && t == T_END) {
+            syntax_error(p, peek_raw(p), "%s", "'end' without a matching 'do'");
+            break;
+        }
+        node *s = parse_statement(p);
+        if (!s || nv_push(p, &stmts, s, NULL))
+            break;
+        token *after = peek_raw(p);
+        if (after->type != T_NEWLINE && after->type != T_SEMI && after->type != T_EOF &&
+            !(open && after->type == T_END)) {
+            char buf[64];
+            syntax_error(p, after, "expected the end of the statement, found %s",
+                         tok_desc(after, buf, sizeof buf));
+            break;
+        }
+    }
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    if (p->failed || !b)
+        return NULL;
+    b->kids = stmts.v;
+    b->nkids = stmts.n;
+    return b;
+}
+
+int parse_source(interp *I, int src, node **out)
+{
+    parser p;
+    memset(&p, 0, sizeof p);
+    p.I = I;
+    *out = NULL;
+    if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl))
+        return err_pos(I, src, I->srcs[src].first_line, 1, ERR_MEMORY, "out of memory while reading the script");
+    node *b = parse_block_until(&p, NULL, 0);
+    lex_free(&p.tl);
+    if (!b || p.failed) {
+        if (!I->err.active)
+            err_pos(I, src, 1, 1, ERR_MEMORY, "out of memory while parsing");
+        return -1;
+    }
+    *out = b;
+    return 0;
+}

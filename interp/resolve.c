@@ -1,0 +1,232 @@
+/* resolve.c — static name resolution. */
+#include "resolve.h"
+
+#include <string.h>
+
+#include "eval.h"
+#include "parser.h"
+
+typedef struct scope {
+    const char **names;
+    int n, cap;
+    struct scope *parent;
+} scope;
+
+typedef struct resolver {
+    interp *I;
+    env *globals;
+    const char *visiting[64]; /* modules being scanned (cycle guard) */
+    int nvisiting;
+} resolver;
+
+static int declare(resolver *r, scope *s, const char *name)
+{
+    if (s->n == s->cap) {
+        int nc = s->cap ? s->cap * 2 : 16;
+        const char **nn = mem_realloc(r->I, s->names, (size_t)nc * sizeof *nn);
+        if (!nn)
+            return -1;
+        s->names = nn;
+        s->cap = nc;
+    }
+    s->names[s->n++] = name;
+    return 0;
+}
+
+static int visible(resolver *r, scope *s, const char *name)
+{
+    for (; s; s = s->parent)
+        for (int i = 0; i < s->n; i++)
+            if (s->names[i] == name)
+                return 1;
+    return env_lookup(r->globals, name) != NULL;
+}
+
+static int unknown(resolver *r, scope *s, const node *at, const char *name)
+{
+    /* gather candidates from every scope and the globals */
+    const char **c = NULL;
+    size_t n = 0, cap = 0;
+    for (scope *t = s; t; t = t->parent)
+        for (int i = 0; i < t->n; i++) {
+            if (n == cap) {
+                cap = cap ? cap * 2 : 64;
+                const char **nc = mem_realloc(r->I, c, cap * sizeof *nc);
+                if (!nc) {
+                    mem_free(r->I, c);
+                    return -1;
+                }
+                c = nc;
+            }
+            c[n++] = t->names[i];
+        }
+    for (env *e = r->globals; e; e = e->parent)
+        for (size_t i = 0; i < e->n; i++) {
+            if (n == cap) {
+                cap = cap ? cap * 2 : 64;
+                const char **nc = mem_realloc(r->I, c, cap * sizeof *nc);
+                if (!nc) {
+                    mem_free(r->I, c);
+                    return -1;
+                }
+                c = nc;
+            }
+            c[n++] = e->names[i];
+        }
+    const char *sug = suggest_name(name, c, n);
+    err_at(r->I, at, ERR_NAME, "unknown name '%s'%s%s%s", name, sug ? " (did you mean '" : "",
+           sug ? sug : "", sug ? "'?)" : "");
+    mem_free(r->I, c);
+    return -1;
+}
+
+static int resolve_node(resolver *r, scope *s, const node *n);
+static int resolve_block(resolver *r, scope *s, const node *b);
+
+static int module_names(resolver *r, scope *s, const node *imp)
+{
+    /* Parse the module (not run it) and declare its top-level names. */
+    env *m;
+    (void)m;
+    const char *name = imp->str;
+    for (int i = 0; i < r->nvisiting; i++)
+        if (strcmp(r->visiting[i], name) == 0)
+            return err_at(r->I, imp, ERR_VALUE, "import cycle: \"%s\" is already being imported", name);
+    /* Loading a module only defines things (modules are libraries), so use
+     * the evaluator's loader: it caches the module, detects cycles and
+     * reports errors inside the module at their own positions. */
+    if (eval_import(r->I, imp, name, &m))
+        return -1;
+    if (imp->names[0])
+        return declare(r, s, imp->names[0]);
+    for (size_t i = 0; i < m->n; i++)
+        if (declare(r, s, m->names[i]))
+            return -1;
+    return 0;
+}
+
+static int resolve_lambda(resolver *r, scope *s, const node *l)
+{
+    scope inner = {0};
+    inner.parent = s;
+    int rc = 0;
+    for (int i = 0; i < l->nparams && rc == 0; i++) {
+        if (l->kids[i])
+            rc = resolve_node(r, &inner, l->kids[i]);
+        if (rc == 0)
+            rc = declare(r, &inner, l->names[i]);
+    }
+    if (rc == 0)
+        rc = l->body->kind == N_BLOCK ? resolve_block(r, &inner, l->body) : resolve_node(r, &inner, l->body);
+    mem_free(r->I, inner.names);
+    return rc;
+}
+
+static int resolve_node(resolver *r, scope *s, const node *n)
+{
+    if (!n)
+        return 0;
+    switch (n->kind) {
+    case N_NAME:
+        return visible(r, s, n->str) ? 0 : unknown(r, s, n, n->str);
+    case N_LAMBDA:
+        return resolve_lambda(r, s, n);
+    case N_BLOCK: {
+        scope inner = {0};
+        inner.parent = s;
+        int rc = resolve_block(r, &inner, n);
+        mem_free(r->I, inner.names);
+        return rc;
+    }
+    case N_COMP: {
+        if (resolve_node(r, s, n->kids[1]))
+            return -1;
+        scope inner = {0};
+        inner.parent = s;
+        int rc = declare(r, &inner, n->str);
+        if (rc == 0)
+            rc = resolve_node(r, &inner, n->kids[2]);
+        if (rc == 0)
+            rc = resolve_node(r, &inner, n->kids[0]);
+        mem_free(r->I, inner.names);
+        return rc;
+    }
+    case N_FIELD:
+        return resolve_node(r, s, n->kids[0]);
+    default:
+        for (int i = 0; i < n->nkids; i++)
+            if (resolve_node(r, s, n->kids[i]))
+                return -1;
+        return 0;
+    }
+}
+
+static int resolve_block(resolver *r, scope *s, const node *b)
+{
+    /* functions defined in a block are visible throughout it */
+    for (int i = 0; i < b->nkids; i++)
+        if (b->kids[i]->kind == N_FNDEF && declare(r, s, b->kids[i]->str))
+            return -1;
+    for (int i = 0; i < b->nkids; i++) {
+        const node *st = b->kids[i];
+        switch (st->kind) {
+        case N_LET:
+        case N_PARAM:
+            if (st->kids[0]->kind == N_LAMBDA) {
+                if (declare(r, s, st->str) || resolve_node(r, s, st->kids[0]))
+                    return -1;
+            } else if (resolve_node(r, s, st->kids[0]) || declare(r, s, st->str)) {
+                return -1;
+            }
+            break;
+        case N_ASSIGN:
+            if (!visible(r, s, st->str))
+                return err_at(r->I, st, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
+                              st->str, st->str);
+            if (resolve_node(r, s, st->kids[0]))
+                return -1;
+            break;
+        case N_FNDEF:
+            if (resolve_lambda(r, s, st->kids[0]))
+                return -1;
+            break;
+        case N_IMPORT:
+            if (module_names(r, s, st))
+                return -1;
+            break;
+        case N_FOR: {
+            if (resolve_node(r, s, st->kids[0]))
+                return -1;
+            scope inner = {0};
+            inner.parent = s;
+            int rc = declare(r, &inner, st->str);
+            if (rc == 0)
+                rc = resolve_node(r, &inner, st->kids[1]);
+            mem_free(r->I, inner.names);
+            if (rc)
+                return -1;
+            break;
+        }
+        case N_EXPR:
+            if (resolve_node(r, s, st->kids[0]))
+                return -1;
+            break;
+        default:
+            if (resolve_node(r, s, st))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+int resolve_program(interp *I, const node *prog, env *globals)
+{
+    resolver r;
+    memset(&r, 0, sizeof r);
+    r.I = I;
+    r.globals = globals;
+    scope top = {0};
+    int rc = resolve_block(&r, &top, prog);
+    mem_free(I, top.names);
+    return rc;
+}

@@ -1,0 +1,18 @@
+/* resolve.h — static checks before running: every name used is defined.
+ *
+ * Scopes follow the evaluator: a block's `fn` definitions are visible in the
+ * whole block (so functions can call each other), `let`/`param` names from
+ * their statement on (a `let` of a lambda sees its own name, for recursion),
+ * parameters and loop variables inside their bodies. An import contributes
+ * the top-level names of the module (found by parsing it, not running it).
+ * Unknown names are reported with the nearest known name.
+ */
+#ifndef RESOLVE_H
+#define RESOLVE_H
+
+#include "state.h"
+
+/* Check a parsed program against the names visible in scope `globals`. */
+int resolve_program(interp *I, const node *prog, env *globals);
+
+#endif

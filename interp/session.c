@@ -1,0 +1,91 @@
+/* session.c — interpreter setup and the run-a-source entry point. */
+#include "session.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "eval.h"
+#include "parser.h"
+#include "resolve.h"
+
+int session_setup(interp *I)
+{
+    env *root = env_new(I, NULL);
+    if (!root)
+        return -1;
+    I->globals = root; /* builtins register into the root */
+    if (builtins_core_init(I) || builtins_image_init(I) || bindings_init(I))
+        return -1;
+    I->globals = env_new(I, root);
+    heap_unref(I, &root->h); /* the global scope holds it now */
+    return I->globals ? 0 : -1;
+}
+
+int session_run(interp *I, const char *name, const char *text, size_t len, int check_only, value *last)
+{
+    return session_run_lines(I, name, text, len, 1, check_only, last);
+}
+
+int session_run_lines(interp *I, const char *name, const char *text, size_t len, int first_line,
+                      int check_only, value *last)
+{
+    int src = interp_add_source(I, name, text, len);
+    if (src < 0)
+        return -1;
+    I->srcs[src].first_line = first_line;
+    node *prog;
+    if (parse_source(I, src, &prog))
+        return -1;
+    if (resolve_program(I, prog, I->globals))
+        return -1;
+    {
+        /* collect params (for `check --params` and to validate -D names) */
+        for (int i = 0; i < prog->nkids; i++) {
+            const node *s = prog->kids[i];
+            if (s->kind != N_PARAM)
+                continue;
+            if (I->nparams == I->cap_params) {
+                int nc = I->cap_params ? I->cap_params * 2 : 16;
+                void *np = mem_realloc(I, I->params, (size_t)nc * sizeof *I->params);
+                if (!np)
+                    return -1;
+                I->params = np;
+                I->cap_params = nc;
+            }
+            I->params[I->nparams].name = s->str;
+            I->params[I->nparams].decl = s;
+            I->nparams++;
+        }
+    }
+    if (I->depth == 0 && !I->is_repl) {
+        for (int k = 0; k < I->noverrides; k++) {
+            int found = 0;
+            const char *cands[256];
+            int nc = 0;
+            for (int p = 0; p < I->nparams; p++) {
+                found |= I->params[p].name == I->overrides[k].name;
+                if (nc < 256)
+                    cands[nc++] = I->params[p].name;
+            }
+            if (!found) {
+                const char *s = suggest_name(I->overrides[k].name, cands, (size_t)nc);
+                return err_pos(I, -1, 0, 0, ERR_USAGE, "-D %s: the script has no param '%s'%s%s%s",
+                               I->overrides[k].name, I->overrides[k].name, s ? " (did you mean '" : "",
+                               s ? s : "", s ? "'?)" : "");
+            }
+        }
+    }
+    if (check_only)
+        return 0;
+    return eval_block(I, I->globals, prog, last);
+}
+
+int session_report(interp *I)
+{
+    if (!I->err.active)
+        return 0;
+    fflush(stdout);
+    diag_print(I, stderr, &I->err);
+    return err_kind_exit(I->err.kind);
+}

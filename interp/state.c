@@ -1,0 +1,420 @@
+/* state.c — interpreter state: allocation hook, names, sources, errors and
+ * the one diagnostic printer. */
+#include "state.h"
+
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fileio.h"
+
+const char *err_kind_name(err_kind k)
+{
+    static const char *names[] = {
+#define X(id, name, code) name,
+        ERROR_KINDS(X)
+#undef X
+    };
+    return names[k];
+}
+
+int err_kind_exit(err_kind k)
+{
+    static const int codes[] = {
+#define X(id, name, code) code,
+        ERROR_KINDS(X)
+#undef X
+    };
+    return codes[k];
+}
+
+/* ---- allocation ---------------------------------------------------------- */
+
+typedef struct memhdr {
+    size_t size;
+    size_t pad; /* keep 16-byte alignment */
+} memhdr;
+
+static int mem_check(interp *I, size_t n)
+{
+    I->alloc_count++;
+    if (I->fail_alloc_at && I->alloc_count == I->fail_alloc_at) {
+        err_at(I, NULL, ERR_MEMORY, "out of memory (allocation %ld failed, as --fail-alloc asked)",
+               I->alloc_count);
+        return -1;
+    }
+    if (n > I->lim.max_memory || I->mem_used > I->lim.max_memory - n) {
+        err_at(I, NULL, ERR_LIMIT,
+               "memory limit of %.0f MiB exceeded (raise it with --max-memory MiB)",
+               (double)I->lim.max_memory / 1048576.0);
+        return -1;
+    }
+    return 0;
+}
+
+void *mem_alloc(interp *I, size_t n)
+{
+    if (mem_check(I, n))
+        return NULL;
+    memhdr *h = malloc(sizeof(memhdr) + n);
+    if (!h) {
+        err_at(I, NULL, ERR_MEMORY, "out of memory (allocating %zu bytes)", n);
+        return NULL;
+    }
+    h->size = n;
+    I->mem_used += n;
+    return h + 1;
+}
+
+void *mem_realloc(interp *I, void *p, size_t n)
+{
+    if (!p)
+        return mem_alloc(I, n);
+    memhdr *h = (memhdr *)p - 1;
+    size_t old = h->size;
+    if (n > old && mem_check(I, n - old))
+        return NULL;
+    memhdr *nh = realloc(h, sizeof(memhdr) + n);
+    if (!nh) {
+        err_at(I, NULL, ERR_MEMORY, "out of memory (allocating %zu bytes)", n);
+        return NULL;
+    }
+    nh->size = n;
+    I->mem_used = I->mem_used - old + n;
+    return nh + 1;
+}
+
+void mem_free(interp *I, void *p)
+{
+    if (!p)
+        return;
+    memhdr *h = (memhdr *)p - 1;
+    I->mem_used -= h->size;
+    free(h);
+}
+
+int mem_reserve(interp *I, double bytes, const char *what)
+{
+    if (bytes < 0 || bytes > (double)I->lim.max_memory ||
+        (double)I->mem_used + bytes > (double)I->lim.max_memory)
+        return err_at(I, NULL, ERR_LIMIT,
+                      "%s needs %.0f MiB, over the memory limit of %.0f MiB (%.0f MiB in use; raise "
+                      "it with --max-memory MiB)",
+                      what, bytes / 1048576.0, (double)I->lim.max_memory / 1048576.0,
+                      (double)I->mem_used / 1048576.0);
+    I->mem_used += (size_t)bytes;
+    return 0;
+}
+
+void mem_release(interp *I, size_t bytes)
+{
+    I->mem_used = bytes > I->mem_used ? 0 : I->mem_used - bytes;
+}
+
+/* ---- arena for syntax trees --------------------------------------------- */
+
+typedef struct arena_block {
+    struct arena_block *next;
+    size_t used, cap;
+    max_align_t data[];
+} arena_block;
+
+void *arena_alloc(interp *I, size_t n)
+{
+    n = (n + 15) & ~(size_t)15;
+    arena_block *b = I->arena;
+    if (!b || b->used + n > b->cap) {
+        size_t cap = n > 65536 ? n : 65536;
+        b = mem_alloc(I, sizeof(arena_block) + cap);
+        if (!b)
+            return NULL;
+        b->cap = cap;
+        b->used = 0;
+        b->next = I->arena;
+        I->arena = b;
+    }
+    void *p = (char *)b->data + b->used;
+    b->used += n;
+    memset(p, 0, n);
+    return p;
+}
+
+/* ---- interned names ------------------------------------------------------- */
+
+static uint64_t hash_bytes(const char *s, size_t n)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ (unsigned char)s[i]) * 1099511628211ull;
+    return h;
+}
+
+const char *intern(interp *I, const char *s, size_t len)
+{
+    if (I->intern_n * 2 >= I->intern_cap) {
+        size_t nc = I->intern_cap ? I->intern_cap * 2 : 1024;
+        char **nt = mem_alloc(I, nc * sizeof *nt);
+        if (!nt)
+            return NULL;
+        memset(nt, 0, nc * sizeof *nt);
+        for (size_t i = 0; i < I->intern_cap; i++) {
+            char *e = I->intern_tab[i];
+            if (!e)
+                continue;
+            size_t j = hash_bytes(e, strlen(e)) & (nc - 1);
+            while (nt[j])
+                j = (j + 1) & (nc - 1);
+            nt[j] = e;
+        }
+        mem_free(I, I->intern_tab);
+        I->intern_tab = nt;
+        I->intern_cap = nc;
+    }
+    size_t j = hash_bytes(s, len) & (I->intern_cap - 1);
+    while (I->intern_tab[j]) {
+        char *e = I->intern_tab[j];
+        if (strncmp(e, s, len) == 0 && e[len] == 0)
+            return e;
+        j = (j + 1) & (I->intern_cap - 1);
+    }
+    char *e = mem_alloc(I, len + 1);
+    if (!e)
+        return NULL;
+    memcpy(e, s, len);
+    e[len] = 0;
+    I->intern_tab[j] = e;
+    I->intern_n++;
+    return e;
+}
+
+/* ---- sources -------------------------------------------------------------- */
+
+static char *dup_str(interp *I, const char *s, size_t n)
+{
+    char *d = mem_alloc(I, n + 1);
+    if (d) {
+        memcpy(d, s, n);
+        d[n] = 0;
+    }
+    return d;
+}
+
+int interp_add_source(interp *I, const char *name, const char *text, size_t len)
+{
+    if (I->nsrc == I->cap_src) {
+        int nc = I->cap_src ? I->cap_src * 2 : 8;
+        source *ns = mem_realloc(I, I->srcs, (size_t)nc * sizeof *ns);
+        if (!ns)
+            return -1;
+        I->srcs = ns;
+        I->cap_src = nc;
+    }
+    source *s = &I->srcs[I->nsrc];
+    s->name = dup_str(I, name, strlen(name));
+    s->text = dup_str(I, text, len);
+    const char *slash = strrchr(name, '/');
+    s->first_line = 1;
+    s->dir = slash ? dup_str(I, name, (size_t)(slash - name)) : dup_str(I, ".", 1);
+    if (!s->name || !s->text || !s->dir)
+        return -1;
+    return I->nsrc++;
+}
+
+/* ---- life cycle ----------------------------------------------------------- */
+
+void interp_init(interp *I)
+{
+    memset(I, 0, sizeof *I);
+    I->lim.max_memory = (size_t)4096 << 20;
+    I->lim.max_depth = 1000;
+    I->lim.max_pixels = 64e6;
+    I->lim.max_points = 1e10;
+    I->lim.max_voxels = 512.0 * 512 * 512;
+    I->lim.max_list = 1e8;
+    I->seed = 1;
+    I->threads = 1;
+    I->out = stdout;
+    I->err.src = -1;
+}
+
+void interp_free(interp *I)
+{
+    heap_free_all(I);
+    for (int i = 0; i < I->nmods; i++)
+        mem_free(I, I->mods[i].key);
+    mem_free(I, I->mods);
+    for (int i = 0; i < I->nsrc; i++) {
+        mem_free(I, I->srcs[i].name);
+        mem_free(I, I->srcs[i].text);
+        mem_free(I, I->srcs[i].dir);
+    }
+    mem_free(I, I->srcs);
+    for (size_t i = 0; i < I->intern_cap; i++)
+        mem_free(I, I->intern_tab[i]);
+    mem_free(I, I->intern_tab);
+    while (I->arena) {
+        arena_block *b = I->arena;
+        I->arena = b->next;
+        mem_free(I, b);
+    }
+    mem_free(I, I->stack);
+    mem_free(I, I->params);
+    mem_free(I, I->overrides);
+    mem_free(I, I->builtins);
+}
+
+/* ---- errors --------------------------------------------------------------- */
+
+static int verr(interp *I, int src, int line, int col, err_kind k, const char *fmt, va_list ap)
+{
+    if (I->err.active)
+        return -1; /* first error wins */
+    err_state *e = &I->err;
+    e->active = 1;
+    e->kind = k;
+    e->src = src;
+    e->line = line;
+    e->col = col;
+    e->note[0] = 0;
+    e->note_src = -1;
+    e->incomplete = 0;
+    vsnprintf(e->msg, sizeof e->msg, fmt, ap);
+    /* call trace, innermost first */
+    e->ntrace = 0;
+    e->trace_dropped = 0;
+    for (int i = I->depth - 1; i >= 0; i--) {
+        if (e->ntrace == MAX_TRACE) {
+            e->trace_dropped = i + 1;
+            break;
+        }
+        const node *c = I->stack[i].call;
+        e->trace[e->ntrace].fname = I->stack[i].fname;
+        e->trace[e->ntrace].src = c ? c->src : -1;
+        e->trace[e->ntrace].line = c ? c->line : 0;
+        e->trace[e->ntrace].col = c ? c->col : 0;
+        e->ntrace++;
+    }
+    return -1;
+}
+
+int err_at(interp *I, const node *at, err_kind k, const char *fmt, ...)
+{
+    if (!at)
+        at = I->cur;
+    va_list ap;
+    va_start(ap, fmt);
+    int r = verr(I, at ? at->src : -1, at ? at->line : 0, at ? at->col : 0, k, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
+int err_pos(interp *I, int src, int line, int col, err_kind k, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int r = verr(I, src, line, col, k, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
+void err_clear(interp *I)
+{
+    memset(&I->err, 0, sizeof I->err);
+    I->err.src = -1;
+}
+
+static void print_line_caret(interp *I, FILE *f, int src, int line, int col)
+{
+    if (src < 0 || src >= I->nsrc || line < 1)
+        return;
+    const char *p = I->srcs[src].text;
+    for (int l = I->srcs[src].first_line; l < line && *p; p++)
+        if (*p == '\n')
+            l++;
+    const char *q = p;
+    while (*q && *q != '\n')
+        q++;
+    int len = (int)(q - p);
+    if (len > 0 && p[len - 1] == '\r')
+        len--;
+    fprintf(f, "%5d | %.*s\n      | ", line, len, p);
+    /* Tabs stay tabs so the caret lines up; other bytes become spaces (one
+     * per UTF-8 character). */
+    for (int i = 0; i < col - 1 && i < len; i++) {
+        unsigned char c = (unsigned char)p[i];
+        if ((c & 0xC0) == 0x80)
+            continue;
+        fputc(c == '\t' ? '\t' : ' ', f);
+    }
+    fputs("^\n", f);
+}
+
+void diag_print(interp *I, FILE *f, const err_state *e)
+{
+    if (e->src >= 0 && e->src < I->nsrc)
+        fprintf(f, "%s:%d:%d: error: %s\n", I->srcs[e->src].name, e->line, e->col, e->msg);
+    else
+        fprintf(f, "frac: error: %s\n", e->msg);
+    print_line_caret(I, f, e->src, e->line, e->col);
+    if (e->note[0]) {
+        if (e->note_src >= 0 && e->note_src < I->nsrc) {
+            fprintf(f, "%s:%d:%d: note: %s\n", I->srcs[e->note_src].name, e->note_line,
+                    e->note_col, e->note);
+            print_line_caret(I, f, e->note_src, e->note_line, e->note_col);
+        } else {
+            fprintf(f, "note: %s\n", e->note);
+        }
+    }
+    for (int i = 0; i < e->ntrace; i++) {
+        const char *fn = e->trace[i].fname ? e->trace[i].fname : "<lambda>";
+        if (e->trace[i].src >= 0 && e->trace[i].src < I->nsrc)
+            fprintf(f, "  in %s, called from %s:%d:%d\n", fn, I->srcs[e->trace[i].src].name,
+                    e->trace[i].line, e->trace[i].col);
+        else
+            fprintf(f, "  in %s\n", fn);
+    }
+    if (e->trace_dropped)
+        fprintf(f, "  … %d more calls\n", e->trace_dropped);
+}
+
+/* ---- suggestions ---------------------------------------------------------- */
+
+static size_t edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 64 || lb > 64)
+        return 99;
+    size_t row[65];
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t prev = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t cur = row[j];
+            size_t sub = prev + (a[i - 1] != b[j - 1]);
+            size_t del = row[j] + 1, ins = row[j - 1] + 1;
+            row[j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+            prev = cur;
+        }
+    }
+    return row[lb];
+}
+
+const char *suggest_name(const char *name, const char *const *cands, size_t n)
+{
+    const char *best = NULL;
+    size_t bestd = 99;
+    size_t len = strlen(name);
+    size_t maxd = len <= 3 ? 1 : len <= 6 ? 2 : 3;
+    for (size_t i = 0; i < n; i++) {
+        if (!cands[i] || strcmp(cands[i], name) == 0)
+            continue;
+        size_t d = edit_distance(name, cands[i]);
+        if (d < bestd || (d == bestd && best && strcmp(cands[i], best) < 0)) {
+            bestd = d;
+            best = cands[i];
+        }
+    }
+    return bestd <= maxd ? best : NULL;
+}

@@ -1,0 +1,175 @@
+/* state.h — the interpreter state, passed as the first argument everywhere.
+ *
+ * Holds the sources (for diagnostics), the interned names, the syntax-tree
+ * arena, the global scope, the limits, the one allocation hook, the current
+ * error and the call stack. There are no mutable globals in interp/.
+ *
+ * Errors: code that detects an error calls one of the err_* functions, which
+ * record the error in I->err (first error wins) and return -1; callers
+ * propagate -1 up to the single catch point (the script runner or the REPL),
+ * which prints it with diag_print and picks the exit code.
+ */
+#ifndef STATE_H
+#define STATE_H
+
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "ast.h"
+#include "value.h"
+
+/* Error classes; the X-macro gives the enum, the name and the exit code
+ * together, so tests can assert on them. */
+#define ERROR_KINDS(X)                                            \
+    X(ERR_USAGE, "usage", 64)                                     \
+    X(ERR_SYNTAX, "syntax", 65)                                   \
+    X(ERR_NAME, "name", 65)                                       \
+    X(ERR_TYPE, "type", 65)                                       \
+    X(ERR_VALUE, "value", 65)                                     \
+    X(ERR_LIMIT, "limit", 65)                                     \
+    X(ERR_IO, "io", 74)                                           \
+    X(ERR_MEMORY, "memory", 70)                                   \
+    X(ERR_RUNTIME, "runtime", 70)                                 \
+    X(ERR_INTERRUPT, "interrupted", 130)
+
+typedef enum err_kind {
+#define X(id, name, code) id,
+    ERROR_KINDS(X)
+#undef X
+} err_kind;
+
+const char *err_kind_name(err_kind k);
+int err_kind_exit(err_kind k);
+
+typedef struct frame {
+    const char *fname;    /* function name, or "<lambda>" */
+    const node *call;     /* call site */
+} frame;
+
+#define MAX_TRACE 16
+
+typedef struct err_state {
+    int active;
+    err_kind kind;
+    char msg[1024];
+    char note[512];        /* optional extra line, e.g. "'(' opened here" */
+    int src, line, col;    /* position (src < 0: none) */
+    int note_src, note_line, note_col;
+    int incomplete;        /* syntax error at end of input (REPL continues) */
+    int ntrace;
+    struct { const char *fname; int src, line, col; } trace[MAX_TRACE];
+    int trace_dropped;
+} err_state;
+
+typedef struct source {
+    char *name; /* as shown in diagnostics */
+    char *text;
+    char *dir;  /* directory for relative imports */
+    int first_line; /* line number of the text's first line (REPL entries) */
+} source;
+
+typedef struct limits {
+    size_t max_memory;   /* bytes the interpreter may allocate (--max-memory) */
+    int max_depth;       /* call depth (--max-depth) */
+    double max_pixels;   /* per image (--max-pixels) */
+    double max_points;   /* chaos game points, samples (--max-points) */
+    double max_voxels;   /* per volume (--max-voxels) */
+    double max_list;     /* list length (--max-list) */
+} limits;
+
+typedef struct param_override {
+    const char *name; /* interned */
+    const char *text; /* value text from -D */
+    int used;
+} param_override;
+
+typedef struct module {
+    char *key;        /* "std:NAME" or canonical path */
+    int state;        /* 1 loading, 2 loaded */
+    env *exports;     /* the module's top-level scope */
+} module;
+
+typedef struct builtin builtin;
+
+typedef struct interp {
+    /* allocation */
+    size_t mem_used;
+    limits lim;
+    long fail_alloc_at; /* testing: fail the N-th allocation (0 = never) */
+    long alloc_count;
+
+    /* sources, names, syntax trees */
+    source *srcs;
+    int nsrc, cap_src;
+    char **intern_tab;
+    size_t intern_n, intern_cap;
+    struct arena_block *arena;
+
+    /* scopes and values */
+    heap *heap_all;
+    env *globals;
+    module *mods;
+    int nmods, cap_mods;
+    param_override *overrides;
+    int noverrides;
+    /* params declared (for `frac check --params`) */
+    struct { const char *name; const node *decl; } *params;
+    int nparams, cap_params;
+    int list_params;     /* check --params: collect, do not evaluate */
+
+    /* evaluation */
+    int depth;
+    frame *stack;
+    int stack_cap;
+    const node *cur;     /* node being evaluated (for builtin errors) */
+    err_state err;
+    volatile sig_atomic_t *interrupt;
+
+    /* settings */
+    uint64_t seed;
+    int threads;
+    int quiet;
+    int progress;
+    const char *out_dir; /* NULL: current directory */
+    int is_repl;
+    FILE *out;           /* where print() writes (stdout) */
+
+    /* builtin registry */
+    const builtin **builtins;
+    int nbuiltins, cap_builtins;
+} interp;
+
+/* Allocation hook: every interpreter allocation goes through here; it
+ * enforces lim.max_memory and records an ERR_MEMORY/ERR_LIMIT error on
+ * failure (returning NULL). Sizes are tracked with a small header. */
+void *mem_alloc(interp *I, size_t n);
+void *mem_realloc(interp *I, void *p, size_t n);
+void mem_free(interp *I, void *p);
+/* Reserve bytes for an engine allocation made with malloc by the runtime
+ * (images, volumes…): checked against the same budget; release when freed. */
+int mem_reserve(interp *I, double bytes, const char *what);
+void mem_release(interp *I, size_t bytes);
+
+void interp_init(interp *I);
+void interp_free(interp *I);
+int interp_add_source(interp *I, const char *name, const char *text, size_t len);
+const char *intern(interp *I, const char *s, size_t len);
+void *arena_alloc(interp *I, size_t n);
+
+/* Record an error at a node's position (or at I->cur when at is NULL). */
+int err_at(interp *I, const node *at, err_kind k, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+int err_pos(interp *I, int src, int line, int col, err_kind k, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+void err_clear(interp *I);
+
+/* The one function that prints positions: `file:line:col: error: msg`,
+ * the source line and a caret; then the note and the call trace. */
+void diag_print(interp *I, FILE *f, const err_state *e);
+
+/* Names closest to `name` among candidates, for "did you mean" (NULL if none
+ * is close enough). */
+const char *suggest_name(const char *name, const char *const *cands, size_t n);
+
+#endif

@@ -1,0 +1,457 @@
+/* value.c — heap values, reference counting, environments, printing. */
+#include "value.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "fileio.h"
+#include "state.h"
+
+static void *heap_new(interp *I, size_t size, int kind)
+{
+    heap *h = mem_alloc(I, size);
+    if (!h)
+        return NULL;
+    memset(h, 0, size);
+    h->rc = 1;
+    h->kind = (uint8_t)kind;
+    h->prev = NULL;
+    h->next = I->heap_all;
+    if (I->heap_all)
+        I->heap_all->prev = h;
+    I->heap_all = h;
+    return h;
+}
+
+static void heap_unlink(interp *I, heap *h)
+{
+    if (h->prev)
+        h->prev->next = h->next;
+    else
+        I->heap_all = h->next;
+    if (h->next)
+        h->next->prev = h->prev;
+}
+
+/* Free the object's own storage; children are dropped by the caller. */
+static void heap_destroy(interp *I, heap *h, int drop_children)
+{
+    switch (h->kind) {
+    case H_STR:
+        break;
+    case H_LIST: {
+        vlist *l = (vlist *)h;
+        if (drop_children)
+            for (size_t i = 0; i < l->n; i++)
+                val_unref(I, l->items[i]);
+        mem_free(I, l->items);
+        break;
+    }
+    case H_REC: {
+        vrec *r = (vrec *)h;
+        if (drop_children)
+            for (size_t i = 0; i < r->n; i++)
+                val_unref(I, r->vals[i]);
+        mem_free(I, r->keys);
+        mem_free(I, r->vals);
+        break;
+    }
+    case H_FUNC: {
+        vfunc *f = (vfunc *)h;
+        if (drop_children && f->closure)
+            heap_unref(I, &f->closure->h);
+        break;
+    }
+    case H_ENV: {
+        env *e = (env *)h;
+        if (drop_children) {
+            for (size_t i = 0; i < e->n; i++)
+                val_unref(I, e->vals[i]);
+            if (e->parent)
+                heap_unref(I, &e->parent->h);
+        }
+        mem_free(I, e->names);
+        mem_free(I, e->vals);
+        break;
+    }
+    case H_OBJ: {
+        vobj *o = (vobj *)h;
+        if (o->cls->destroy)
+            o->cls->destroy(o->payload);
+        break;
+    }
+    }
+    heap_unlink(I, h);
+    mem_free(I, h);
+}
+
+void heap_unref(interp *I, heap *h)
+{
+    if (h && --h->rc == 0)
+        heap_destroy(I, h, 1);
+}
+
+void val_ref(value v)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN)
+        v.u.h->rc++;
+}
+
+void val_unref(interp *I, value v)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN)
+        heap_unref(I, v.u.h);
+}
+
+void heap_free_all(interp *I)
+{
+    while (I->heap_all)
+        heap_destroy(I, I->heap_all, 0);
+}
+
+value val_str(interp *I, const char *s, size_t len)
+{
+    vstr *str = heap_new(I, sizeof(vstr) + len + 1, H_STR);
+    if (!str)
+        return val_nil();
+    memcpy(str->s, s, len);
+    str->s[len] = 0;
+    str->len = len;
+    value v;
+    v.k = V_STR;
+    v.u.h = &str->h;
+    return v;
+}
+
+value val_cstr(interp *I, const char *s) { return val_str(I, s, strlen(s)); }
+
+value val_list(interp *I, size_t cap)
+{
+    vlist *l = heap_new(I, sizeof(vlist), H_LIST);
+    if (!l)
+        return val_nil();
+    if (cap) {
+        l->items = mem_alloc(I, cap * sizeof(value));
+        if (!l->items) {
+            heap_destroy(I, &l->h, 0);
+            return val_nil();
+        }
+        l->cap = cap;
+    }
+    value v;
+    v.k = V_LIST;
+    v.u.h = &l->h;
+    return v;
+}
+
+int list_push(interp *I, vlist *l, value v)
+{
+    if (l->n == l->cap) {
+        if ((double)l->n + 1 > I->lim.max_list) {
+            val_unref(I, v);
+            return err_at(I, NULL, ERR_LIMIT, "list longer than %.0f items (raise it with --max-list)",
+                          I->lim.max_list);
+        }
+        size_t nc = l->cap ? l->cap * 2 : 8;
+        value *ni = mem_realloc(I, l->items, nc * sizeof(value));
+        if (!ni) {
+            val_unref(I, v);
+            return -1;
+        }
+        l->items = ni;
+        l->cap = nc;
+    }
+    l->items[l->n++] = v;
+    return 0;
+}
+
+value val_rec(interp *I)
+{
+    vrec *r = heap_new(I, sizeof(vrec), H_REC);
+    value v;
+    if (!r)
+        return val_nil();
+    v.k = V_REC;
+    v.u.h = &r->h;
+    return v;
+}
+
+value *rec_get(const vrec *r, const char *key)
+{
+    for (size_t i = 0; i < r->n; i++)
+        if (r->keys[i] == key)
+            return &r->vals[i];
+    return NULL;
+}
+
+int rec_set(interp *I, vrec *r, const char *key, value v)
+{
+    value *old = rec_get(r, key);
+    if (old) {
+        val_unref(I, *old);
+        *old = v;
+        return 0;
+    }
+    if (r->n == r->cap) {
+        size_t nc = r->cap ? r->cap * 2 : 4;
+        const char **nk = mem_realloc(I, r->keys, nc * sizeof *nk);
+        if (!nk) {
+            val_unref(I, v);
+            return -1;
+        }
+        r->keys = nk;
+        value *nv = mem_realloc(I, r->vals, nc * sizeof *nv);
+        if (!nv) {
+            val_unref(I, v);
+            return -1;
+        }
+        r->vals = nv;
+        r->cap = nc;
+    }
+    r->keys[r->n] = key;
+    r->vals[r->n] = v;
+    r->n++;
+    return 0;
+}
+
+value val_func(interp *I, const node *lambda, env *closure, const char *name)
+{
+    vfunc *f = heap_new(I, sizeof(vfunc), H_FUNC);
+    if (!f)
+        return val_nil();
+    f->lambda = lambda;
+    f->closure = closure;
+    if (closure)
+        closure->h.rc++;
+    f->name = name;
+    value v;
+    v.k = V_FUNC;
+    v.u.h = &f->h;
+    return v;
+}
+
+value val_obj(interp *I, const obj_class *cls, void *payload)
+{
+    vobj *o = heap_new(I, sizeof(vobj), H_OBJ);
+    if (!o) {
+        if (cls->destroy)
+            cls->destroy(payload);
+        return val_nil();
+    }
+    o->cls = cls;
+    o->payload = payload;
+    value v;
+    v.k = V_OBJ;
+    v.u.h = &o->h;
+    return v;
+}
+
+env *env_new(interp *I, env *parent)
+{
+    env *e = heap_new(I, sizeof(env), H_ENV);
+    if (!e)
+        return NULL;
+    e->parent = parent;
+    if (parent)
+        parent->h.rc++;
+    return e;
+}
+
+int env_define(interp *I, env *e, const char *name, value v)
+{
+    for (size_t i = 0; i < e->n; i++) {
+        if (e->names[i] == name) {
+            val_unref(I, e->vals[i]);
+            e->vals[i] = v;
+            return 0;
+        }
+    }
+    if (e->n == e->cap) {
+        size_t nc = e->cap ? e->cap * 2 : 8;
+        const char **nn = mem_realloc(I, e->names, nc * sizeof *nn);
+        if (!nn) {
+            val_unref(I, v);
+            return -1;
+        }
+        e->names = nn;
+        value *nv = mem_realloc(I, e->vals, nc * sizeof *nv);
+        if (!nv) {
+            val_unref(I, v);
+            return -1;
+        }
+        e->vals = nv;
+        e->cap = nc;
+    }
+    e->names[e->n] = name;
+    e->vals[e->n] = v;
+    e->n++;
+    return 0;
+}
+
+value *env_lookup(env *e, const char *name)
+{
+    for (; e; e = e->parent)
+        for (size_t i = e->n; i-- > 0;)
+            if (e->names[i] == name)
+                return &e->vals[i];
+    return NULL;
+}
+
+const char *val_type_name(value v)
+{
+    switch (v.k) {
+    case V_NIL: return "nil";
+    case V_BOOL: return "boolean";
+    case V_NUM: return "number";
+    case V_STR: return "string";
+    case V_LIST: return "list";
+    case V_REC: return "record";
+    case V_FUNC:
+    case V_BUILTIN: return "function";
+    case V_OBJ: return AS_OBJ(v)->cls->name;
+    }
+    return "value";
+}
+
+int val_truthy(value v)
+{
+    switch (v.k) {
+    case V_NIL: return 0;
+    case V_BOOL: return v.u.b;
+    default: return 1;
+    }
+}
+
+int val_equal(value a, value b)
+{
+    if (a.k != b.k)
+        return 0;
+    switch (a.k) {
+    case V_NIL: return 1;
+    case V_BOOL: return a.u.b == b.u.b;
+    case V_NUM: return a.u.n == b.u.n;
+    case V_STR: return AS_STR(a)->len == AS_STR(b)->len && memcmp(AS_STR(a)->s, AS_STR(b)->s, AS_STR(a)->len) == 0;
+    case V_LIST: {
+        vlist *x = AS_LIST(a), *y = AS_LIST(b);
+        if (x->n != y->n)
+            return 0;
+        for (size_t i = 0; i < x->n; i++)
+            if (!val_equal(x->items[i], y->items[i]))
+                return 0;
+        return 1;
+    }
+    case V_REC: {
+        vrec *x = AS_REC(a), *y = AS_REC(b);
+        if (x->n != y->n)
+            return 0;
+        for (size_t i = 0; i < x->n; i++) {
+            value *o = rec_get(y, x->keys[i]);
+            if (!o || !val_equal(x->vals[i], *o))
+                return 0;
+        }
+        return 1;
+    }
+    case V_BUILTIN: return a.u.bi == b.u.bi;
+    default: return a.u.h == b.u.h;
+    }
+}
+
+/* Numbers print in the shortest form that reads back to the same double
+ * (%.17g would show 0.1 as 0.10000000000000001). */
+void fmt_number(double n, char *buf, size_t size)
+{
+    if (isnan(n)) {
+        snprintf(buf, size, "nan");
+        return;
+    }
+    if (isinf(n)) {
+        snprintf(buf, size, n > 0 ? "inf" : "-inf");
+        return;
+    }
+    if (n == floor(n) && fabs(n) < 1e15) {
+        snprintf(buf, size, "%.0f", n == 0 ? 0.0 : n);
+        return;
+    }
+    for (int prec = 1; prec <= 17; prec++) {
+        snprintf(buf, size, "%.*g", prec, n);
+        if (strtod(buf, NULL) == n)
+            return;
+    }
+}
+
+static void print_string_repr(bytebuf *out, const vstr *s)
+{
+    bytebuf_byte(out, '"');
+    for (size_t i = 0; i < s->len; i++) {
+        char c = s->s[i];
+        switch (c) {
+        case '"': bytebuf_append(out, "\\\"", 2); break;
+        case '\\': bytebuf_append(out, "\\\\", 2); break;
+        case '\n': bytebuf_append(out, "\\n", 2); break;
+        case '\t': bytebuf_append(out, "\\t", 2); break;
+        default: bytebuf_byte(out, (unsigned char)c);
+        }
+    }
+    bytebuf_byte(out, '"');
+}
+
+void val_print(interp *I, value v, bytebuf *out, int repr)
+{
+    char buf[64];
+    switch (v.k) {
+    case V_NIL: bytebuf_printf(out, "nil"); break;
+    case V_BOOL: bytebuf_printf(out, v.u.b ? "true" : "false"); break;
+    case V_NUM:
+        fmt_number(v.u.n, buf, sizeof buf);
+        bytebuf_printf(out, "%s", buf);
+        break;
+    case V_STR:
+        if (repr)
+            print_string_repr(out, AS_STR(v));
+        else
+            bytebuf_append(out, AS_STR(v)->s, AS_STR(v)->len);
+        break;
+    case V_LIST: {
+        vlist *l = AS_LIST(v);
+        bytebuf_byte(out, '[');
+        size_t shown = l->n > 1000 ? 1000 : l->n;
+        for (size_t i = 0; i < shown; i++) {
+            if (i)
+                bytebuf_append(out, ", ", 2);
+            val_print(I, l->items[i], out, 1);
+        }
+        if (shown < l->n)
+            bytebuf_printf(out, ", … (%zu items)", l->n);
+        bytebuf_byte(out, ']');
+        break;
+    }
+    case V_REC: {
+        vrec *r = AS_REC(v);
+        bytebuf_byte(out, '{');
+        for (size_t i = 0; i < r->n; i++) {
+            bytebuf_printf(out, "%s%s: ", i ? ", " : "", r->keys[i]);
+            val_print(I, r->vals[i], out, 1);
+        }
+        bytebuf_byte(out, '}');
+        break;
+    }
+    case V_FUNC: {
+        vfunc *f = AS_FUNC(v);
+        bytebuf_printf(out, "<fn %s>", f->name ? f->name : "lambda");
+        break;
+    }
+    case V_BUILTIN: bytebuf_printf(out, "<builtin %s>", v.u.bi->name); break;
+    case V_OBJ: {
+        vobj *o = AS_OBJ(v);
+        if (o->cls->summary)
+            o->cls->summary(o->payload, out);
+        else
+            bytebuf_printf(out, "<%s>", o->cls->name);
+        break;
+    }
+    }
+    (void)I;
+}

@@ -1,0 +1,155 @@
+/* value.h — the values of the language.
+ *
+ * A value is a small tagged struct passed by copy. Numbers, booleans and nil
+ * are immediate; strings, lists, records, closures, environments and engine
+ * objects live on the heap, reference-counted, and every heap object is also
+ * on one list in the interpreter state so a session can free everything at
+ * the end even when closures and their environments form cycles.
+ *
+ * Ownership convention: a function that returns a value (or writes one
+ * through an out-parameter) hands over one reference; arguments are borrowed.
+ * Use val_ref to keep a borrowed value, val_unref to drop an owned one.
+ *
+ * Engine objects (image now; ifs, field, volume, mesh… later) are values of
+ * kind V_OBJ with a class that gives their type name (used in messages), a
+ * destructor and a one-line summary (the REPL prints it).
+ */
+#ifndef VALUE_H
+#define VALUE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+struct interp;
+struct node;
+struct bytebuf;
+
+typedef enum vkind { V_NIL, V_BOOL, V_NUM, V_STR, V_LIST, V_REC, V_FUNC, V_BUILTIN, V_OBJ } vkind;
+
+typedef struct heap {
+    uint32_t rc;
+    uint8_t kind; /* H_* */
+    struct heap *prev, *next;
+} heap;
+
+enum { H_STR, H_LIST, H_REC, H_FUNC, H_ENV, H_OBJ };
+
+typedef struct value {
+    vkind k;
+    union {
+        int b;
+        double n;
+        heap *h;
+        const struct builtin *bi;
+    } u;
+} value;
+
+typedef struct vstr {
+    heap h;
+    size_t len;
+    char s[]; /* NUL-terminated */
+} vstr;
+
+typedef struct vlist {
+    heap h;
+    size_t n, cap;
+    value *items;
+} vlist;
+
+typedef struct vrec {
+    heap h;
+    size_t n, cap;
+    const char **keys; /* interned */
+    value *vals;
+} vrec;
+
+typedef struct env env;
+
+typedef struct vfunc {
+    heap h;
+    const struct node *lambda;
+    env *closure;
+    const char *name; /* interned, may be NULL for anonymous */
+} vfunc;
+
+/* Environments are scopes: a small array of (interned name, value) plus a
+ * parent; the global scope uses the same structure (linear search is fine:
+ * the interpreter never runs per point). */
+struct env {
+    heap h;
+    env *parent;
+    size_t n, cap;
+    const char **names;
+    value *vals;
+};
+
+typedef struct obj_class {
+    const char *name;                              /* "image", "ifs", … */
+    void (*destroy)(void *payload);
+    void (*summary)(const void *payload, struct bytebuf *out); /* one line */
+    /* Optional: arithmetic where either operand is of this class (op is the
+     * token type: T_PLUS…, or '-' 'n' for unary minus/not with b nil).
+     * Return 1 if handled (result in *out), 0 to fall through to the
+     * generic "cannot add image and string" error, -1 on error. */
+    int (*arith)(struct interp *I, int op, value a, value b, value *out);
+    /* Optional: obj.name (a new reference in *out; 0 ok, 1 no such field, -1 error). */
+    int (*get)(struct interp *I, const void *payload, const char *name, value *out);
+    /* Optional: show in the terminal (REPL); NULL: not showable. */
+    int (*show)(struct interp *I, const void *payload, value self);
+    /* Optional: save to a file (path already joined with --out-dir; the
+     * extension picks the format). 0 ok, -1 error. */
+    int (*save)(struct interp *I, const void *payload, const char *path, value opts);
+} obj_class;
+
+typedef struct vobj {
+    heap h;
+    const obj_class *cls;
+    void *payload;
+} vobj;
+
+static inline value val_nil(void) { value v; v.k = V_NIL; v.u.n = 0; return v; }
+static inline value val_bool(int b) { value v; v.k = V_BOOL; v.u.b = b != 0; return v; }
+static inline value val_num(double n) { value v; v.k = V_NUM; v.u.n = n; return v; }
+
+#define AS_STR(v) ((vstr *)(v).u.h)
+#define AS_LIST(v) ((vlist *)(v).u.h)
+#define AS_REC(v) ((vrec *)(v).u.h)
+#define AS_FUNC(v) ((vfunc *)(v).u.h)
+#define AS_OBJ(v) ((vobj *)(v).u.h)
+
+void val_ref(value v);
+void val_unref(struct interp *I, value v);
+void heap_unref(struct interp *I, heap *h);
+
+/* Constructors return a new reference, or a nil value with an out-of-memory
+ * error raised in I (check I->err.active or use the eval helpers). */
+value val_str(struct interp *I, const char *s, size_t len);
+value val_cstr(struct interp *I, const char *s);
+value val_list(struct interp *I, size_t cap);
+int list_push(struct interp *I, vlist *l, value v); /* takes ownership of v */
+value val_rec(struct interp *I);
+int rec_set(struct interp *I, vrec *r, const char *key, value v); /* key interned; takes v */
+value *rec_get(const vrec *r, const char *key);                 /* borrowed, or NULL */
+value val_func(struct interp *I, const struct node *lambda, env *closure, const char *name);
+value val_obj(struct interp *I, const obj_class *cls, void *payload); /* destroys payload on OOM */
+
+env *env_new(struct interp *I, env *parent);
+int env_define(struct interp *I, env *e, const char *name, value v); /* takes v; redefines */
+value *env_lookup(env *e, const char *name);                        /* borrowed, or NULL */
+
+/* The type name used in messages: "number", "string", "list", "image"… */
+const char *val_type_name(value v);
+int val_truthy(value v);
+int val_equal(value a, value b);
+/* Printed form: strings quoted when repr is set (inside lists). */
+void val_print(struct interp *I, value v, struct bytebuf *out, int repr);
+
+/* Free every heap object (end of session): ignores reference counts. */
+void heap_free_all(struct interp *I);
+
+
+
+/* Shortest decimal that reads back to the same double. */
+void fmt_number(double n, char *buf, size_t size);
+
+#endif

@@ -1,0 +1,618 @@
+/* runner.c — the one test runner: C unit tests, language tests, REPL
+ * sessions and golden tests of the examples. Its last line is
+ * "N passed, N failed".
+ *
+ *   runner --frac build/frac [--unit build/tests] [--update-golden] [FILTER]
+ *
+ * Language tests (.frac files under tests/lang/ and tests/regression/) carry their
+ * expectations as comments:
+ *   # expect: TEXT                 next line of stdout, exactly
+ *   # expect error: MESSAGE        a compile-time error at THIS line:
+ *                                  stderr has "FILE:LINE:COL: error: MESSAGE"
+ *   # expect runtime error: MESSAGE  stderr has "error: MESSAGE" (any line)
+ *   # stderr: TEXT                 stderr contains TEXT
+ *   # exit: N                      exit code (default 0; 65 with an error)
+ *   # args: ARGS…                  extra command-line arguments before the script
+ *   # stdin: TEXT                  a line of standard input
+ * REPL tests (.repl files in tests/repl/): lines "in: TEXT" are piped to `frac repl`;
+ * "out: TEXT" lines are the whole stdout, in order; "err: TEXT" must appear
+ * in stderr in order; "exit: N" (default 0).
+ * Golden tests: every examples/NAME.frac runs with --threads 1 and with
+ * --threads 3 into fresh directories; every file written and the stdout must
+ * equal tests/golden/NAME/ byte for byte (both thread counts).
+ * Every program runs with a timeout, in the repository root.
+ */
+#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+typedef struct buf {
+    char *d;
+    size_t n, cap;
+} buf;
+
+static void buf_add(buf *b, const char *s, size_t n)
+{
+    if (b->n + n + 1 > b->cap) {
+        size_t nc = b->cap ? b->cap : 4096;
+        while (nc < b->n + n + 1)
+            nc *= 2;
+        b->d = realloc(b->d, nc);
+        if (!b->d) {
+            perror("runner");
+            exit(2);
+        }
+        b->cap = nc;
+    }
+    memcpy(b->d + b->n, s, n);
+    b->n += n;
+    b->d[b->n] = 0;
+}
+
+static void buf_fmt(buf *b, const char *fmt, ...)
+{
+    char tmp[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    buf_add(b, tmp, k < 0 ? 0 : (size_t)k >= sizeof tmp ? sizeof tmp - 1 : (size_t)k);
+}
+
+static int passed, failed;
+static const char *filter;
+static double timeout_s = 120;
+
+/* Run argv with stdin text (may be NULL), capture stdout/stderr; returns the
+ * exit code, 128+signal, or -1 on timeout. */
+static int run(char *const argv[], const char *in, buf *out, buf *err, double timeout)
+{
+    int pin[2], pout[2], perr[2];
+    if (pipe(pin) || pipe(pout) || pipe(perr)) {
+        perror("pipe");
+        exit(2);
+    }
+    pid_t pid = fork();
+    if (pid < 0) {
+        perror("fork");
+        exit(2);
+    }
+    if (pid == 0) {
+        setpgid(0, 0);
+        dup2(pin[0], 0);
+        dup2(pout[1], 1);
+        dup2(perr[1], 2);
+        close(pin[0]); close(pin[1]); close(pout[0]); close(pout[1]); close(perr[0]); close(perr[1]);
+        execv(argv[0], argv);
+        fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
+        _exit(127);
+    }
+    setpgid(pid, pid);
+    close(pin[0]);
+    close(pout[1]);
+    close(perr[1]);
+    size_t in_len = in ? strlen(in) : 0, in_off = 0;
+    if (!in_len)
+        close(pin[1]);
+    fcntl(pin[1], F_SETFL, O_NONBLOCK);
+    struct timespec t0, t;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int open_out = 1, open_err = 1, open_in = in_len > 0, timed_out = 0;
+    while (open_out || open_err) {
+        struct pollfd fds[3];
+        int nf = 0;
+        if (open_out) fds[nf++] = (struct pollfd){pout[0], POLLIN, 0};
+        if (open_err) fds[nf++] = (struct pollfd){perr[0], POLLIN, 0};
+        if (open_in) fds[nf++] = (struct pollfd){pin[1], POLLOUT, 0};
+        poll(fds, (nfds_t)nf, 100);
+        for (int i = 0; i < nf; i++) {
+            if (!fds[i].revents)
+                continue;
+            if (fds[i].fd == pin[1]) {
+                ssize_t w = write(pin[1], in + in_off, in_len - in_off);
+                if (w > 0)
+                    in_off += (size_t)w;
+                if (w < 0 || in_off == in_len) {
+                    close(pin[1]);
+                    open_in = 0;
+                }
+                continue;
+            }
+            char tmp[65536];
+            ssize_t r = read(fds[i].fd, tmp, sizeof tmp);
+            if (r <= 0) {
+                if (fds[i].fd == pout[0]) open_out = 0; else open_err = 0;
+            } else {
+                buf_add(fds[i].fd == pout[0] ? out : err, tmp, (size_t)r);
+            }
+        }
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        if ((double)(t.tv_sec - t0.tv_sec) + (double)(t.tv_nsec - t0.tv_nsec) * 1e-9 > timeout) {
+            kill(-pid, SIGKILL);
+            timed_out = 1;
+            break;
+        }
+    }
+    if (open_in)
+        close(pin[1]);
+    close(pout[0]);
+    close(perr[0]);
+    int status;
+    waitpid(pid, &status, 0);
+    if (!out->d) buf_add(out, "", 0);
+    if (!err->d) buf_add(err, "", 0);
+    if (timed_out)
+        return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+static void result(const char *name, int ok, buf *why)
+{
+    if (ok) {
+        passed++;
+    } else {
+        failed++;
+        printf("FAIL %s\n%s\n", name, why && why->d ? why->d : "");
+    }
+    fflush(stdout);
+}
+
+static char *read_file(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    buf b = {0};
+    char tmp[65536];
+    size_t r;
+    while ((r = fread(tmp, 1, sizeof tmp, f)) > 0)
+        buf_add(&b, tmp, r);
+    fclose(f);
+    if (!b.d)
+        buf_add(&b, "", 0);
+    if (len)
+        *len = b.n;
+    return b.d;
+}
+
+static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* Sorted list of entries of dir whose names end with ext (NULL: all files). */
+static char **list_dir(const char *dir, const char *ext, int *n)
+{
+    *n = 0;
+    DIR *d = opendir(dir);
+    if (!d)
+        return NULL;
+    char **v = NULL;
+    int cap = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.')
+            continue;
+        size_t l = strlen(e->d_name), el = ext ? strlen(ext) : 0;
+        if (ext && (l < el || strcmp(e->d_name + l - el, ext) != 0))
+            continue;
+        if (*n == cap) {
+            cap = cap ? cap * 2 : 32;
+            v = realloc(v, (size_t)cap * sizeof *v);
+        }
+        v[(*n)++] = strdup(e->d_name);
+    }
+    closedir(d);
+    qsort(v, (size_t)*n, sizeof *v, cmp_str);
+    return v;
+}
+
+static int matches_filter(const char *name) { return !filter || strstr(name, filter); }
+
+/* ---- unit tests ---------------------------------------------------------------- */
+
+static void run_unit(const char *dir)
+{
+    int n;
+    char **names = list_dir(dir, NULL, &n);
+    for (int i = 0; i < n; i++) {
+        if (strncmp(names[i], "test_", 5) != 0 || strchr(names[i], '.') || !matches_filter(names[i]))
+            continue;
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        char *argv[] = {path, NULL};
+        buf out = {0}, err = {0}, why = {0};
+        int rc = run(argv, NULL, &out, &err, timeout_s);
+        char label[512];
+        snprintf(label, sizeof label, "unit/%s", names[i]);
+        if (rc != 0)
+            buf_fmt(&why, "  exit %d%s\n  stdout: %s\n  stderr: %.4000s", rc, rc < 0 ? " (timeout)" : "", out.d, err.d);
+        result(label, rc == 0, &why);
+        free(out.d); free(err.d); free(why.d);
+    }
+}
+
+/* ---- language tests ---------------------------------------------------------------- */
+
+static void run_lang_file(const char *frac, const char *path)
+{
+    size_t len;
+    char *text = read_file(path, &len);
+    if (!text)
+        return;
+    buf expect_out = {0}, in = {0}, why = {0};
+    char *errs[64], *rterrs[64], *stderrs[64];
+    int nerr = 0, nrt = 0, nst = 0, exit_code = -1;
+    char *args[64];
+    int nargs = 0;
+    int line = 1;
+    for (char *p = text; *p;) {
+        char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        char ln[4096];
+        snprintf(ln, sizeof ln, "%.*s", (int)(l < sizeof ln - 1 ? l : sizeof ln - 1), p);
+        char *c = strstr(ln, "# expect: ");
+        if (c) {
+            buf_add(&expect_out, c + 10, strlen(c + 10));
+            buf_add(&expect_out, "\n", 1);
+        } else if ((c = strstr(ln, "# expect error: ")) && nerr < 64) {
+            char m[4200];
+            snprintf(m, sizeof m, "%s:%d:", path, line);
+            errs[nerr] = malloc(strlen(m) + strlen(c + 16) + 16);
+            sprintf(errs[nerr++], "%s\x01%s", m, c + 16);
+        } else if ((c = strstr(ln, "# expect runtime error: ")) && nrt < 64) {
+            rterrs[nrt++] = strdup(c + 24);
+        } else if ((c = strstr(ln, "# stderr: ")) && nst < 64) {
+            stderrs[nst++] = strdup(c + 10);
+        } else if ((c = strstr(ln, "# exit: "))) {
+            exit_code = atoi(c + 8);
+        } else if ((c = strstr(ln, "# stdin: "))) {
+            buf_add(&in, c + 9, strlen(c + 9));
+            buf_add(&in, "\n", 1);
+        } else if ((c = strstr(ln, "# args: "))) {
+            char *tok = strtok(c + 8, " ");
+            while (tok && nargs < 60) {
+                args[nargs++] = strdup(tok);
+                tok = strtok(NULL, " ");
+            }
+        }
+        line++;
+        p = e ? e + 1 : p + l;
+    }
+    if (exit_code < 0)
+        exit_code = (nerr || nrt) ? 65 : 0;
+    char *argv[72];
+    int k = 0;
+    argv[k++] = (char *)frac;
+    argv[k++] = "--quiet";
+    for (int i = 0; i < nargs; i++)
+        argv[k++] = args[i];
+    argv[k++] = (char *)path;
+    argv[k] = NULL;
+    buf out = {0}, err = {0};
+    int rc = run(argv, in.d, &out, &err, 60);
+    int ok = 1;
+    if (rc != exit_code) {
+        ok = 0;
+        buf_fmt(&why, "  exit code %d, expected %d%s\n", rc, exit_code, rc < 0 ? " (timeout)" : "");
+    }
+    const char *eo = expect_out.d ? expect_out.d : "";
+    if (strcmp(out.d, eo) != 0) {
+        ok = 0;
+        buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, eo);
+    }
+    for (int i = 0; i < nerr; i++) {
+        char *sep = strchr(errs[i], '\x01');
+        *sep = 0;
+        const char *msg = sep + 1;
+        /* find a line starting with the position prefix and containing the message */
+        int found = 0;
+        for (char *q = strstr(err.d, errs[i]); q; q = strstr(q + 1, errs[i])) {
+            char *eol = strchr(q, '\n');
+            size_t l = eol ? (size_t)(eol - q) : strlen(q);
+            char tmp[4096];
+            snprintf(tmp, sizeof tmp, "%.*s", (int)(l < 4000 ? l : 4000), q);
+            char want[4200];
+            snprintf(want, sizeof want, "error: %s", msg);
+            if (strstr(tmp, want))
+                found = 1;
+        }
+        if (!found) {
+            ok = 0;
+            buf_fmt(&why, "  missing error at %sCOL: error: %s\n", errs[i], msg);
+        }
+        free(errs[i]);
+    }
+    for (int i = 0; i < nrt; i++) {
+        char want[4200];
+        snprintf(want, sizeof want, "error: %s", rterrs[i]);
+        if (!strstr(err.d, want)) {
+            ok = 0;
+            buf_fmt(&why, "  missing runtime error: %s\n", rterrs[i]);
+        }
+        free(rterrs[i]);
+    }
+    for (int i = 0; i < nst; i++) {
+        if (!strstr(err.d, stderrs[i])) {
+            ok = 0;
+            buf_fmt(&why, "  stderr lacks: %s\n", stderrs[i]);
+        }
+        free(stderrs[i]);
+    }
+    if (!ok)
+        buf_fmt(&why, "  stderr was:\n%.3000s", err.d);
+    result(path, ok, &why);
+    for (int i = 0; i < nargs; i++)
+        free(args[i]);
+    free(text); free(out.d); free(err.d); free(expect_out.d); free(in.d); free(why.d);
+}
+
+static void run_lang_dir(const char *frac, const char *dir)
+{
+    int n;
+    char **names = list_dir(dir, NULL, &n);
+    for (int i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        struct stat st;
+        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+            run_lang_dir(frac, path);
+        } else {
+            size_t l = strlen(names[i]);
+            if (l > 5 && strcmp(names[i] + l - 5, ".frac") == 0 && matches_filter(path) &&
+                strncmp(names[i], "_", 1) != 0) /* _NAME.frac: helpers imported by tests */
+                run_lang_file(frac, path);
+        }
+        free(names[i]);
+    }
+    free(names);
+}
+
+/* ---- REPL sessions ------------------------------------------------------------------ */
+
+static void run_repl_dir(const char *frac, const char *dir)
+{
+    int n;
+    char **names = list_dir(dir, ".repl", &n);
+    for (int i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        if (!matches_filter(path))
+            continue;
+        char *text = read_file(path, NULL);
+        buf in = {0}, want = {0}, why = {0};
+        char *errs[64];
+        int nerr = 0, exit_code = 0;
+        for (char *p = text; p && *p;) {
+            char *e = strchr(p, '\n');
+            size_t l = e ? (size_t)(e - p) : strlen(p);
+            if (strncmp(p, "in: ", 4) == 0) {
+                buf_add(&in, p + 4, l - 4);
+                buf_add(&in, "\n", 1);
+            } else if (strncmp(p, "in:", 3) == 0 && l == 3) {
+                buf_add(&in, "\n", 1);
+            } else if (strncmp(p, "out: ", 5) == 0) {
+                buf_add(&want, p + 5, l - 5);
+                buf_add(&want, "\n", 1);
+            } else if (strncmp(p, "err: ", 5) == 0 && nerr < 64) {
+                errs[nerr++] = strndup(p + 5, l - 5);
+            } else if (strncmp(p, "exit: ", 6) == 0) {
+                exit_code = atoi(p + 6);
+            }
+            p = e ? e + 1 : p + l;
+        }
+        char *argv[] = {(char *)frac, "--quiet", "repl", NULL};
+        buf out = {0}, err = {0};
+        int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
+        int ok = rc == exit_code;
+        if (!ok)
+            buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
+        if (strcmp(out.d, want.d ? want.d : "") != 0) {
+            ok = 0;
+            buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, want.d ? want.d : "");
+        }
+        const char *from = err.d;
+        for (int k = 0; k < nerr; k++) {
+            const char *f = strstr(from, errs[k]);
+            if (!f) {
+                ok = 0;
+                buf_fmt(&why, "  stderr lacks (in order): %s\n", errs[k]);
+            } else {
+                from = f + strlen(errs[k]);
+            }
+            free(errs[k]);
+        }
+        if (!ok)
+            buf_fmt(&why, "  stderr was:\n%.3000s", err.d);
+        result(path, ok, &why);
+        free(text); free(in.d); free(want.d); free(out.d); free(err.d); free(why.d);
+    }
+}
+
+/* ---- golden tests ---------------------------------------------------------------------- */
+
+static int rm_tree(const char *dir)
+{
+    int n;
+    char **names = list_dir(dir, NULL, &n);
+    for (int i = 0; i < n; i++) {
+        char p[4096];
+        snprintf(p, sizeof p, "%s/%s", dir, names[i]);
+        struct stat st;
+        if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
+            rm_tree(p);
+        else
+            unlink(p);
+        free(names[i]);
+    }
+    free(names);
+    return rmdir(dir);
+}
+
+static int write_file(const char *path, const char *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return -1;
+    int ok = fwrite(data, 1, n, f) == n;
+    return (fclose(f) == 0 && ok) ? 0 : -1;
+}
+
+static void run_golden(const char *frac, int update)
+{
+    int n;
+    char **names = list_dir("examples", ".frac", &n);
+    char tmpl[] = "/tmp/frac-golden-XXXXXX";
+    char *tmp = mkdtemp(tmpl);
+    if (!tmp) {
+        perror("mkdtemp");
+        exit(2);
+    }
+    for (int i = 0; i < n; i++) {
+        char script[4096], base[1024], label[1200];
+        snprintf(script, sizeof script, "examples/%s", names[i]);
+        snprintf(base, sizeof base, "%.*s", (int)(strlen(names[i]) - 5), names[i]);
+        snprintf(label, sizeof label, "golden/%s", base);
+        if (!matches_filter(label))
+            continue;
+        const char *threads[] = {"1", "3"};
+        buf why = {0};
+        int ok = 1;
+        for (int t = 0; t < (update ? 1 : 2); t++) {
+            char outdir[4200];
+            snprintf(outdir, sizeof outdir, "%s/%s-%s", tmp, base, threads[t]);
+            mkdir(outdir, 0755);
+            char *argv[] = {(char *)frac, "--quiet", "--threads", (char *)threads[t], "-o", outdir, script, NULL};
+            buf out = {0}, err = {0};
+            int rc = run(argv, NULL, &out, &err, timeout_s);
+            if (rc != 0) {
+                ok = 0;
+                buf_fmt(&why, "  --threads %s: exit %d%s\n  stderr: %.3000s\n", threads[t], rc,
+                        rc < 0 ? " (timeout)" : "", err.d);
+                free(out.d); free(err.d);
+                break;
+            }
+            char gdir[4200];
+            snprintf(gdir, sizeof gdir, "tests/golden/%s", base);
+            if (update) {
+                mkdir("tests/golden", 0755);
+                rm_tree(gdir);
+                mkdir(gdir, 0755);
+                char p[4400];
+                snprintf(p, sizeof p, "%s/stdout.txt", gdir);
+                write_file(p, out.d, out.n);
+            }
+            int nf;
+            char **files = list_dir(outdir, NULL, &nf);
+            for (int f = 0; f < nf; f++) {
+                char op[4400], gp[4400];
+                snprintf(op, sizeof op, "%s/%s", outdir, files[f]);
+                snprintf(gp, sizeof gp, "%s/%s", gdir, files[f]);
+                size_t ol, gl;
+                char *od = read_file(op, &ol);
+                if (update) {
+                    write_file(gp, od, ol);
+                } else {
+                    char *gd = read_file(gp, &gl);
+                    if (!gd) {
+                        ok = 0;
+                        buf_fmt(&why, "  %s: no golden %s (run `make golden` and review the diff)\n",
+                                files[f], gp);
+                    } else if (gl != ol || memcmp(gd, od, ol) != 0) {
+                        ok = 0;
+                        buf_fmt(&why, "  --threads %s: %s differs from %s (%zu vs %zu bytes)\n", threads[t],
+                                files[f], gp, ol, gl);
+                    }
+                    free(gd);
+                }
+                free(od);
+                free(files[f]);
+            }
+            free(files);
+            if (!update) {
+                /* every golden file must be produced, and stdout must match */
+                int ng;
+                char **gfiles = list_dir(gdir, NULL, &ng);
+                if (!gfiles) {
+                    ok = 0;
+                    buf_fmt(&why, "  no goldens in %s (run `make golden`)\n", gdir);
+                }
+                for (int g = 0; g < ng; g++) {
+                    char op[4400];
+                    snprintf(op, sizeof op, "%s/%s", outdir, gfiles[g]);
+                    if (strcmp(gfiles[g], "stdout.txt") == 0) {
+                        char gp[4400];
+                        snprintf(gp, sizeof gp, "%s/stdout.txt", gdir);
+                        char *gd = read_file(gp, NULL);
+                        if (!gd || strcmp(gd, out.d) != 0) {
+                            ok = 0;
+                            buf_fmt(&why, "  stdout differs from %s:\n%.2000s", gp, out.d);
+                        }
+                        free(gd);
+                    } else if (access(op, F_OK) != 0) {
+                        ok = 0;
+                        buf_fmt(&why, "  %s was not written (golden has it)\n", gfiles[g]);
+                    }
+                    free(gfiles[g]);
+                }
+                free(gfiles);
+            }
+            free(out.d);
+            free(err.d);
+        }
+        if (update)
+            printf("updated %s\n", label);
+        else
+            result(label, ok, &why);
+        free(why.d);
+    }
+    rm_tree(tmp);
+}
+
+int main(int argc, char **argv)
+{
+    const char *frac = NULL, *unit = NULL;
+    int update = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--frac") == 0 && i + 1 < argc)
+            frac = argv[++i];
+        else if (strcmp(argv[i], "--unit") == 0 && i + 1 < argc)
+            unit = argv[++i];
+        else if (strcmp(argv[i], "--update-golden") == 0)
+            update = 1;
+        else if (strcmp(argv[i], "--timeout") == 0 && i + 1 < argc)
+            timeout_s = atof(argv[++i]);
+        else
+            filter = argv[i];
+    }
+    if (!frac) {
+        fprintf(stderr, "usage: runner --frac FRAC [--unit DIR] [--update-golden] [FILTER]\n");
+        return 64;
+    }
+    static char fracabs[4096];
+    if (!realpath(frac, fracabs)) {
+        perror(frac);
+        return 2;
+    }
+    if (update) {
+        run_golden(fracabs, 1);
+        return 0;
+    }
+    if (unit)
+        run_unit(unit);
+    run_lang_dir(fracabs, "tests/lang");
+    run_lang_dir(fracabs, "tests/regression");
+    run_repl_dir(fracabs, "tests/repl");
+    run_golden(fracabs, 0);
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
