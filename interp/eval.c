@@ -107,7 +107,7 @@ int eval_binary(interp *I, int op, value a, value b, value *out, const node *at)
     int arith = op == T_PLUS || op == T_MINUS || op == T_STAR || op == T_SLASH || op == T_PERCENT ||
                 op == T_CARET;
     if (arith && (a.k == V_LIST || b.k == V_LIST) &&
-        (a.k == V_LIST || a.k == V_NUM || a.k == V_OBJ) && (b.k == V_LIST || b.k == V_NUM || b.k == V_OBJ)) {
+        (a.k == V_LIST || a.k == V_NUM) && (b.k == V_LIST || b.k == V_NUM)) {
         /* element-wise: vectors are lists of numbers */
         size_t n = a.k == V_LIST ? AS_LIST(a)->n : AS_LIST(b)->n;
         if (a.k == V_LIST && b.k == V_LIST && AS_LIST(a)->n != AS_LIST(b)->n)

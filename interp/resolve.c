@@ -9,8 +9,73 @@
 typedef struct scope {
     const char **names;
     int n, cap;
+    const char **set; /* pointer hash set of names, for large scopes */
+    size_t set_cap;
     struct scope *parent;
 } scope;
+
+static void scope_free(interp *I, scope *s)
+{
+    mem_free(I, s->names);
+    mem_free(I, s->set);
+}
+
+static int set_insert(interp *I, scope *s, const char *name)
+{
+    if (!s->set && s->n > 16) {
+        /* first time: index every name so far */
+        s->set_cap = 64;
+        while (s->set_cap < (size_t)s->n * 2 + 2)
+            s->set_cap *= 2;
+        s->set = mem_alloc(I, s->set_cap * sizeof *s->set);
+        if (!s->set)
+            return -1;
+        memset(s->set, 0, s->set_cap * sizeof *s->set);
+        for (int i = 0; i < s->n; i++) {
+            size_t h = name_hash(s->names[i]) & (s->set_cap - 1);
+            while (s->set[h] && s->set[h] != s->names[i])
+                h = (h + 1) & (s->set_cap - 1);
+            s->set[h] = s->names[i];
+        }
+        return 0;
+    }
+    if ((size_t)s->n * 2 >= s->set_cap) {
+        size_t cap = s->set_cap ? s->set_cap * 2 : 64;
+        const char **ns = mem_alloc(I, cap * sizeof *ns);
+        if (!ns)
+            return -1;
+        memset(ns, 0, cap * sizeof *ns);
+        for (size_t i = 0; i < s->set_cap; i++)
+            if (s->set[i]) {
+                size_t h = name_hash(s->set[i]) & (cap - 1);
+                while (ns[h])
+                    h = (h + 1) & (cap - 1);
+                ns[h] = s->set[i];
+            }
+        mem_free(I, s->set);
+        s->set = ns;
+        s->set_cap = cap;
+    }
+    size_t h = name_hash(name) & (s->set_cap - 1);
+    while (s->set[h] && s->set[h] != name)
+        h = (h + 1) & (s->set_cap - 1);
+    s->set[h] = name;
+    return 0;
+}
+
+static int scope_has(const scope *s, const char *name)
+{
+    if (s->set) {
+        for (size_t h = name_hash(name) & (s->set_cap - 1); s->set[h]; h = (h + 1) & (s->set_cap - 1))
+            if (s->set[h] == name)
+                return 1;
+        return 0;
+    }
+    for (int i = 0; i < s->n; i++)
+        if (s->names[i] == name)
+            return 1;
+    return 0;
+}
 
 typedef struct resolver {
     interp *I;
@@ -30,15 +95,14 @@ static int declare(resolver *r, scope *s, const char *name)
         s->cap = nc;
     }
     s->names[s->n++] = name;
-    return 0;
+    return s->n > 16 ? set_insert(r->I, s, name) : 0;
 }
 
 static int visible(resolver *r, scope *s, const char *name)
 {
     for (; s; s = s->parent)
-        for (int i = 0; i < s->n; i++)
-            if (s->names[i] == name)
-                return 1;
+        if (scope_has(s, name))
+            return 1;
     return env_lookup(r->globals, name) != NULL;
 }
 
@@ -118,7 +182,7 @@ static int resolve_lambda(resolver *r, scope *s, const node *l)
     }
     if (rc == 0)
         rc = l->body->kind == N_BLOCK ? resolve_block(r, &inner, l->body) : resolve_node(r, &inner, l->body);
-    mem_free(r->I, inner.names);
+    scope_free(r->I, &inner);
     return rc;
 }
 
@@ -135,7 +199,7 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         scope inner = {0};
         inner.parent = s;
         int rc = resolve_block(r, &inner, n);
-        mem_free(r->I, inner.names);
+        scope_free(r->I, &inner);
         return rc;
     }
     case N_COMP: {
@@ -148,7 +212,7 @@ static int resolve_node(resolver *r, scope *s, const node *n)
             rc = resolve_node(r, &inner, n->kids[2]);
         if (rc == 0)
             rc = resolve_node(r, &inner, n->kids[0]);
-        mem_free(r->I, inner.names);
+        scope_free(r->I, &inner);
         return rc;
     }
     case N_FIELD:
@@ -202,7 +266,7 @@ static int resolve_block(resolver *r, scope *s, const node *b)
             int rc = declare(r, &inner, st->str);
             if (rc == 0)
                 rc = resolve_node(r, &inner, st->kids[1]);
-            mem_free(r->I, inner.names);
+            scope_free(r->I, &inner);
             if (rc)
                 return -1;
             break;
@@ -227,6 +291,6 @@ int resolve_program(interp *I, const node *prog, env *globals)
     r.globals = globals;
     scope top = {0};
     int rc = resolve_block(&r, &top, prog);
-    mem_free(I, top.names);
+    scope_free(I, &top);
     return rc;
 }

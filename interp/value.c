@@ -75,6 +75,7 @@ static void heap_destroy(interp *I, heap *h, int drop_children)
         }
         mem_free(I, e->names);
         mem_free(I, e->vals);
+        mem_free(I, e->index);
         break;
     }
     case H_OBJ: {
@@ -260,14 +261,49 @@ env *env_new(interp *I, env *parent)
     return e;
 }
 
+static long env_find(const env *e, const char *name)
+{
+    if (e->index) {
+        size_t m = e->index_cap - 1;
+        for (size_t h = name_hash(name) & m; e->index[h]; h = (h + 1) & m)
+            if (e->names[e->index[h] - 1] == name)
+                return (long)e->index[h] - 1;
+        return -1;
+    }
+    for (size_t i = e->n; i-- > 0;)
+        if (e->names[i] == name)
+            return (long)i;
+    return -1;
+}
+
+static int env_reindex(interp *I, env *e)
+{
+    size_t cap = 64;
+    while (cap < e->n * 2 + 2)
+        cap *= 2;
+    uint32_t *ix = mem_alloc(I, cap * sizeof *ix);
+    if (!ix)
+        return -1;
+    memset(ix, 0, cap * sizeof *ix);
+    for (size_t i = 0; i < e->n; i++) {
+        size_t h = name_hash(e->names[i]) & (cap - 1);
+        while (ix[h])
+            h = (h + 1) & (cap - 1);
+        ix[h] = (uint32_t)i + 1;
+    }
+    mem_free(I, e->index);
+    e->index = ix;
+    e->index_cap = cap;
+    return 0;
+}
+
 int env_define(interp *I, env *e, const char *name, value v)
 {
-    for (size_t i = 0; i < e->n; i++) {
-        if (e->names[i] == name) {
-            val_unref(I, e->vals[i]);
-            e->vals[i] = v;
-            return 0;
-        }
+    long at = env_find(e, name);
+    if (at >= 0) {
+        val_unref(I, e->vals[at]);
+        e->vals[at] = v;
+        return 0;
     }
     if (e->n == e->cap) {
         size_t nc = e->cap ? e->cap * 2 : 8;
@@ -288,15 +324,25 @@ int env_define(interp *I, env *e, const char *name, value v)
     e->names[e->n] = name;
     e->vals[e->n] = v;
     e->n++;
+    if (e->n > 16 && (e->n * 2 > e->index_cap)) {
+        if (env_reindex(I, e))
+            return -1;
+    } else if (e->index) {
+        size_t m = e->index_cap - 1, h = name_hash(name) & m;
+        while (e->index[h])
+            h = (h + 1) & m;
+        e->index[h] = (uint32_t)e->n;
+    }
     return 0;
 }
 
 value *env_lookup(env *e, const char *name)
 {
-    for (; e; e = e->parent)
-        for (size_t i = e->n; i-- > 0;)
-            if (e->names[i] == name)
-                return &e->vals[i];
+    for (; e; e = e->parent) {
+        long at = env_find(e, name);
+        if (at >= 0)
+            return &e->vals[at];
+    }
     return NULL;
 }
 

@@ -81,7 +81,18 @@ struct env {
     size_t n, cap;
     const char **names;
     value *vals;
+    uint32_t *index;  /* open addressing: slot + 1, 0 = empty; NULL while small */
+    size_t index_cap;
 };
+
+/* Hash of an interned name (its address). */
+static inline size_t name_hash(const char *name)
+{
+    uint64_t x = (uint64_t)(uintptr_t)name;
+    x ^= x >> 29;
+    x *= 0xbf58476d1ce4e5b9ull;
+    return (size_t)(x ^ (x >> 32));
+}
 
 typedef struct obj_class {
     const char *name;                              /* "image", "ifs", … */
