@@ -438,6 +438,48 @@ static void run_repl_dir(const char *frac, const char *dir)
     }
 }
 
+static int rm_tree(const char *dir);
+
+/* ---- allocation failure ----------------------------------------------------------
+ * Run a script failing the N-th interpreter allocation, for every N until the
+ * script no longer runs out: each run must end with exit 70 and an "out of
+ * memory" message (or succeed once N is past the last allocation) — never a
+ * crash, a sanitizer report or another exit code. */
+static void run_fail_alloc(const char *frac, const char *script)
+{
+    char label[4200];
+    snprintf(label, sizeof label, "fail-alloc/%s", script);
+    if (!matches_filter(label))
+        return;
+    char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
+    char *dir = mkdtemp(tmpl);
+    buf why = {0};
+    int ok = 1, n;
+    for (n = 1; n < 20000; n++) {
+        char num[32];
+        snprintf(num, sizeof num, "%d", n);
+        char *argv[] = {(char *)frac, "--quiet", "--fail-alloc", num, "-o", dir, (char *)script, NULL};
+        buf out = {0}, err = {0};
+        int rc = run(argv, NULL, &out, &err, 60);
+        int oom = strstr(err.d, "out of memory") != NULL;
+        if (rc == 0 && !oom) {
+            free(out.d); free(err.d);
+            break; /* past the last allocation */
+        }
+        if (rc != 70 || !oom) {
+            ok = 0;
+            buf_fmt(&why, "  --fail-alloc %d: exit %d\n  stderr: %.2000s\n", n, rc, err.d);
+            free(out.d); free(err.d);
+            break;
+        }
+        free(out.d); free(err.d);
+    }
+    if (dir)
+        rm_tree(dir);
+    result(label, ok, &why);
+    free(why.d);
+}
+
 /* ---- golden tests ---------------------------------------------------------------------- */
 
 static int rm_tree(const char *dir)
@@ -613,6 +655,8 @@ int main(int argc, char **argv)
     run_lang_dir(fracabs, "tests/regression");
     run_repl_dir(fracabs, "tests/repl");
     run_golden(fracabs, 0);
+    run_fail_alloc(fracabs, "examples/tour.frac");
+    run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

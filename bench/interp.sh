@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Interpreter start-up and front-end speed:
+#   1. `frac -e '1+1'` process time (target ≤ 5 ms)
+#   2. `frac check` on a generated 10,000-line script (target ≤ 50 ms)
+# Usage: bash bench/interp.sh [build/frac]
+set -eu
+frac=${1:-build/frac}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+gen() {
+    local i
+    for ((i = 0; i < 2500; i++)); do
+        echo "let v$i = [$i, $i+1, sqrt($i)] * 2"
+        echo "fn f$i(x, y = $i) = if x > y then x * v$i[0] else y - v$i[2]"
+        echo "let t$i = { 1 2 3; $i -$i 0.5 }"
+        echo "let r$i = f$i($((i % 7))) + len(t$i)  # comment $i"
+    done
+}
+gen > "$tmp/big.frac"
+now() { date +%s%N; }
+best_e=999999999
+for run in 1 2 3; do
+    t0=$(now)
+    for k in $(seq 100); do "$frac" -e '1+1' > /dev/null; done
+    t1=$(now)
+    d=$(((t1 - t0) / 100))
+    [ "$d" -lt "$best_e" ] && best_e=$d
+done
+best_c=999999999
+for run in 1 2 3 4 5; do
+    t0=$(now)
+    "$frac" check "$tmp/big.frac"
+    t1=$(now)
+    d=$((t1 - t0))
+    [ "$d" -lt "$best_c" ] && best_c=$d
+done
+printf 'frac -e 1+1            %6.2f ms per process (target <= 5)\n' "$(awk "BEGIN{print $best_e/1e6}")"
+printf 'frac check 10k lines   %6.2f ms (target <= 50)\n' "$(awk "BEGIN{print $best_c/1e6}")"
