@@ -38,7 +38,7 @@ const char *lex_name(tok_type t)
 static int push(token_list *tl, token t)
 {
     if (tl->n == tl->cap) {
-        size_t nc = tl->cap ? tl->cap * 2 : 256;
+        size_t nc = tl->cap ? tl->cap * 2 : 1024;
         token *nt = realloc(tl->toks, nc * sizeof *nt);
         if (!nt)
             return -1;
@@ -116,7 +116,7 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             }
             space = 1;
         }
-        t.src = src;
+        t.src = (unsigned short)src;
         t.line = line;
         t.col = (int)(p - line_start) + 1;
         t.start = p;

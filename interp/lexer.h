@@ -26,14 +26,16 @@ typedef enum tok_type {
 } tok_type;
 
 typedef struct token {
-    tok_type type;
-    int src;           /* source index (see state.h) */
-    int line, col;     /* 1-based; col counts bytes */
     const char *start; /* into the source text */
+    union {
+        double num;      /* T_NUMBER */
+        const char *err; /* T_ERROR: static message */
+    };
+    int line, col;     /* 1-based; col counts bytes */
     int len;
-    int space_before;  /* white space (or start of line) precedes it */
-    double num;        /* T_NUMBER */
-    const char *err;   /* T_ERROR: static message */
+    unsigned short src; /* source index (see state.h) */
+    unsigned char type; /* tok_type */
+    unsigned char space_before; /* white space (or start of line) precedes it */
 } token;
 
 typedef struct token_list {

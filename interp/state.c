@@ -201,6 +201,8 @@ static char *dup_str(interp *I, const char *s, size_t n)
 
 int interp_add_source(interp *I, const char *name, const char *text, size_t len)
 {
+    if (I->nsrc >= 65535) /* tokens store the source index in 16 bits */
+        return err_pos(I, -1, 0, 0, ERR_LIMIT, "too many sources in one session (65535); start a new one");
     if (I->nsrc == I->cap_src) {
         int nc = I->cap_src ? I->cap_src * 2 : 8;
         source *ns = mem_realloc(I, I->srcs, (size_t)nc * sizeof *ns);
