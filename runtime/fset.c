@@ -1,0 +1,459 @@
+/* fset.c — iterated function sets (seed 003 def. 3.1, 3.2), their orders,
+ * the composition-notation parser and the chaos game with an order. */
+#include "fset.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "par.h"
+#include "rng.h"
+
+#define CHAOS_CHUNK ((uint64_t)1 << 16) /* plotted points per ORBIT chunk */
+
+/* ---- validation ---------------------------------------------------- */
+
+static rt_code check_probs(const double *p, int n, const char *what, rt_error *e)
+{
+    if (!p)
+        return RT_OK;
+    double s = 0;
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(p[i]) || p[i] < 0)
+            return rt_fail(e, RT_EINVAL, "%s: probability %d is %g (expected a number >= 0)", what,
+                           i + 1, p[i]);
+        s += p[i];
+    }
+    if (!(fabs(s - 1) <= 1e-6))
+        return rt_fail(e, RT_EINVAL, "%s: probabilities sum to %.9g (expected 1)", what, s);
+    return RT_OK;
+}
+
+rt_code fset_validate(const fset *fs, rt_error *e)
+{
+    if (!fs || fs->n < 1 || !fs->sets)
+        return rt_fail(e, RT_EINVAL, "function set has no sets (expected at least 1)");
+    int dim = 0;
+    for (int s = 0; s < fs->n; s++) {
+        const fset_ifs *w = &fs->sets[s];
+        char what[48];
+        snprintf(what, sizeof what, "function set W%d", s + 1);
+        if (w->n < 1 || w->n > FSET_MAX_MAPS || !w->maps)
+            return rt_fail(e, RT_EINVAL, "%s has %d maps (expected 1 to %d)", what, w->n,
+                           FSET_MAX_MAPS);
+        for (int m = 0; m < w->n; m++) {
+            const affine *a = &w->maps[m];
+            if (a->dim != 2 && a->dim != 3)
+                return rt_fail(e, RT_EINVAL, "%s: map %d has dimension %d (expected 2 or 3)", what,
+                               m + 1, a->dim);
+            if (!dim)
+                dim = a->dim;
+            if (a->dim != dim)
+                return rt_fail(e, RT_EINVAL,
+                               "%s: map %d is %d-D but the first map is %d-D (expected all the same)",
+                               what, m + 1, a->dim, dim);
+            for (int i = 0; i < 3; i++) {
+                int ok = isfinite(a->t[i]);
+                for (int j = 0; j < 3; j++)
+                    ok &= isfinite(a->m[i][j]);
+                if (!ok)
+                    return rt_fail(e, RT_EINVAL, "%s: map %d has a non-finite coefficient", what,
+                                   m + 1);
+            }
+        }
+        rt_code c = check_probs(w->p, w->n, what, e);
+        if (c)
+            return c;
+    }
+    return RT_OK;
+}
+
+rt_code fset_order_validate(const fset_order *o, int nsets, rt_error *e)
+{
+    if (!o)
+        return rt_fail(e, RT_EINVAL, "order is missing");
+    if (o->kind == FSET_RANDOM)
+        return check_probs(o->p, nsets, "random order", e);
+    if (o->kind != FSET_SEQUENCE && o->kind != FSET_PERIODIC)
+        return rt_fail(e, RT_EINVAL, "order has an unknown kind %d", (int)o->kind);
+    if (o->len < 1 || !o->seq)
+        return rt_fail(e, RT_EINVAL, "order is empty (expected at least one set)");
+    for (int i = 0; i < o->len; i++)
+        if (o->seq[i] < 0 || o->seq[i] >= nsets)
+            return rt_fail(e, RT_EINVAL,
+                           "order step %d names set W%d but the function set has %d sets", i + 1,
+                           o->seq[i] + 1, nsets);
+    return RT_OK;
+}
+
+void fset_cumulative(const double *p, int n, double *cum)
+{
+    double total = 0;
+    for (int i = 0; i < n; i++)
+        total += p ? p[i] : 1.0;
+    double s = 0;
+    for (int i = 0; i < n; i++) {
+        s += p ? p[i] : 1.0;
+        cum[i] = total > 0 ? s / total : (double)(i + 1) / n;
+    }
+    cum[n - 1] = 1.0;
+}
+
+int fset_choose(const double *p, int n, uint64_t h)
+{
+    double u = rng_to_unit(h);
+    if (!p) {
+        int i = (int)(u * n);
+        return i < n ? i : n - 1;
+    }
+    double total = 0, s = 0;
+    for (int i = 0; i < n; i++)
+        total += p[i];
+    for (int i = 0; i < n - 1; i++) {
+        s += p[i];
+        if (u < s / total)
+            return i;
+    }
+    return n - 1;
+}
+
+int fset_order_at(const fset_order *o, int nsets, uint64_t k)
+{
+    /* RANDOM: a pure function of (seed, k), the same σ(k) in every chunk
+     * and every engine. */
+    if (o->kind == FSET_RANDOM)
+        return fset_choose(o->p, nsets, rng_hash3(o->seed, k, 0, 0));
+    return o->seq[k % (uint64_t)o->len];
+}
+
+/* ---- composition notation ------------------------------------------ */
+
+typedef struct scan {
+    const char *s;
+    size_t i;
+} scan;
+
+static size_t char_offset(const scan *sc, size_t byte)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < byte; i++)
+        n += ((unsigned char)sc->s[i] & 0xC0) != 0x80;
+    return n;
+}
+
+static void skip_space(scan *sc)
+{
+    while (sc->s[sc->i] == ' ' || sc->s[sc->i] == '\t' || sc->s[sc->i] == '\n' ||
+           sc->s[sc->i] == '\r')
+        sc->i++;
+}
+
+static int at_operator(const scan *sc, size_t *len)
+{
+    const char *p = sc->s + sc->i;
+    if (p[0] == '*' || p[0] == 'o') {
+        *len = 1;
+        return 1;
+    }
+    if ((unsigned char)p[0] == 0xE2 && (unsigned char)p[1] == 0x88 && (unsigned char)p[2] == 0x98) {
+        *len = 3; /* U+2218 RING OPERATOR */
+        return 1;
+    }
+    return 0;
+}
+
+/* "(K0)" or "(K_0)" at the end. */
+static int at_k0(const scan *sc, size_t *len)
+{
+    const char *p = sc->s + sc->i;
+    const char *forms[] = {"(K0)", "(K_0)", "(k0)", "(k_0)", "(K_{0})"};
+    for (size_t f = 0; f < sizeof forms / sizeof forms[0]; f++) {
+        size_t n = strlen(forms[f]);
+        if (strncmp(p, forms[f], n) == 0) {
+            *len = n;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+rt_code fset_order_parse(const char *text, int nsets, int **seq, int *len, size_t *err_offset,
+                         rt_error *e)
+{
+    *seq = NULL;
+    *len = 0;
+    if (err_offset)
+        *err_offset = 0;
+    scan sc = {text ? text : "", 0};
+    size_t cap = 0, n = 0;
+    int *v = NULL;
+    size_t bad = 0;
+    rt_code code = RT_OK;
+    skip_space(&sc);
+    if (!sc.s[sc.i]) {
+        code = rt_fail(e, RT_EINVAL, "order: empty composition (expected e.g. W2 ∘ W1)");
+        goto fail;
+    }
+    for (;;) {
+        skip_space(&sc);
+        size_t name_at = sc.i;
+        if (sc.s[sc.i] != 'W' && sc.s[sc.i] != 'w') {
+            bad = sc.i;
+            code = rt_fail(e, RT_EINVAL, "order: expected a set name like W3 at character %zu",
+                           char_offset(&sc, bad));
+            goto fail;
+        }
+        sc.i++;
+        if (sc.s[sc.i] == '_')
+            sc.i++;
+        int brace = sc.s[sc.i] == '{';
+        if (brace)
+            sc.i++;
+        if (sc.s[sc.i] < '0' || sc.s[sc.i] > '9') {
+            bad = sc.i;
+            code = rt_fail(e, RT_EINVAL,
+                           "order: expected a set number after 'W' at character %zu",
+                           char_offset(&sc, bad));
+            goto fail;
+        }
+        long idx = 0;
+        while (sc.s[sc.i] >= '0' && sc.s[sc.i] <= '9') {
+            if (idx < 100000000)
+                idx = idx * 10 + (sc.s[sc.i] - '0');
+            sc.i++;
+        }
+        if (brace) {
+            if (sc.s[sc.i] != '}') {
+                bad = sc.i;
+                code = rt_fail(e, RT_EINVAL, "order: expected '}' at character %zu",
+                               char_offset(&sc, bad));
+                goto fail;
+            }
+            sc.i++;
+        }
+        if (idx < 1) {
+            bad = name_at;
+            code = rt_fail(e, RT_EINVAL,
+                           "order: set W%ld at character %zu does not exist (sets are numbered "
+                           "from 1)",
+                           idx, char_offset(&sc, bad));
+            goto fail;
+        }
+        if (nsets > 0 && idx > nsets) {
+            bad = name_at;
+            code = rt_fail(e, RT_EINVAL,
+                           "order: set W%ld at character %zu does not exist (the function set has "
+                           "%d sets)",
+                           idx, char_offset(&sc, bad), nsets);
+            goto fail;
+        }
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            int *nv = realloc(v, cap * sizeof *nv);
+            if (!nv) {
+                code = rt_fail(e, RT_ENOMEM, "out of memory parsing an order");
+                goto fail;
+            }
+            v = nv;
+        }
+        v[n++] = (int)(idx - 1);
+        skip_space(&sc);
+        size_t ol;
+        if (!sc.s[sc.i])
+            break;
+        if (at_k0(&sc, &ol)) {
+            sc.i += ol;
+            skip_space(&sc);
+            if (sc.s[sc.i]) {
+                bad = sc.i;
+                code = rt_fail(e, RT_EINVAL, "order: unexpected text after (K0) at character %zu",
+                               char_offset(&sc, bad));
+                goto fail;
+            }
+            break;
+        }
+        if (!at_operator(&sc, &ol)) {
+            bad = sc.i;
+            code = rt_fail(e, RT_EINVAL,
+                           "order: expected '∘', 'o' or '*' between sets at character %zu",
+                           char_offset(&sc, bad));
+            goto fail;
+        }
+        sc.i += ol;
+    }
+    /* Rightmost is applied first: reverse into application order. */
+    for (size_t i = 0; i < n / 2; i++) {
+        int t = v[i];
+        v[i] = v[n - 1 - i];
+        v[n - 1 - i] = t;
+    }
+    *seq = v;
+    *len = (int)n;
+    return RT_OK;
+fail:
+    free(v);
+    if (err_offset)
+        *err_offset = char_offset(&sc, bad);
+    return code;
+}
+
+/* ---- chaos game ------------------------------------------------------ */
+
+long fset_hist_bin(const hist2 *hs, double x, double y)
+{
+    double fx = (x - hs->lo[0]) / (hs->hi[0] - hs->lo[0]) * hs->w;
+    double fy = (hs->hi[1] - y) / (hs->hi[1] - hs->lo[1]) * hs->h;
+    if (!(fx >= 0 && fx < hs->w && fy >= 0 && fy < hs->h))
+        return -1;
+    int ix = (int)fx, iy = (int)fy;
+    if (ix >= hs->w)
+        ix = hs->w - 1;
+    if (iy >= hs->h)
+        iy = hs->h - 1;
+    return (long)iy * hs->w + ix;
+}
+
+typedef struct chaos_ctx {
+    const fset *fs;
+    const fset_order *o;
+    const fset_chaos_opts *opts;
+    const hist2 *hs;
+    double *cum;      /* fs->n * FSET_MAX_MAPS */
+    uint64_t **count; /* per worker */
+    int failed;       /* a worker could not allocate */
+} chaos_ctx;
+
+static void chaos_step(const chaos_ctx *c, uint64_t k, rng *r, double *x, double *y)
+{
+    int s = fset_order_at(c->o, c->fs->n, k);
+    const fset_ifs *w = &c->fs->sets[s];
+    int m = fset_pick(c->cum + (size_t)s * FSET_MAX_MAPS, w->n, rng_uniform(r));
+    fset_apply2(&w->maps[m], x, y);
+}
+
+static void chaos_orbit(void *p, size_t chunk, int worker)
+{
+    chaos_ctx *c = p;
+    const fset_chaos_opts *op = c->opts;
+    uint64_t *cnt = c->count[worker];
+    uint64_t first = (uint64_t)chunk * CHAOS_CHUNK;
+    uint64_t npts = op->points - first < CHAOS_CHUNK ? op->points - first : CHAOS_CHUNK;
+    uint64_t period = (op->plot_period && c->o->kind != FSET_RANDOM) ? (uint64_t)c->o->len : 1;
+    rng r;
+    rng_init(&r, op->seed, chunk);
+    double x = op->start[0], y = op->start[1];
+    uint64_t k = 0;
+    for (; k < op->burn; k++)
+        chaos_step(c, k, &r, &x, &y);
+    /* Plot after complete periods counted from the orbit's start. */
+    while (k % period)
+        chaos_step(c, k++, &r, &x, &y);
+    for (uint64_t done = 0; done < npts;) {
+        chaos_step(c, k++, &r, &x, &y);
+        if (k % period == 0) {
+            long b = fset_hist_bin(c->hs, x, y);
+            if (b >= 0)
+                cnt[b]++;
+            done++;
+        }
+    }
+}
+
+static void chaos_walk(void *p, size_t chunk, int worker)
+{
+    chaos_ctx *c = p;
+    const fset_chaos_opts *op = c->opts;
+    uint64_t *cnt = c->count[worker];
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
+    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
+    double *pt = malloc(n * 2 * sizeof *pt);
+    if (!pt) {
+        c->failed = 1;
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        pt[2 * i] = op->start[0];
+        pt[2 * i + 1] = op->start[1];
+    }
+    for (uint64_t k = 0; k < op->depth; k++) {
+        int s = fset_order_at(c->o, c->fs->n, k);
+        const fset_ifs *w = &c->fs->sets[s];
+        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
+        rng r;
+        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
+        for (size_t i = 0; i < n; i++) {
+            int m = fset_pick(cum, w->n, rng_uniform(&r));
+            fset_apply2(&w->maps[m], &pt[2 * i], &pt[2 * i + 1]);
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        long b = fset_hist_bin(c->hs, pt[2 * i], pt[2 * i + 1]);
+        if (b >= 0)
+            cnt[b]++;
+    }
+    free(pt);
+}
+
+rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, hist2 *hs,
+                   const rt_run *run, rt_error *e)
+{
+    rt_code code = fset_validate(fs, e);
+    if (code)
+        return code;
+    if ((code = fset_order_validate(o, fs->n, e)))
+        return code;
+    for (int s = 0; s < fs->n; s++)
+        if (fs->sets[s].maps[0].dim != 2)
+            return rt_fail(e, RT_EINVAL,
+                           "chaos game with a function set needs 2-D maps (W%d is %d-D)", s + 1,
+                           fs->sets[s].maps[0].dim);
+    if (!hs->count || hs->w < 1 || hs->h < 1)
+        return rt_fail(e, RT_EINVAL, "chaos game: the histogram is not allocated");
+    if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
+        return rt_fail(e, RT_EINVAL, "chaos game: the histogram window is empty");
+    if (opts->mode == FSET_WALK && opts->depth < 1)
+        return rt_fail(e, RT_EINVAL, "chaos game walk depth is 0 (expected at least 1)");
+    if (opts->points == 0)
+        return RT_OK;
+
+    chaos_ctx c = {fs, o, opts, hs, NULL, NULL, 0};
+    uint64_t per = opts->mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
+    size_t nchunks = (size_t)((opts->points + per - 1) / per);
+    int nw = par_workers(run, nchunks);
+    size_t nbins = (size_t)hs->w * (size_t)hs->h;
+    c.cum = malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.count = calloc((size_t)nw, sizeof *c.count);
+    if (!c.cum || !c.count) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        goto done;
+    }
+    for (int s = 0; s < fs->n; s++)
+        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
+    for (int i = 0; i < nw; i++) {
+        c.count[i] = calloc(nbins, sizeof **c.count);
+        if (!c.count[i]) {
+            code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread histograms", nw);
+            goto done;
+        }
+    }
+    code = par_for(run, "chaos", nchunks, opts->mode == FSET_WALK ? chaos_walk : chaos_orbit, &c);
+    if (code == RT_ECANCEL) {
+        rt_fail(e, code, "interrupted");
+        goto done;
+    }
+    if (c.failed) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
+        goto done;
+    }
+    for (int i = 0; i < nw; i++)
+        for (size_t b = 0; b < nbins; b++)
+            hs->count[b] += c.count[i][b];
+done:
+    if (c.count)
+        for (int i = 0; i < nw; i++)
+            free(c.count[i]);
+    free(c.count);
+    free(c.cum);
+    return code;
+}

@@ -1,0 +1,138 @@
+/* superifs.c — V-variable super IFS with point-set buffers (seed 004 eq. (14)). */
+#include "superifs.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "par.h"
+#include "rng.h"
+
+typedef struct step_ctx {
+    const fset *fs;
+    const superifs_opts *opts;
+    uint64_t k;
+    size_t chunks_per_buf;
+    const int *nv;      /* V: IFS of each buffer this step */
+    const int *input;   /* V * FSET_MAX_MAPS: K_{v,m} */
+    const double *cum;  /* N * FSET_MAX_MAPS */
+    const double *from; /* old buffers */
+    double *to;         /* new buffers */
+} step_ctx;
+
+static void step_chunk(void *p, size_t chunk, int worker)
+{
+    (void)worker;
+    step_ctx *c = p;
+    size_t S = c->opts->points;
+    int v = (int)(chunk / c->chunks_per_buf);
+    size_t ch = chunk % c->chunks_per_buf;
+    size_t lo = ch * FSET_WALK_CHUNK, hi = lo + FSET_WALK_CHUNK < S ? lo + FSET_WALK_CHUNK : S;
+    int n = c->nv[v];
+    const fset_ifs *F = &c->fs->sets[n];
+    const double *cum = c->cum + (size_t)n * FSET_MAX_MAPS;
+    rng r;
+    rng_init(&r, rng_hash3(c->opts->seed, c->k, (uint64_t)v, FSET_WALK_TAG), ch);
+    for (size_t i = lo; i < hi; i++) {
+        int m = fset_pick(cum, F->n, rng_uniform(&r));
+        int src = c->input[(size_t)v * FSET_MAX_MAPS + (size_t)m];
+        const double *q = c->from + 2 * ((size_t)src * S + i);
+        double x = q[0], y = q[1];
+        fset_apply2(&F->maps[m], &x, &y);
+        double *d = c->to + 2 * ((size_t)v * S + i);
+        d[0] = x;
+        d[1] = y;
+    }
+}
+
+rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
+                     superifs_state *out, const rt_run *run, rt_error *e)
+{
+    memset(out, 0, sizeof *out);
+    rt_code code = fset_validate(fs, e);
+    if (code)
+        return code;
+    fset_order ord = {FSET_RANDOM, 0, NULL, P, opts->seed};
+    if ((code = fset_order_validate(&ord, fs->n, e)))
+        return code;
+    for (int s = 0; s < fs->n; s++)
+        if (fs->sets[s].maps[0].dim != 2)
+            return rt_fail(e, RT_EINVAL, "super IFS needs 2-D maps (F%d is %d-D)", s + 1,
+                           fs->sets[s].maps[0].dim);
+    if (opts->V < 1)
+        return rt_fail(e, RT_EINVAL, "super IFS has %d buffers (expected at least 1)", opts->V);
+    if (opts->points < 1)
+        return rt_fail(e, RT_EINVAL, "super IFS buffers have no points (expected at least 1)");
+    size_t V = (size_t)opts->V, S = opts->points;
+    size_t n = rt_mul_size(rt_mul_size(V, S), 2);
+    if (!n)
+        return rt_fail(e, RT_EINVAL, "super IFS of %zu buffers of %zu points is too large", V, S);
+    double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    double *cum = malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *cum);
+    int *nv = malloc(V * sizeof *nv), *input = malloc(V * FSET_MAX_MAPS * sizeof *input);
+    if (!a || !b || !cum || !nv || !input) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory for %zu buffers of %zu points", V, S);
+        goto done;
+    }
+    for (int s = 0; s < fs->n; s++)
+        fset_cumulative(fs->sets[s].p, fs->sets[s].n, cum + (size_t)s * FSET_MAX_MAPS);
+    for (size_t i = 0; i < V * S; i++) {
+        a[2 * i] = opts->start[0];
+        a[2 * i + 1] = opts->start[1];
+    }
+    for (size_t v = 0; v < V; v++)
+        nv[v] = -1;
+    size_t cpb = (S + FSET_WALK_CHUNK - 1) / FSET_WALK_CHUNK;
+    for (uint64_t k = 0; k < opts->steps; k++) {
+        for (size_t v = 0; v < V; v++) {
+            nv[v] = fset_choose(P, fs->n, rng_hash3(opts->seed, k, v, 0));
+            for (int m = 0; m < fs->sets[nv[v]].n; m++)
+                input[v * FSET_MAX_MAPS + (size_t)m] =
+                    (int)(rng_hash3(opts->seed, k, v, 1 + (uint64_t)m) % V);
+        }
+        step_ctx c = {fs, opts, k, cpb, nv, input, cum, a, b};
+        code = par_for(run, "super IFS", V * cpb, step_chunk, &c);
+        if (code) {
+            rt_fail(e, code, "interrupted");
+            goto done;
+        }
+        double *t = a;
+        a = b;
+        b = t;
+    }
+    out->V = opts->V;
+    out->points = S;
+    out->pts = a;
+    out->ifs_of = nv;
+    a = NULL;
+    nv = NULL;
+done:
+    free(a);
+    free(b);
+    free(cum);
+    free(nv);
+    free(input);
+    return code;
+}
+
+rt_code superifs_render(const superifs_state *s, int v, hist2 *hs, rt_error *e)
+{
+    if (v < 0 || v >= s->V)
+        return rt_fail(e, RT_EINVAL, "super IFS buffer %d does not exist (expected 1 to %d)", v + 1,
+                       s->V);
+    if (!hs->count || !(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
+        return rt_fail(e, RT_EINVAL, "super IFS render: the histogram is not allocated or empty");
+    const double *p = s->pts + 2 * (size_t)v * s->points;
+    for (size_t i = 0; i < s->points; i++) {
+        long b = fset_hist_bin(hs, p[2 * i], p[2 * i + 1]);
+        if (b >= 0)
+            hs->count[b]++;
+    }
+    return RT_OK;
+}
+
+void superifs_free(superifs_state *s)
+{
+    free(s->pts);
+    free(s->ifs_of);
+    memset(s, 0, sizeof *s);
+}
