@@ -22,7 +22,11 @@
  * sample and a virtual one is placed at the middle of that edge, which is on
  * the faces of the box [lo, hi]: the solid is clipped by the box and capped
  * by flat faces, and the mesh is closed even where the field is inside at
- * the boundary. Cap vertices get the box's outward normal.
+ * the boundary. Cap vertices get the box's outward normal. The caps lie on
+ * the box faces, but along the six box edges that run across the Kuhn
+ * diagonal (e.g. the z-parallel edges at (x = hi, y = lo) and (x = lo,
+ * y = hi)) the linear interpolation cuts a chamfer with legs of half a cell:
+ * a solid filling the whole box loses at most 12 · length · cell² / 8.
  *
  * Vertex position on an edge p–q (both real samples): linear interpolation
  * s = (level - f(p)) / (f(q) - f(p)), clamped to [1e-3, 1 - 1e-3] so that no

@@ -1,0 +1,177 @@
+/* iso_bench.c — iso-surface extraction and ray marching of a hypertexture-
+ * like field (soft sphere × an analytic "noise" of products of sines).
+ *
+ * Reports, best of R runs each:
+ *   - field sampling of an n³ grid, and marching tetrahedra on it, for
+ *     n = 128 and 256, with 1 and 2 threads;
+ *   - ray marching a 512² image (emission–absorption with lighting, and the
+ *     thresholded solid) with 1 and 2 threads;
+ * with ratios against plain C baseline loops run in the same process:
+ *   - iso: one pass over the volume comparing each sample with its +x, +y,
+ *     +z neighbours against the level (the least any extractor must do);
+ *   - raymarch: the same number of field evaluations as the render made,
+ *     in a plain loop over points (no blocks, no compositing).
+ *
+ *   build/bench/iso_bench [runs] [iso|rm]
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "isosurf.h"
+#include "raymarch.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static atomic_size_t evals;
+
+static double field1(double x, double y, double z)
+{
+    double d2 = x * x + y * y + z * z, r1 = 0.55, r0 = 0.95; /* seed 001 soft sphere */
+    double s = d2 < r1 * r1 ? 1 : d2 > r0 * r0 ? 0 : (r0 * r0 - d2) / (r0 * r0 - r1 * r1);
+    double n = sin(7.1 * x + 1.3) * sin(8.3 * y + 0.7) * sin(9.7 * z + 2.1) +
+               0.5 * sin(15.3 * x + 0.4) * sin(17.9 * y + 1.9) * sin(19.1 * z + 0.3);
+    return s * (0.6 + 0.4 * n);
+}
+
+static void field(const void *ctx, size_t n, const double *x, const double *y, const double *z,
+                  double *out)
+{
+    (void)ctx;
+    atomic_fetch_add_explicit(&evals, n, memory_order_relaxed);
+    for (size_t i = 0; i < n; i++)
+        out[i] = field1(x[i], y[i], z[i]);
+}
+
+static size_t baseline_scan(const volume *v, float level)
+{
+    size_t c = 0;
+    for (int z = 0; z + 1 < v->nz; z++)
+        for (int y = 0; y + 1 < v->ny; y++)
+            for (int x = 0; x + 1 < v->nx; x++) {
+                int a = *volume_at(v, x, y, z) >= level;
+                c += (size_t)(a != (*volume_at(v, x + 1, y, z) >= level));
+                c += (size_t)(a != (*volume_at(v, x, y + 1, z) >= level));
+                c += (size_t)(a != (*volume_at(v, x, y, z + 1) >= level));
+            }
+    return c;
+}
+
+int main(int argc, char **argv)
+{
+    int runs = argc > 1 ? atoi(argv[1]) : 3;
+    const char *only = argc > 2 ? argv[2] : "";
+    if (runs < 1)
+        runs = 1;
+    rt_error e;
+    double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    iso_opts o;
+    memset(&o, 0, sizeof o);
+    o.level = 0.3;
+    o.normals = 1;
+    printf("iso_bench: best of %d runs\n", runs);
+    int sizes[2] = {128, 256};
+    for (int si = 0; si < 2 && strcmp(only, "rm") != 0; si++) {
+        int n = sizes[si];
+        volume v;
+        if (volume_init(&v, n, n, n, lo, hi, &e))
+            return 1;
+        double tsample[3] = {1e9, 1e9, 1e9}, tiso[3] = {1e9, 1e9, 1e9}, tbase = 1e9;
+        size_t nv = 0, nt = 0, sink = 0;
+        for (int th = 1; th <= 2; th++) {
+            rt_run run = {th, NULL, 0};
+            for (int r = 0; r < runs; r++) {
+                double t0 = now();
+                iso_sample_field(field, NULL, &v, &run, &e);
+                double t1 = now();
+                mesh m;
+                if (iso_from_volume(&v, &o, &run, &m, &e)) {
+                    fprintf(stderr, "%s\n", e.msg);
+                    return 1;
+                }
+                double t2 = now();
+                nv = m.nv;
+                nt = m.nt;
+                mesh_free(&m);
+                if (t1 - t0 < tsample[th])
+                    tsample[th] = t1 - t0;
+                if (t2 - t1 < tiso[th])
+                    tiso[th] = t2 - t1;
+            }
+        }
+        for (int r = 0; r < runs; r++) {
+            double t0 = now();
+            sink += baseline_scan(&v, 0.3f);
+            double t1 = now();
+            if (t1 - t0 < tbase)
+                tbase = t1 - t0;
+        }
+        printf("%3d^3: %zu vertices, %zu triangles (sink %zu)\n", n, nv, nt, sink % 7);
+        printf("  sample field   1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tsample[1], tsample[2],
+               tsample[1] / tsample[2]);
+        printf("  march tets     1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tiso[1], tiso[2],
+               tiso[1] / tiso[2]);
+        printf("  baseline scan  1 thr %7.3f s   ratio march/baseline (1 thr) %.1fx\n", tbase, tiso[1] / tbase);
+        volume_free(&v);
+    }
+
+    camera cam;
+    double tgt[3] = {0, 0, 0};
+    camera_orbit(&cam, tgt, 3.2, 30, 20, 40);
+    rm_opts ro;
+    rm_defaults(&ro);
+    ro.step = 1.0 / 128;
+    ro.lighting = 1;
+    ro.sigma = 6;
+    static const char *mname[2] = {"emission+light", "solid t=0.3"};
+    for (int mode = 0; mode < 2 && strcmp(only, "iso") != 0; mode++) {
+        ro.mode = mode;
+        ro.threshold = 0.3;
+        double t[3] = {1e9, 1e9, 1e9};
+        size_t ne = 0;
+        image im;
+        if (image_init(&im, 512, 512, &e))
+            return 1;
+        for (int th = 1; th <= 2; th++) {
+            rt_run run = {th, NULL, 0};
+            for (int r = 0; r < runs; r++) {
+                atomic_store(&evals, 0);
+                double t0 = now();
+                if (rm_render(field, NULL, &cam, &ro, &run, &im, &e)) {
+                    fprintf(stderr, "%s\n", e.msg);
+                    return 1;
+                }
+                double t1 = now();
+                ne = atomic_load(&evals);
+                if (t1 - t0 < t[th])
+                    t[th] = t1 - t0;
+            }
+        }
+        /* baseline: the same number of evaluations in a plain loop */
+        double tb = 1e9, acc = 0;
+        for (int r = 0; r < runs; r++) {
+            double t0 = now();
+            for (size_t i = 0; i < ne; i++) {
+                double u = (double)(i % 4096) / 4096.0 * 2 - 1, w = (double)(i / 4096 % 4096) / 4096.0 * 2 - 1;
+                acc += field1(u, w, 0.37 * u - 0.2);
+            }
+            double t1 = now();
+            if (t1 - t0 < tb)
+                tb = t1 - t0;
+        }
+        printf("raymarch 512^2 %-15s %zu evals: 1 thr %6.3f s  2 thr %6.3f s  speed-up %.2fx  "
+               "baseline %6.3f s  ratio %.2fx (acc %d)\n",
+               mname[mode], ne, t[1], t[2], t[1] / t[2], tb, t[1] / tb, (int)acc % 2);
+        image_free(&im);
+    }
+    return 0;
+}

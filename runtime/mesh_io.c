@@ -1,0 +1,619 @@
+/* mesh_io.c — PLY, OBJ and binary STL writers and readers (see mesh_io.h). */
+#include "mesh_io.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned char to_u8(float c)
+{
+    double t = c > 0 ? (c < 1 ? c : 1) : 0;
+    return (unsigned char)lround(t * 255.0);
+}
+
+static rt_code finish(bytebuf *out, rt_error *e)
+{
+    return out->failed ? rt_fail(e, RT_ENOMEM, "out of memory writing a mesh") : RT_OK;
+}
+
+rt_code mio_ply_to_mem(const mesh *m, int ascii, bytebuf *out, rt_error *e)
+{
+    if (m->failed)
+        return rt_fail(e, RT_ENOMEM, "mesh is incomplete (an allocation failed)");
+    bytebuf_printf(out, "ply\nformat %s 1.0\ncomment frac mesh\n", ascii ? "ascii" : "binary_little_endian");
+    bytebuf_printf(out, "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n", m->nv);
+    if (m->nrm)
+        bytebuf_printf(out, "property float nx\nproperty float ny\nproperty float nz\n");
+    if (m->col)
+        bytebuf_printf(out, "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n");
+    if (m->nt)
+        bytebuf_printf(out, "element face %zu\nproperty list uchar int vertex_indices\n", m->nt);
+    bytebuf_printf(out, "end_header\n");
+    for (size_t i = 0; i < m->nv && !out->failed; i++) {
+        const float *p = m->pos + 3 * i;
+        if (ascii) {
+            bytebuf_printf(out, "%.9g %.9g %.9g", p[0], p[1], p[2]);
+            if (m->nrm)
+                bytebuf_printf(out, " %.9g %.9g %.9g", m->nrm[3 * i], m->nrm[3 * i + 1], m->nrm[3 * i + 2]);
+            if (m->col)
+                for (int k = 0; k < 4; k++)
+                    bytebuf_printf(out, " %u", to_u8(m->col[4 * i + k]));
+            bytebuf_printf(out, "\n");
+        } else {
+            for (int k = 0; k < 3; k++)
+                bytebuf_f32le(out, p[k]);
+            if (m->nrm)
+                for (int k = 0; k < 3; k++)
+                    bytebuf_f32le(out, m->nrm[3 * i + k]);
+            if (m->col)
+                for (int k = 0; k < 4; k++)
+                    bytebuf_byte(out, to_u8(m->col[4 * i + k]));
+        }
+    }
+    for (size_t t = 0; t < m->nt && !out->failed; t++) {
+        const uint32_t *v = m->tri + 3 * t;
+        if (ascii) {
+            bytebuf_printf(out, "3 %u %u %u\n", (unsigned)v[0], (unsigned)v[1], (unsigned)v[2]);
+        } else {
+            bytebuf_byte(out, 3);
+            for (int k = 0; k < 3; k++)
+                bytebuf_u32le(out, v[k]);
+        }
+    }
+    return finish(out, e);
+}
+
+rt_code mio_obj_to_mem(const mesh *m, bytebuf *out, rt_error *e)
+{
+    if (m->failed)
+        return rt_fail(e, RT_ENOMEM, "mesh is incomplete (an allocation failed)");
+    bytebuf_printf(out, "# frac mesh\n");
+    for (size_t i = 0; i < m->nv && !out->failed; i++) {
+        const float *p = m->pos + 3 * i;
+        bytebuf_printf(out, "v %.9g %.9g %.9g", p[0], p[1], p[2]);
+        if (m->col)
+            bytebuf_printf(out, " %.9g %.9g %.9g", m->col[4 * i], m->col[4 * i + 1], m->col[4 * i + 2]);
+        bytebuf_printf(out, "\n");
+    }
+    if (m->nrm)
+        for (size_t i = 0; i < m->nv && !out->failed; i++)
+            bytebuf_printf(out, "vn %.9g %.9g %.9g\n", m->nrm[3 * i], m->nrm[3 * i + 1], m->nrm[3 * i + 2]);
+    for (size_t t = 0; t < m->nt && !out->failed; t++) {
+        unsigned a = m->tri[3 * t] + 1u, b = m->tri[3 * t + 1] + 1u, c = m->tri[3 * t + 2] + 1u;
+        if (m->nrm)
+            bytebuf_printf(out, "f %u//%u %u//%u %u//%u\n", a, a, b, b, c, c);
+        else
+            bytebuf_printf(out, "f %u %u %u\n", a, b, c);
+    }
+    return finish(out, e);
+}
+
+rt_code mio_stl_to_mem(const mesh *m, bytebuf *out, rt_error *e)
+{
+    if (m->failed)
+        return rt_fail(e, RT_ENOMEM, "mesh is incomplete (an allocation failed)");
+    if (m->nt > UINT32_MAX)
+        return rt_fail(e, RT_EINVAL, "mesh has %zu triangles, more than STL can hold", m->nt);
+    unsigned char hdr[80] = "frac mesh";
+    bytebuf_append(out, hdr, 80);
+    bytebuf_u32le(out, (uint32_t)m->nt);
+    for (size_t t = 0; t < m->nt && !out->failed; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = m->pos + 3 * (size_t)m->tri[3 * t + k];
+        double u[3], w[3];
+        for (int k = 0; k < 3; k++) {
+            u[k] = (double)p[1][k] - p[0][k];
+            w[k] = (double)p[2][k] - p[0][k];
+        }
+        double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; k++)
+            bytebuf_f32le(out, l > 0 ? (float)(n[k] / l) : 0.0f);
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++)
+                bytebuf_f32le(out, p[v][k]);
+        bytebuf_u16le(out, 0);
+    }
+    return finish(out, e);
+}
+
+static rt_code save_with(const char *path, const mesh *m, int kind, rt_error *e)
+{
+    bytebuf b;
+    bytebuf_init(&b);
+    rt_code rc = kind == 0 ? mio_ply_to_mem(m, 0, &b, e)
+                 : kind == 1 ? mio_ply_to_mem(m, 1, &b, e)
+                 : kind == 2 ? mio_obj_to_mem(m, &b, e)
+                             : mio_stl_to_mem(m, &b, e);
+    if (!rc)
+        rc = fileio_write_atomic(path, b.data, b.len, e);
+    bytebuf_free(&b);
+    return rc;
+}
+
+rt_code mio_save_ply(const char *path, const mesh *m, int ascii, rt_error *e)
+{
+    return save_with(path, m, ascii ? 1 : 0, e);
+}
+
+rt_code mio_save(const char *path, const mesh *m, rt_error *e)
+{
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    if (strcmp(ext, "ply") == 0)
+        return save_with(path, m, 0, e);
+    if (strcmp(ext, "obj") == 0)
+        return save_with(path, m, 2, e);
+    if (strcmp(ext, "stl") == 0)
+        return save_with(path, m, 3, e);
+    return rt_fail(e, RT_EINVAL, "mesh file '%s' does not end in .ply, .obj or .stl", path);
+}
+
+/* ---- readers ---- */
+
+static rt_code reader_oom(mesh *m, rt_error *e)
+{
+    return m->failed ? rt_fail(e, RT_ENOMEM, "out of memory reading a mesh") : RT_OK;
+}
+
+/* PLY scalar types */
+enum { P_NONE, P_I8, P_U8, P_I16, P_U16, P_I32, P_U32, P_F32, P_F64 };
+
+static int ply_type(const char *s)
+{
+    static const struct {
+        const char *n;
+        int t;
+    } tt[] = {{"char", P_I8},    {"int8", P_I8},     {"uchar", P_U8},    {"uint8", P_U8},
+              {"short", P_I16},  {"int16", P_I16},   {"ushort", P_U16},  {"uint16", P_U16},
+              {"int", P_I32},    {"int32", P_I32},   {"uint", P_U32},    {"uint32", P_U32},
+              {"float", P_F32},  {"float32", P_F32}, {"double", P_F64},  {"float64", P_F64}};
+    for (size_t i = 0; i < sizeof tt / sizeof tt[0]; i++)
+        if (strcmp(s, tt[i].n) == 0)
+            return tt[i].t;
+    return P_NONE;
+}
+
+static size_t ply_size(int t)
+{
+    static const size_t sz[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+    return sz[t];
+}
+
+#define PLY_MAXPROP 32
+#define PLY_MAXELEM 16
+
+typedef struct ply_prop {
+    char name[64];
+    int type, count_type; /* count_type != P_NONE: a list */
+} ply_prop;
+
+typedef struct ply_elem {
+    char name[64];
+    size_t count;
+    int nprop;
+    ply_prop prop[PLY_MAXPROP];
+} ply_elem;
+
+typedef struct ply_in {
+    const unsigned char *d;
+    size_t n, pos;
+    int fmt; /* 0 ascii, 1 LE, 2 BE */
+    int bad;
+} ply_in;
+
+static double ply_read(ply_in *in, int t)
+{
+    if (in->bad)
+        return 0;
+    if (in->fmt == 0) {
+        while (in->pos < in->n && (in->d[in->pos] == ' ' || in->d[in->pos] == '\t' ||
+                                   in->d[in->pos] == '\n' || in->d[in->pos] == '\r'))
+            in->pos++;
+        char tmp[64];
+        size_t k = 0;
+        while (in->pos < in->n && k < sizeof tmp - 1 && in->d[in->pos] > ' ')
+            tmp[k++] = (char)in->d[in->pos++];
+        tmp[k] = 0;
+        char *end;
+        double v = strtod(tmp, &end);
+        if (!k || *end)
+            in->bad = 1;
+        return v;
+    }
+    size_t sz = ply_size(t);
+    if (in->n - in->pos < sz) {
+        in->bad = 1;
+        return 0;
+    }
+    uint64_t u = 0;
+    const unsigned char *p = in->d + in->pos;
+    for (size_t i = 0; i < sz; i++)
+        u |= (uint64_t)p[in->fmt == 2 ? i : sz - 1 - i] << (8 * (sz - 1 - i));
+    in->pos += sz;
+    switch (t) {
+    case P_I8:
+        return (int8_t)(uint8_t)u;
+    case P_U8:
+        return (double)u;
+    case P_I16:
+        return (int16_t)(uint16_t)u;
+    case P_U16:
+        return (double)u;
+    case P_I32:
+        return (int32_t)(uint32_t)u;
+    case P_U32:
+        return (double)u;
+    case P_F32: {
+        uint32_t w = (uint32_t)u;
+        float f;
+        memcpy(&f, &w, 4);
+        return f;
+    }
+    default: {
+        double dd;
+        memcpy(&dd, &u, 8);
+        return dd;
+    }
+    }
+}
+
+static int add_poly(mesh *m, const double *idx, size_t k, size_t nv)
+{
+    for (size_t i = 0; i < k; i++)
+        if (!(idx[i] >= 0 && idx[i] < (double)nv))
+            return -1;
+    for (size_t i = 1; i + 1 < k; i++)
+        mesh_add_tri(m, (uint32_t)idx[0], (uint32_t)idx[i], (uint32_t)idx[i + 1]);
+    return 0;
+}
+
+rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
+{
+    mesh_init(m, 0, 0);
+    if (n < 4 || memcmp(d, "ply", 3) != 0 || (d[3] != '\n' && d[3] != '\r'))
+        return rt_fail(e, RT_EFORMAT, "not a PLY file (no 'ply' magic line)");
+    ply_elem el[PLY_MAXELEM];
+    int nel = 0, fmt = -1, lineno = 0;
+    size_t pos = 0;
+    char line[512];
+    for (;;) {
+        if (pos >= n)
+            return rt_fail(e, RT_EFORMAT, "PLY header has no end_header");
+        size_t end = pos;
+        while (end < n && d[end] != '\n')
+            end++;
+        size_t len = end - pos;
+        if (len && d[pos + len - 1] == '\r')
+            len--;
+        if (len >= sizeof line)
+            len = sizeof line - 1;
+        memcpy(line, d + pos, len);
+        line[len] = 0;
+        pos = end < n ? end + 1 : end;
+        lineno++;
+        char a[64], b[64], c[64], dd[64];
+        int nw = sscanf(line, "%63s %63s %63s %63s", a, b, c, dd);
+        if (nw <= 0 || strcmp(a, "comment") == 0 || strcmp(a, "obj_info") == 0 || strcmp(a, "ply") == 0)
+            continue;
+        if (strcmp(a, "end_header") == 0)
+            break;
+        if (strcmp(a, "format") == 0 && nw >= 2) {
+            fmt = strcmp(b, "ascii") == 0 ? 0 : strcmp(b, "binary_little_endian") == 0 ? 1
+                  : strcmp(b, "binary_big_endian") == 0 ? 2 : -2;
+            if (fmt == -2)
+                return rt_fail(e, RT_EFORMAT, "PLY header line %d: unknown format '%s'", lineno, b);
+        } else if (strcmp(a, "element") == 0 && nw >= 3) {
+            if (nel == PLY_MAXELEM)
+                return rt_fail(e, RT_EFORMAT, "PLY header line %d: more than %d elements", lineno, PLY_MAXELEM);
+            char *endp;
+            double cnt = strtod(c, &endp);
+            if (*endp || !(cnt >= 0 && cnt < 4e9) || cnt != floor(cnt))
+                return rt_fail(e, RT_EFORMAT, "PLY header line %d: element count '%s'", lineno, c);
+            memset(&el[nel], 0, sizeof el[nel]);
+            snprintf(el[nel].name, sizeof el[nel].name, "%s", b);
+            el[nel].count = (size_t)cnt;
+            nel++;
+        } else if (strcmp(a, "property") == 0 && nw >= 3) {
+            if (!nel)
+                return rt_fail(e, RT_EFORMAT, "PLY header line %d: property before any element", lineno);
+            ply_elem *E = &el[nel - 1];
+            if (E->nprop == PLY_MAXPROP)
+                return rt_fail(e, RT_EFORMAT, "PLY header line %d: too many properties", lineno);
+            ply_prop *P = &E->prop[E->nprop++];
+            if (strcmp(b, "list") == 0) {
+                char f5[64] = "";
+                if (nw < 4 || sscanf(line, "%*s %*s %*s %*s %63s", f5) != 1)
+                    return rt_fail(e, RT_EFORMAT, "PLY header line %d: list property needs two types and a name", lineno);
+                P->count_type = ply_type(c);
+                P->type = ply_type(dd);
+                snprintf(P->name, sizeof P->name, "%s", f5);
+                if (!P->count_type || !P->type)
+                    return rt_fail(e, RT_EFORMAT, "PLY header line %d: unknown type in '%s'", lineno, line);
+            } else {
+                P->type = ply_type(b);
+                P->count_type = P_NONE;
+                snprintf(P->name, sizeof P->name, "%s", c);
+                if (!P->type)
+                    return rt_fail(e, RT_EFORMAT, "PLY header line %d: unknown type '%s'", lineno, b);
+            }
+        } else {
+            return rt_fail(e, RT_EFORMAT, "PLY header line %d: unexpected '%.60s'", lineno, line);
+        }
+    }
+    if (fmt < 0)
+        return rt_fail(e, RT_EFORMAT, "PLY header has no format line");
+    /* Which attributes does the vertex element carry? */
+    int have_n = 0, have_c = 0;
+    size_t nverts = 0;
+    for (int i = 0; i < nel; i++)
+        if (strcmp(el[i].name, "vertex") == 0) {
+            nverts = el[i].count;
+            for (int k = 0; k < el[i].nprop; k++) {
+                have_n |= strcmp(el[i].prop[k].name, "nx") == 0;
+                have_c |= strcmp(el[i].prop[k].name, "red") == 0;
+            }
+        }
+    mesh_free(m);
+    mesh_init(m, have_n, have_c);
+    ply_in in = {d, n, pos, fmt, 0};
+    double idx[256];
+    for (int i = 0; i < nel; i++) {
+        ply_elem *E = &el[i];
+        int is_v = strcmp(E->name, "vertex") == 0, is_f = strcmp(E->name, "face") == 0;
+        for (size_t r = 0; r < E->count && !in.bad; r++) {
+            float p[3] = {0, 0, 0}, nn[3] = {0, 0, 0}, cc[4] = {1, 1, 1, 1};
+            for (int k = 0; k < E->nprop; k++) {
+                ply_prop *P = &E->prop[k];
+                if (P->count_type) {
+                    double cnt = ply_read(&in, P->count_type);
+                    if (!(cnt >= 0 && cnt <= 255)) {
+                        in.bad = 1;
+                        break;
+                    }
+                    size_t kk = (size_t)cnt;
+                    int use = is_f && (strcmp(P->name, "vertex_indices") == 0 || strcmp(P->name, "vertex_index") == 0);
+                    for (size_t q = 0; q < kk; q++)
+                        idx[q] = ply_read(&in, P->type);
+                    if (use && !in.bad && add_poly(m, idx, kk, nverts))
+                        return rt_fail(e, RT_EFORMAT, "PLY face %zu has a vertex index out of 0..%zu", r,
+                                       nverts ? nverts - 1 : 0);
+                    continue;
+                }
+                double v = ply_read(&in, P->type);
+                if (!is_v)
+                    continue;
+                static const char *names[10] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha"};
+                for (int q = 0; q < 10; q++)
+                    if (strcmp(P->name, names[q]) == 0) {
+                        if (q < 3)
+                            p[q] = (float)v;
+                        else if (q < 6)
+                            nn[q - 3] = (float)v;
+                        else
+                            cc[q - 6] = (float)(P->type == P_F32 || P->type == P_F64 ? v : v / 255.0);
+                    }
+            }
+            if (is_v && !in.bad)
+                mesh_add_vertex(m, p, nn, cc);
+        }
+        if (in.bad)
+            return rt_fail(e, RT_EFORMAT, "PLY data for element '%s' is truncated or malformed", E->name);
+    }
+    return reader_oom(m, e);
+}
+
+/* Parse a 1-based (or negative, relative) OBJ index; 0 on error. */
+static long obj_index(const char *s, char **end, size_t count)
+{
+    long v = strtol(s, end, 10);
+    if (*end == s)
+        return 0;
+    if (v < 0)
+        v = (long)count + v + 1;
+    if (v < 1 || (size_t)v > count)
+        return 0;
+    return v;
+}
+
+rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
+{
+    /* First pass: which attributes exist; collect normals. */
+    size_t nvn = 0, cap_vn = 0, nv = 0;
+    float *vn = NULL;
+    int have_c = 0, lineno = 0;
+    char line[4096];
+    for (int pass = 0; pass < 2; pass++) {
+        size_t pos = 0;
+        lineno = 0;
+        if (pass == 1) {
+            mesh_init(m, nvn > 0, have_c);
+            nv = 0;
+        }
+        while (pos < n) {
+            size_t end = pos;
+            while (end < n && d[end] != '\n')
+                end++;
+            size_t len = end - pos;
+            if (len >= sizeof line)
+                len = sizeof line - 1;
+            memcpy(line, d + pos, len);
+            line[len] = 0;
+            pos = end < n ? end + 1 : end;
+            lineno++;
+            char *s = line;
+            while (*s == ' ' || *s == '\t')
+                s++;
+            if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
+                double c[6];
+                int k = 0;
+                char *p = s + 2, *q;
+                while (k < 6) {
+                    c[k] = strtod(p, &q);
+                    if (q == p)
+                        break;
+                    p = q;
+                    k++;
+                }
+                if (k < 3) {
+                    free(vn);
+                    if (pass == 1)
+                        mesh_free(m);
+                    return rt_fail(e, RT_EFORMAT, "OBJ line %d: vertex needs 3 coordinates", lineno);
+                }
+                if (pass == 0) {
+                    have_c |= k == 6;
+                    nv++;
+                } else {
+                    float p3[3] = {(float)c[0], (float)c[1], (float)c[2]};
+                    float c4[4] = {k == 6 ? (float)c[3] : 1, k == 6 ? (float)c[4] : 1, k == 6 ? (float)c[5] : 1, 1};
+                    mesh_add_vertex(m, p3, NULL, c4);
+                    nv++;
+                }
+            } else if (s[0] == 'v' && s[1] == 'n' && (s[2] == ' ' || s[2] == '\t')) {
+                if (pass == 1)
+                    continue;
+                double c[3];
+                char *p = s + 3, *q;
+                for (int k = 0; k < 3; k++) {
+                    c[k] = strtod(p, &q);
+                    if (q == p) {
+                        free(vn);
+                        return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal needs 3 components", lineno);
+                    }
+                    p = q;
+                }
+                if (nvn == cap_vn) {
+                    cap_vn = cap_vn ? 2 * cap_vn : 64;
+                    float *nb = realloc(vn, cap_vn * 3 * sizeof(float));
+                    if (!nb) {
+                        free(vn);
+                        return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
+                    }
+                    vn = nb;
+                }
+                for (int k = 0; k < 3; k++)
+                    vn[3 * nvn + (size_t)k] = (float)c[k];
+                nvn++;
+            } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t') && pass == 1) {
+                double idx[256];
+                size_t k = 0;
+                char *p = s + 2;
+                for (;;) {
+                    while (*p == ' ' || *p == '\t' || *p == '\r')
+                        p++;
+                    if (!*p)
+                        break;
+                    char *q;
+                    long vi = obj_index(p, &q, nv), ni = 0;
+                    if (!vi || k == 256) {
+                        free(vn);
+                        mesh_free(m);
+                        return rt_fail(e, RT_EFORMAT, "OBJ line %d: face index out of 1..%zu", lineno, nv);
+                    }
+                    p = q;
+                    if (*p == '/') {
+                        p++;
+                        if (*p != '/')
+                            strtol(p, &p, 10); /* texture index, unused */
+                        if (*p == '/') {
+                            p++;
+                            ni = obj_index(p, &q, nvn);
+                            if (!ni) {
+                                free(vn);
+                                mesh_free(m);
+                                return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal index out of 1..%zu", lineno, nvn);
+                            }
+                            p = q;
+                        }
+                    }
+                    if (ni && m->nrm && !m->failed)
+                        memcpy(m->nrm + 3 * (size_t)(vi - 1), vn + 3 * (size_t)(ni - 1), 3 * sizeof(float));
+                    idx[k++] = (double)(vi - 1);
+                }
+                if (k < 3) {
+                    free(vn);
+                    mesh_free(m);
+                    return rt_fail(e, RT_EFORMAT, "OBJ line %d: face has fewer than 3 vertices", lineno);
+                }
+                add_poly(m, idx, k, nv);
+            }
+        }
+    }
+    free(vn);
+    return reader_oom(m, e);
+}
+
+/* Weld table: bit patterns of positions -> vertex index. */
+typedef struct weld_slot {
+    uint32_t key[3];
+    uint32_t idx; /* UINT32_MAX = empty */
+} weld_slot;
+
+rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
+{
+    mesh_init(m, 0, 0);
+    if (n >= 5 && memcmp(d, "solid", 5) == 0 && (n < 84 || 84 + 50 * (size_t)(d[80] | d[81] << 8 | d[82] << 16 | (uint32_t)d[83] << 24) != n))
+        return rt_fail(e, RT_EFORMAT, "ASCII STL is not read (only binary STL)");
+    if (n < 84)
+        return rt_fail(e, RT_EFORMAT, "STL file is %zu bytes, shorter than its 84-byte header", n);
+    uint32_t nt = (uint32_t)d[80] | (uint32_t)d[81] << 8 | (uint32_t)d[82] << 16 | (uint32_t)d[83] << 24;
+    if ((n - 84) / 50 < nt)
+        return rt_fail(e, RT_EFORMAT, "STL file holds %zu triangles, its header says %u", (n - 84) / 50, (unsigned)nt);
+    size_t cap = 16;
+    while (cap < (size_t)nt * 6 + 16)
+        cap *= 2;
+    weld_slot *tab = malloc(cap * sizeof *tab);
+    if (!tab)
+        return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
+    for (size_t i = 0; i < cap; i++)
+        tab[i].idx = UINT32_MAX;
+    for (uint32_t t = 0; t < nt && !m->failed; t++) {
+        const unsigned char *f = d + 84 + 50 * (size_t)t + 12;
+        uint32_t v[3];
+        for (int k = 0; k < 3; k++) {
+            uint32_t key[3];
+            float p[3];
+            for (int a = 0; a < 3; a++) {
+                const unsigned char *b = f + 12 * k + 4 * a;
+                key[a] = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+                memcpy(&p[a], &key[a], 4);
+            }
+            uint64_t h = ((uint64_t)key[0] * 0x9e3779b97f4a7c15ull) ^ ((uint64_t)key[1] * 0xc2b2ae3d27d4eb4full) ^
+                         ((uint64_t)key[2] * 0x165667b19e3779f9ull);
+            size_t s = (size_t)(h >> 17) & (cap - 1);
+            while (tab[s].idx != UINT32_MAX && memcmp(tab[s].key, key, sizeof key) != 0)
+                s = (s + 1) & (cap - 1);
+            if (tab[s].idx == UINT32_MAX) {
+                memcpy(tab[s].key, key, sizeof key);
+                tab[s].idx = mesh_add_vertex(m, p, NULL, NULL);
+            }
+            v[k] = tab[s].idx;
+        }
+        mesh_add_tri(m, v[0], v[1], v[2]);
+    }
+    free(tab);
+    return reader_oom(m, e);
+}
+
+rt_code mio_load(const char *path, mesh *m, rt_error *e)
+{
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    mesh_init(m, 0, 0);
+    int kind = strcmp(ext, "ply") == 0 ? 0 : strcmp(ext, "obj") == 0 ? 1 : strcmp(ext, "stl") == 0 ? 2 : -1;
+    if (kind < 0)
+        return rt_fail(e, RT_EINVAL, "mesh file '%s' does not end in .ply, .obj or .stl", path);
+    unsigned char *d;
+    size_t n;
+    rt_code rc = fileio_read_all(path, (size_t)1 << 40, &d, &n, e);
+    if (rc)
+        return rc;
+    mesh_free(m);
+    rc = kind == 0 ? mio_ply_from_mem(d, n, m, e) : kind == 1 ? mio_obj_from_mem(d, n, m, e)
+                                                           : mio_stl_from_mem(d, n, m, e);
+    free(d);
+    return rc;
+}

@@ -1,0 +1,245 @@
+/* test_mesh_io.c — mesh files against hand-written references.
+ *
+ * tests/data/formats/ holds a tetrahedron (0,0,0) (1,0,0) (0,1,0) (0,0,1)
+ * with faces (0,2,1) (0,1,3) (0,3,2) (1,2,3) (counter-clockwise from
+ * outside), written by hand: tet.ply (binary, RGBA colours red, green,
+ * blue with alpha 128, white), tet_ascii.ply (normals and colours),
+ * tet.obj (normals) and tet.stl (facet normals -z, -y, -x and (1,1,1)/√3 as
+ * 0x3f13cd3a). Writers must produce exactly these bytes, readers must read
+ * them; meshes round-trip through files (bit-exact positions); a point cloud
+ * has no face element; malformed files give precise errors. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "mesh_io.h"
+
+#define DATA "tests/data/formats/"
+
+static const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+static const float N[4][3] = {{0, 0, -1}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+static const float C[4][4] = {{1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 1, 128.0f / 255}, {1, 1, 1, 1}};
+static const uint32_t T[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+
+static void tet(mesh *m, int normals, int colours)
+{
+    mesh_init(m, normals, colours);
+    for (int i = 0; i < 4; i++)
+        mesh_add_vertex(m, P[i], normals ? N[i] : NULL, colours ? C[i] : NULL);
+    for (int i = 0; i < 4; i++)
+        mesh_add_tri(m, T[i][0], T[i][1], T[i][2]);
+}
+
+static int same_as_file(const bytebuf *b, const char *path)
+{
+    unsigned char *d;
+    size_t n;
+    rt_error e;
+    if (fileio_read_all(path, 1 << 20, &d, &n, &e) != RT_OK)
+        return 0;
+    int ok = n == b->len && memcmp(d, b->data, n) == 0;
+    if (!ok)
+        fprintf(stderr, "%s: %zu bytes, writer gave %zu\n", path, n, b->len);
+    free(d);
+    return ok;
+}
+
+static void test_writers(void)
+{
+    mesh m;
+    rt_error e;
+    bytebuf b;
+    tet(&m, 0, 1);
+    bytebuf_init(&b);
+    CHECK(mio_ply_to_mem(&m, 0, &b, &e) == RT_OK, "%s", e.msg);
+    CHECK(same_as_file(&b, DATA "tet.ply"), "binary PLY differs");
+    bytebuf_free(&b);
+    bytebuf_init(&b);
+    CHECK(mio_stl_to_mem(&m, &b, &e) == RT_OK, "%s", e.msg);
+    CHECK(same_as_file(&b, DATA "tet.stl"), "STL differs");
+    bytebuf_free(&b);
+    mesh_free(&m);
+    tet(&m, 1, 1);
+    bytebuf_init(&b);
+    CHECK(mio_ply_to_mem(&m, 1, &b, &e) == RT_OK, "%s", e.msg);
+    CHECK(same_as_file(&b, DATA "tet_ascii.ply"), "ASCII PLY differs");
+    bytebuf_free(&b);
+    mesh_free(&m);
+    tet(&m, 1, 0);
+    bytebuf_init(&b);
+    CHECK(mio_obj_to_mem(&m, &b, &e) == RT_OK, "%s", e.msg);
+    CHECK(same_as_file(&b, DATA "tet.obj"), "OBJ differs");
+    bytebuf_free(&b);
+    mesh_free(&m);
+}
+
+/* Same triangles corner by corner, by position (STL renumbers vertices in
+ * order of first use). */
+static int same_corners(const mesh *a, const mesh *b)
+{
+    if (a->nt != b->nt)
+        return 0;
+    for (size_t t = 0; t < 3 * a->nt; t++)
+        if (memcmp(a->pos + 3 * (size_t)a->tri[t], b->pos + 3 * (size_t)b->tri[t], 12) != 0)
+            return 0;
+    return 1;
+}
+
+static void check_tet(const mesh *m, int normals, int colours, const char *what)
+{
+    CHECK(m->nv == 4 && m->nt == 4, "%s: %zu vertices %zu triangles", what, m->nv, m->nt);
+    if (m->nv != 4 || m->nt != 4)
+        return;
+    mesh ref;
+    tet(&ref, 0, 0);
+    CHECK(same_corners(m, &ref), "%s: triangle corners differ", what);
+    mesh_free(&ref);
+    if (strstr(what, "stl") == NULL) {
+        CHECK(memcmp(m->pos, P, sizeof P) == 0, "%s: positions", what);
+        CHECK(memcmp(m->tri, T, sizeof T) == 0, "%s: triangles", what);
+    }
+    CHECK((m->nrm != NULL) == normals, "%s: normals present %d", what, m->nrm != NULL);
+    if (normals && m->nrm)
+        CHECK(memcmp(m->nrm, N, sizeof N) == 0, "%s: normals", what);
+    CHECK((m->col != NULL) == colours, "%s: colours present", what);
+    if (colours && m->col)
+        for (int i = 0; i < 16; i++)
+            CHECK_NEAR(m->col[i], C[i / 4][i % 4], 1e-7, what);
+    mesh_stats st;
+    rt_error e;
+    mesh_compute_stats(m, &st, &e);
+    CHECK(st.boundary_edges == 0 && st.euler == 2, "%s: not a closed tetrahedron", what);
+}
+
+static void test_readers(void)
+{
+    mesh m;
+    rt_error e;
+    CHECK(mio_load(DATA "tet.ply", &m, &e) == RT_OK, "%s", e.msg);
+    check_tet(&m, 0, 1, "tet.ply");
+    mesh_free(&m);
+    CHECK(mio_load(DATA "tet_ascii.ply", &m, &e) == RT_OK, "%s", e.msg);
+    check_tet(&m, 1, 1, "tet_ascii.ply");
+    mesh_free(&m);
+    CHECK(mio_load(DATA "tet.obj", &m, &e) == RT_OK, "%s", e.msg);
+    check_tet(&m, 1, 0, "tet.obj");
+    mesh_free(&m);
+    CHECK(mio_load(DATA "tet.stl", &m, &e) == RT_OK, "%s", e.msg);
+    check_tet(&m, 0, 0, "tet.stl"); /* welding recovers the 4 shared vertices */
+    mesh_free(&m);
+}
+
+/* A closed octahedron with awkward coordinates. */
+static void octa(mesh *m, int normals, int colours)
+{
+    mesh_init(m, normals, colours);
+    static const int ax[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int i = 0; i < 6; i++) {
+        float p[3], c[4] = {0.1f * i, 0.3f, 1.0f / 3.0f, 0.5f};
+        for (int a = 0; a < 3; a++)
+            p[a] = (float)(ax[i][a] * (0.7 + 0.01 * i) + 1e-3 * a / 3.0);
+        float n[3] = {(float)ax[i][0], (float)ax[i][1], (float)ax[i][2]};
+        mesh_add_vertex(m, p, n, c);
+    }
+    static const uint32_t f[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                     {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (int t = 0; t < 8; t++)
+        mesh_add_tri(m, f[t][0], f[t][1], f[t][2]);
+}
+
+static void test_roundtrip(void)
+{
+    char dir[] = "/tmp/frac_meshio_XXXXXX";
+    CHECK(mkdtemp(dir) != NULL, "mkdtemp");
+    static const char *names[4] = {"a.ply", "b.ply", "c.obj", "d.stl"};
+    mesh m, r;
+    rt_error e;
+    octa(&m, 1, 1);
+    for (int k = 0; k < 4; k++) {
+        char path[128];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        rt_code rc = k == 1 ? mio_save_ply(path, &m, 1, &e) : mio_save(path, &m, &e);
+        CHECK(rc == RT_OK, "%s: %s", names[k], e.msg);
+        CHECK(mio_load(path, &r, &e) == RT_OK, "%s: %s", names[k], e.msg);
+        CHECK(r.nv == 6 && r.nt == 8, "%s: %zu / %zu", names[k], r.nv, r.nt);
+        if (r.nv == 6 && r.nt == 8) {
+            CHECK(same_corners(&r, &m), "%s: triangle corners not exact", names[k]);
+            if (k < 3) {
+                CHECK(memcmp(r.pos, m.pos, 6 * 12) == 0, "%s: positions not exact", names[k]);
+                CHECK(memcmp(r.tri, m.tri, 8 * 12) == 0, "%s: triangles differ", names[k]);
+            }
+            if (k < 3)
+                CHECK(r.nrm && memcmp(r.nrm, m.nrm, 6 * 12) == 0, "%s: normals differ", names[k]);
+            if (k < 2 && r.col)
+                for (int i = 0; i < 24; i++)
+                    CHECK(fabs(r.col[i] - m.col[i]) <= 0.5 / 255 + 1e-7, "%s: colour %d", names[k], i);
+            if (k == 2 && r.col) /* OBJ carries rgb exactly (9 digits), alpha 1 */
+                CHECK(r.col[4] == m.col[4] && r.col[6] == m.col[6] && r.col[7] == 1, "obj colours");
+        }
+        mesh_free(&r);
+        remove(path);
+    }
+    mesh_free(&m);
+
+    /* Point cloud: no face element at all. */
+    char path[128];
+    snprintf(path, sizeof path, "%s/cloud.ply", dir);
+    mesh_init(&m, 0, 0);
+    float p[3] = {0.25f, -1.5f, 3};
+    mesh_add_vertex(&m, p, NULL, NULL);
+    mesh_add_vertex(&m, P[1], NULL, NULL);
+    bytebuf b;
+    bytebuf_init(&b);
+    CHECK(mio_ply_to_mem(&m, 0, &b, &e) == RT_OK, "%s", e.msg);
+    bytebuf_byte(&b, 0);
+    CHECK(strstr((const char *)b.data, "element face") == NULL, "point cloud has a face element");
+    bytebuf_free(&b);
+    CHECK(mio_save(path, &m, &e) == RT_OK, "%s", e.msg);
+    CHECK(mio_load(path, &r, &e) == RT_OK, "%s", e.msg);
+    CHECK(r.nv == 2 && r.nt == 0 && r.pos[1] == -1.5f, "point cloud read back");
+    mesh_free(&r);
+    mesh_free(&m);
+    remove(path);
+    rmdir(dir);
+}
+
+static void test_errors(void)
+{
+    mesh m;
+    rt_error e;
+    const char *bad1 = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                       "end_header\n0 0 0\n3 0 1 2\n";
+    CHECK(mio_ply_from_mem((const unsigned char *)bad1, strlen(bad1), &m, &e) == RT_EFORMAT, "index");
+    CHECK(strcmp(e.msg, "PLY face 0 has a vertex index out of 0..0") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    const char *bad2 = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n0\n";
+    CHECK(mio_ply_from_mem((const unsigned char *)bad2, strlen(bad2), &m, &e) == RT_EFORMAT, "trunc");
+    CHECK(strcmp(e.msg, "PLY data for element 'vertex' is truncated or malformed") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    const char *bad3 = "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n";
+    CHECK(mio_ply_from_mem((const unsigned char *)bad3, strlen(bad3), &m, &e) == RT_EFORMAT, "type");
+    CHECK(strcmp(e.msg, "PLY header line 4: unknown type 'quad'") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    const char *bad4 = "v 0 0 0\nv 1 0 0\nf 1 2 3\n";
+    CHECK(mio_obj_from_mem((const unsigned char *)bad4, strlen(bad4), &m, &e) == RT_EFORMAT, "obj");
+    CHECK(strcmp(e.msg, "OBJ line 3: face index out of 1..2") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    const char *bad5 = "solid x\nfacet normal 0 0 1\n";
+    CHECK(mio_stl_from_mem((const unsigned char *)bad5, strlen(bad5), &m, &e) == RT_EFORMAT, "stl");
+    CHECK(strcmp(e.msg, "ASCII STL is not read (only binary STL)") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    CHECK(mio_save("/tmp/x.off", &m, &e) == RT_EINVAL, "ext");
+    CHECK(strcmp(e.msg, "mesh file '/tmp/x.off' does not end in .ply, .obj or .stl") == 0, "msg: %s", e.msg);
+}
+
+int main(void)
+{
+    test_writers();
+    test_readers();
+    test_roundtrip();
+    test_errors();
+    return check_done("test_mesh_io");
+}
