@@ -153,8 +153,14 @@ static int image_arith(interp *I, int op, value a, value b, value *out)
     const image *shape = x ? x : y;
     if (lang_image_new(I, shape->w, shape->h, &r))
         return -1;
+    /* Colour channels combine; alpha is the first image operand's. */
     size_t n = (size_t)shape->w * (size_t)shape->h * 4;
+    const image *alpha = x ? x : y;
     for (size_t i = 0; i < n; i++) {
+        if ((i & 3) == 3) {
+            r->px[i] = alpha->px[i];
+            continue;
+        }
         float p = x ? x->px[i] : (float)a.u.n;
         float q = y ? y->px[i] : (float)b.u.n;
         r->px[i] = fop(op, p, q);

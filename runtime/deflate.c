@@ -1,0 +1,800 @@
+/* deflate.c — DEFLATE compressor (RFC 1951), zlib wrapper (RFC 1950),
+ * Adler-32 and CRC-32. Not one of the seed papers: this is infrastructure for
+ * PNG output (see DESIGN.md, "PNG": fixed Huffman alone costs ~45% in size).
+ *
+ * Pipeline: LZ77 with hash chains over the whole input (the input is in
+ * memory, so positions are absolute and the 32 KiB window is enforced by a
+ * distance check instead of sliding a buffer) -> symbols buffered per block
+ * -> for each block the smallest of dynamic Huffman, fixed Huffman and stored
+ * (RFC 1951 §3.2.4–3.2.7). The lazy-matching rule and the per-level
+ * parameters (good/lazy/nice/chain) are zlib's, so level 6 behaves like
+ * zlib's level 6; the code itself is ours.
+ */
+#include "deflate.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------- checksums */
+
+static uint32_t crc_table[256];
+static pthread_once_t crc_once = PTHREAD_ONCE_INIT;
+
+static void crc_init(void)
+{
+    /* reflected CRC-32, polynomial 0xEDB88320 (PNG spec annex D, ISO 3309) */
+    for (uint32_t i = 0; i < 256; i++) {
+        uint32_t c = i;
+        for (int k = 0; k < 8; k++)
+            c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        crc_table[i] = c;
+    }
+}
+
+uint32_t deflate_crc32(uint32_t crc, const void *p, size_t n)
+{
+    pthread_once(&crc_once, crc_init);
+    const unsigned char *s = p;
+    uint32_t c = crc ^ 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++)
+        c = crc_table[(c ^ s[i]) & 0xFF] ^ (c >> 8);
+    return c ^ 0xFFFFFFFFu;
+}
+
+uint32_t deflate_adler32(uint32_t adler, const void *p, size_t n)
+{
+    /* RFC 1950 §8.2; 5552 is the largest block for which the sums cannot
+     * overflow 32 bits before the reduction modulo 65521. */
+    const unsigned char *s = p;
+    uint32_t a = adler & 0xFFFF, b = adler >> 16;
+    while (n > 0) {
+        size_t k = n < 5552 ? n : 5552;
+        n -= k;
+        while (k--) {
+            a += *s++;
+            b += a;
+        }
+        a %= 65521;
+        b %= 65521;
+    }
+    return (b << 16) | a;
+}
+
+/* ------------------------------------------------------------- bit writer */
+
+typedef struct bitw {
+    unsigned char *buf;
+    size_t len, cap;
+    uint64_t bits;
+    int nbits;
+    int failed;
+} bitw;
+
+static int bw_reserve(bitw *w, size_t extra)
+{
+    if (w->failed)
+        return 0;
+    if (w->len + extra <= w->cap)
+        return 1;
+    size_t ncap = w->cap ? w->cap : 4096;
+    while (ncap < w->len + extra) {
+        if (ncap > SIZE_MAX / 2) {
+            w->failed = 1;
+            return 0;
+        }
+        ncap *= 2;
+    }
+    unsigned char *nb = realloc(w->buf, ncap);
+    if (!nb) {
+        w->failed = 1;
+        return 0;
+    }
+    w->buf = nb;
+    w->cap = ncap;
+    return 1;
+}
+
+/* Append the n (<= 32) low bits of v, least significant first (§3.1.1). */
+static inline void bw_put(bitw *w, uint32_t v, int n)
+{
+    w->bits |= (uint64_t)v << w->nbits;
+    w->nbits += n;
+    if (w->nbits >= 32) {
+        if (w->len + 4 > w->cap && !bw_reserve(w, 4)) {
+            w->bits = 0; /* failed: keep the shift counts in range */
+            w->nbits = 0;
+            return;
+        }
+        unsigned char *o = w->buf + w->len;
+        o[0] = (unsigned char)w->bits;
+        o[1] = (unsigned char)(w->bits >> 8);
+        o[2] = (unsigned char)(w->bits >> 16);
+        o[3] = (unsigned char)(w->bits >> 24);
+        w->len += 4;
+        w->bits >>= 32;
+        w->nbits -= 32;
+    }
+}
+
+/* Pad with zero bits to a byte boundary and flush the bit buffer. */
+static void bw_align(bitw *w)
+{
+    if (!bw_reserve(w, 8))
+        return;
+    while (w->nbits > 0) {
+        w->buf[w->len++] = (unsigned char)w->bits;
+        w->bits >>= 8;
+        w->nbits -= 8;
+    }
+    w->nbits = 0;
+    w->bits = 0;
+}
+
+static void bw_bytes(bitw *w, const unsigned char *p, size_t n)
+{
+    if (n == 0 || !bw_reserve(w, n))
+        return;
+    memcpy(w->buf + w->len, p, n);
+    w->len += n;
+}
+
+/* --------------------------------------------------------------- Huffman */
+
+#define NLIT 288  /* literal/length alphabet incl. the two unused codes */
+#define NDIST 32
+#define NCL 19
+
+static int ilog2u(uint32_t v) /* floor(log2 v), v >= 1 */
+{
+#if defined(__GNUC__)
+    return 31 - __builtin_clz(v);
+#else
+    int r = 0;
+    while (v >>= 1)
+        r++;
+    return r;
+#endif
+}
+
+typedef struct symfreq {
+    uint32_t freq;
+    int sym;
+} symfreq;
+
+static int cmp_symfreq(const void *a, const void *b)
+{
+    const symfreq *x = a, *y = b;
+    if (x->freq != y->freq)
+        return x->freq < y->freq ? -1 : 1;
+    return (x->sym > y->sym) - (x->sym < y->sym);
+}
+
+/* Code lengths for a length-limited Huffman code over freq[0..n-1] (n <= 288).
+ * Unused symbols get length 0. A code is always complete: if only one symbol
+ * is used a second one gets a 1-bit code too (some decoders reject an
+ * incomplete code). No symbol used: all lengths 0. */
+static void huff_lengths(const uint32_t *freq, int n, int maxlen, uint8_t *len)
+{
+    symfreq sf[NLIT];
+    uint32_t A[NLIT];
+    int m = 0;
+    memset(len, 0, (size_t)n);
+    for (int i = 0; i < n; i++)
+        if (freq[i]) {
+            sf[m].freq = freq[i];
+            sf[m].sym = i;
+            m++;
+        }
+    if (m == 0)
+        return;
+    if (m == 1) {
+        len[sf[0].sym] = 1;
+        len[sf[0].sym == 0 ? 1 : 0] = 1;
+        return;
+    }
+    qsort(sf, (size_t)m, sizeof sf[0], cmp_symfreq);
+    for (int i = 0; i < m; i++)
+        A[i] = sf[i].freq;
+
+    /* In-place minimum-redundancy code lengths for sorted weights: Moffat &
+     * Katajainen, "In-place calculation of minimum-redundancy codes" (1995).
+     * Pass 1 builds the tree (parent pointers), pass 2 computes internal
+     * node depths, pass 3 leaf depths; A[i] ends as the length of the i-th
+     * lightest symbol. */
+    int root = 0, leaf = 2, next;
+    A[0] += A[1];
+    for (next = 1; next < m - 1; next++) {
+        if (leaf >= m || A[root] < A[leaf]) {
+            A[next] = A[root];
+            A[root++] = (uint32_t)next;
+        } else
+            A[next] = A[leaf++];
+        if (leaf >= m || (root < next && A[root] < A[leaf])) {
+            A[next] += A[root];
+            A[root++] = (uint32_t)next;
+        } else
+            A[next] += A[leaf++];
+    }
+    A[m - 2] = 0;
+    for (next = m - 3; next >= 0; next--)
+        A[next] = A[A[next]] + 1;
+    {
+        int avbl = 1, used = 0, dpth = 0;
+        root = m - 2;
+        next = m - 1;
+        while (avbl > 0) {
+            while (root >= 0 && (int)A[root] == dpth) {
+                used++;
+                root--;
+            }
+            while (avbl > used) {
+                A[next--] = (uint32_t)dpth;
+                avbl--;
+            }
+            avbl = 2 * used;
+            dpth++;
+            used = 0;
+        }
+    }
+
+    /* Limit to maxlen: clamp, then repair the Kraft sum by moving codes one
+     * level down (each step keeps the code count and lowers the sum by one
+     * unit of 2^-maxlen). */
+    int count[64] = {0};
+    for (int i = 0; i < m; i++)
+        count[A[i] > (uint32_t)maxlen ? maxlen : (int)A[i]]++;
+    uint32_t total = 0;
+    for (int l = 1; l <= maxlen; l++)
+        total += (uint32_t)count[l] << (maxlen - l);
+    while (total > (1u << maxlen)) {
+        count[maxlen]--;
+        for (int l = maxlen - 1; l > 0; l--)
+            if (count[l]) {
+                count[l]--;
+                count[l + 1] += 2;
+                break;
+            }
+        total--;
+    }
+    /* the lightest symbols get the longest codes */
+    int i = 0;
+    for (int l = maxlen; l >= 1; l--)
+        for (int k = 0; k < count[l]; k++)
+            len[sf[i++].sym] = (uint8_t)l;
+}
+
+/* Canonical codes (§3.2.2), bit-reversed for the LSB-first writer. */
+static void huff_codes(const uint8_t *len, int n, uint16_t *code)
+{
+    int count[16] = {0};
+    uint32_t next[16];
+    for (int i = 0; i < n; i++)
+        count[len[i]]++;
+    count[0] = 0;
+    uint32_t c = 0;
+    for (int l = 1; l < 16; l++) {
+        c = (c + (uint32_t)count[l - 1]) << 1;
+        next[l] = c;
+    }
+    for (int i = 0; i < n; i++) {
+        int l = len[i];
+        if (!l) {
+            code[i] = 0;
+            continue;
+        }
+        uint32_t v = next[l]++, r = 0;
+        for (int k = 0; k < l; k++) {
+            r = (r << 1) | (v & 1);
+            v >>= 1;
+        }
+        code[i] = (uint16_t)r;
+    }
+}
+
+/* Length 3..258 -> symbol 257..285, extra bits and their value (§3.2.5). */
+static inline void len_sym(int length, int *sym, int *nextra, int *extra)
+{
+    int l = length - 3;
+    if (l < 8) {
+        *sym = 257 + l;
+        *nextra = 0;
+        *extra = 0;
+    } else if (l == 255) {
+        *sym = 285;
+        *nextra = 0;
+        *extra = 0;
+    } else {
+        int nb = ilog2u((uint32_t)l);
+        *sym = 257 + 4 * (nb - 1) + ((l >> (nb - 2)) & 3);
+        *nextra = nb - 2;
+        *extra = l & ((1 << (nb - 2)) - 1);
+    }
+}
+
+/* Distance 1..32768 -> symbol 0..29, extra bits and their value. */
+static inline void dist_sym(int dist, int *sym, int *nextra, int *extra)
+{
+    int d = dist - 1;
+    if (d < 4) {
+        *sym = d;
+        *nextra = 0;
+        *extra = 0;
+    } else {
+        int nb = ilog2u((uint32_t)d);
+        *sym = 2 * nb + ((d >> (nb - 1)) & 1);
+        *nextra = nb - 1;
+        *extra = d & ((1 << (nb - 1)) - 1);
+    }
+}
+
+/* ---------------------------------------------------------------- LZ77 */
+
+#define WSIZE 32768
+#define WMASK (WSIZE - 1)
+#define MAX_DIST 32768
+#define HBITS 15
+#define HSIZE (1 << HBITS)
+#define MIN_MATCH 3
+#define MAX_MATCH 258
+#define TOO_FAR 4096
+#define BLOCK_SYMS 16384
+
+typedef struct level_cfg {
+    int good, lazy, nice, chain, lazy_mode;
+} level_cfg;
+
+/* zlib's configuration table (deflate.c, configuration_table); for the
+ * greedy levels 1..3 "lazy" is the longest match whose positions are all
+ * inserted into the hash chains. */
+static const level_cfg level_cfgs[10] = {
+    {0, 0, 0, 0, 0},         {4, 4, 8, 4, 0},       {4, 5, 16, 8, 0},
+    {4, 6, 32, 32, 0},       {4, 4, 16, 16, 1},     {8, 16, 32, 32, 1},
+    {8, 16, 128, 128, 1},    {8, 32, 128, 256, 1},  {32, 128, 258, 1024, 1},
+    {32, 258, 258, 4096, 1},
+};
+
+typedef struct deflater {
+    const unsigned char *in;
+    size_t n;
+    level_cfg cfg;
+    int32_t *head, *prev;
+    uint16_t *sym_ll, *sym_d; /* literal or length; distance (0 = literal) */
+    int nsyms;
+    uint32_t lfreq[NLIT], dfreq[NDIST];
+    size_t block_start, covered; /* input range of the pending block */
+    bitw w;
+} deflater;
+
+static inline uint32_t hash3(const unsigned char *p)
+{
+    uint32_t v = ((uint32_t)p[0] << 16) | ((uint32_t)p[1] << 8) | p[2];
+    return (v * 2654435761u) >> (32 - HBITS);
+}
+
+/* Insert position pos (pos + 2 < n) and return the previous chain head. */
+static inline int32_t insert_pos(deflater *d, size_t pos)
+{
+    uint32_t h = hash3(d->in + pos);
+    int32_t old = d->head[h];
+    d->prev[pos & WMASK] = old;
+    d->head[h] = (int32_t)pos;
+    return old;
+}
+
+/* Longest match for pos among the chain starting at cur that is longer than
+ * prev_len (and >= MIN_MATCH); returns its length or 0. */
+static int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_len, int *mdist)
+{
+    const unsigned char *s = d->in + pos;
+    size_t avail = d->n - pos;
+    int maxlen = avail < MAX_MATCH ? (int)avail : MAX_MATCH;
+    int best = prev_len < MIN_MATCH - 1 ? MIN_MATCH - 1 : prev_len;
+    int found = 0;
+    if (best >= maxlen)
+        return 0;
+    int chain = d->cfg.chain;
+    if (prev_len >= d->cfg.good)
+        chain >>= 2;
+    int nice = d->cfg.nice < maxlen ? d->cfg.nice : maxlen;
+    uint16_t end2, start2;
+    memcpy(&end2, s + best - 1, 2);
+    memcpy(&start2, s, 2);
+    while (cur >= 0 && pos - (size_t)cur <= MAX_DIST && chain-- > 0) {
+        const unsigned char *m = d->in + cur;
+        uint16_t me, ms;
+        memcpy(&me, m + best - 1, 2);
+        memcpy(&ms, m, 2);
+        /* a longer match must agree at best-1, best and at the start */
+        if (me == end2 && ms == start2) {
+            int len = 2;
+            while (len + 8 <= maxlen) {
+                uint64_t a, b;
+                memcpy(&a, m + len, 8);
+                memcpy(&b, s + len, 8);
+                if (a != b)
+                    break;
+                len += 8;
+            }
+            while (len < maxlen && m[len] == s[len])
+                len++;
+            if (len > best) {
+                best = len;
+                found = 1;
+                if (len < maxlen)
+                    memcpy(&end2, s + best - 1, 2);
+                *mdist = (int)(pos - (size_t)cur);
+                if (len >= nice)
+                    break;
+            }
+        }
+        int32_t nx = d->prev[cur & WMASK];
+        if (nx >= cur) /* slot reused by a newer position: chain ends */
+            break;
+        cur = nx;
+    }
+    return found ? best : 0;
+}
+
+/* ----------------------------------------------------------- block output */
+
+static const uint8_t cl_order[NCL] = {16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15};
+
+static void fixed_lengths(uint8_t *ll, uint8_t *dl)
+{
+    for (int i = 0; i < NLIT; i++)
+        ll[i] = i < 144 ? 8 : i < 256 ? 9 : i < 280 ? 7 : 8;
+    for (int i = 0; i < NDIST; i++)
+        dl[i] = 5;
+}
+
+static void write_symbols(deflater *d, const uint8_t *ll, const uint16_t *lc, const uint8_t *dl,
+                          const uint16_t *dc)
+{
+    bitw *w = &d->w;
+    for (int i = 0; i < d->nsyms; i++) {
+        int v = d->sym_ll[i], dist = d->sym_d[i];
+        if (dist == 0) {
+            bw_put(w, lc[v], ll[v]);
+        } else {
+            int sym, nx, x;
+            len_sym(v, &sym, &nx, &x);
+            bw_put(w, lc[sym], ll[sym]);
+            if (nx)
+                bw_put(w, (uint32_t)x, nx);
+            dist_sym(dist, &sym, &nx, &x);
+            bw_put(w, dc[sym], dl[sym]);
+            if (nx)
+                bw_put(w, (uint32_t)x, nx);
+        }
+    }
+    bw_put(w, lc[256], ll[256]);
+}
+
+/* Emit the pending symbols as one block (or several stored blocks). */
+static void flush_block(deflater *d, int final, int force_stored)
+{
+    bitw *w = &d->w;
+    d->lfreq[256] = 1;
+
+    /* bits spent on extra bits, the same for fixed and dynamic */
+    uint64_t extra_bits = 0;
+    for (int s = 265; s < 285; s++)
+        extra_bits += (uint64_t)d->lfreq[s] * (uint64_t)((s - 261) / 4);
+    for (int s = 4; s < 30; s++)
+        extra_bits += (uint64_t)d->dfreq[s] * (uint64_t)((s - 2) / 2);
+
+    /* dynamic code */
+    uint8_t ll[NLIT], dl[NDIST];
+    huff_lengths(d->lfreq, 286, 15, ll);
+    ll[286] = ll[287] = 0;
+    huff_lengths(d->dfreq, 30, 15, dl);
+    dl[30] = dl[31] = 0;
+    if (dl[0] == 0 && dl[1] == 0) {
+        int any = 0;
+        for (int i = 0; i < 30; i++)
+            any |= dl[i];
+        if (!any) /* no distances: two 1-bit codes keep the code complete */
+            dl[0] = dl[1] = 1;
+    }
+    int hlit = 286, hdist = 30;
+    while (hlit > 257 && ll[hlit - 1] == 0)
+        hlit--;
+    while (hdist > 1 && dl[hdist - 1] == 0)
+        hdist--;
+
+    /* run-length code the concatenated lengths (§3.2.7) */
+    uint8_t all[286 + 30];
+    memcpy(all, ll, (size_t)hlit);
+    memcpy(all + hlit, dl, (size_t)hdist);
+    int nall = hlit + hdist;
+    uint8_t rl_sym[286 + 30], rl_x[286 + 30];
+    int nrl = 0;
+    uint32_t clfreq[NCL] = {0};
+    for (int i = 0; i < nall;) {
+        int l = all[i], run = 1;
+        while (i + run < nall && all[i + run] == l)
+            run++;
+        i += run;
+        if (l == 0) {
+            while (run >= 11) {
+                int r = run < 138 ? run : 138;
+                rl_sym[nrl] = 18, rl_x[nrl++] = (uint8_t)(r - 11);
+                run -= r;
+            }
+            if (run >= 3) {
+                rl_sym[nrl] = 17, rl_x[nrl++] = (uint8_t)(run - 3);
+                run = 0;
+            }
+        } else {
+            rl_sym[nrl] = (uint8_t)l, rl_x[nrl++] = 0;
+            run--;
+            while (run >= 3) {
+                int r = run < 6 ? run : 6;
+                rl_sym[nrl] = 16, rl_x[nrl++] = (uint8_t)(r - 3);
+                run -= r;
+            }
+        }
+        while (run-- > 0)
+            rl_sym[nrl] = (uint8_t)l, rl_x[nrl++] = 0;
+    }
+    for (int i = 0; i < nrl; i++)
+        clfreq[rl_sym[i]]++;
+    uint8_t cll[NCL];
+    uint16_t clc[NCL];
+    huff_lengths(clfreq, NCL, 7, cll);
+    int hclen = NCL;
+    while (hclen > 4 && cll[cl_order[hclen - 1]] == 0)
+        hclen--;
+
+    uint64_t dyn = 3 + 14 + 3 * (uint64_t)hclen + extra_bits;
+    for (int i = 0; i < NCL; i++)
+        dyn += (uint64_t)clfreq[i] * cll[i];
+    dyn += 2 * (uint64_t)clfreq[16] + 3 * (uint64_t)clfreq[17] + 7 * (uint64_t)clfreq[18];
+    for (int i = 0; i < 286; i++)
+        dyn += (uint64_t)d->lfreq[i] * ll[i];
+    for (int i = 0; i < 30; i++)
+        dyn += (uint64_t)d->dfreq[i] * dl[i];
+
+    uint8_t fll[NLIT], fdl[NDIST];
+    fixed_lengths(fll, fdl);
+    uint64_t fix = 3 + extra_bits;
+    for (int i = 0; i < 286; i++)
+        fix += (uint64_t)d->lfreq[i] * fll[i];
+    for (int i = 0; i < 30; i++)
+        fix += (uint64_t)d->dfreq[i] * 5;
+
+    size_t raw = d->covered - d->block_start;
+    uint64_t sto = 0;
+    {
+        int pos = w->nbits & 7;
+        size_t left = raw;
+        do {
+            size_t k = left < 65535 ? left : 65535;
+            sto += 3 + (uint64_t)((8 - (pos + 3) % 8) % 8) + 32 + 8 * (uint64_t)k;
+            pos = 0;
+            left -= k;
+        } while (left > 0);
+    }
+
+    if (force_stored || (sto < dyn && sto < fix)) {
+        const unsigned char *p = d->in + d->block_start;
+        size_t left = raw;
+        do {
+            size_t k = left < 65535 ? left : 65535;
+            left -= k;
+            bw_put(w, (uint32_t)(final && left == 0), 1);
+            bw_put(w, 0, 2);
+            bw_align(w);
+            unsigned char hdr[4] = {(unsigned char)k, (unsigned char)(k >> 8), (unsigned char)~k,
+                                    (unsigned char)(~k >> 8)};
+            bw_bytes(w, hdr, 4);
+            bw_bytes(w, p, k);
+            p += k;
+        } while (left > 0);
+    } else if (fix <= dyn) {
+        uint16_t lc[NLIT], dc[NDIST];
+        huff_codes(fll, NLIT, lc);
+        huff_codes(fdl, NDIST, dc);
+        bw_put(w, (uint32_t)final, 1);
+        bw_put(w, 1, 2);
+        write_symbols(d, fll, lc, fdl, dc);
+    } else {
+        uint16_t lc[NLIT], dc[NDIST];
+        huff_codes(ll, NLIT, lc);
+        huff_codes(dl, NDIST, dc);
+        huff_codes(cll, NCL, clc);
+        bw_put(w, (uint32_t)final, 1);
+        bw_put(w, 2, 2);
+        bw_put(w, (uint32_t)(hlit - 257), 5);
+        bw_put(w, (uint32_t)(hdist - 1), 5);
+        bw_put(w, (uint32_t)(hclen - 4), 4);
+        for (int i = 0; i < hclen; i++)
+            bw_put(w, cll[cl_order[i]], 3);
+        for (int i = 0; i < nrl; i++) {
+            int s = rl_sym[i];
+            bw_put(w, clc[s], cll[s]);
+            if (s == 16)
+                bw_put(w, rl_x[i], 2);
+            else if (s == 17)
+                bw_put(w, rl_x[i], 3);
+            else if (s == 18)
+                bw_put(w, rl_x[i], 7);
+        }
+        write_symbols(d, ll, lc, dl, dc);
+    }
+    d->nsyms = 0;
+    memset(d->lfreq, 0, sizeof d->lfreq);
+    memset(d->dfreq, 0, sizeof d->dfreq);
+    d->block_start = d->covered;
+}
+
+static inline void emit_lit(deflater *d, int c)
+{
+    d->sym_ll[d->nsyms] = (uint16_t)c;
+    d->sym_d[d->nsyms++] = 0;
+    d->lfreq[c]++;
+    d->covered++;
+    if (d->nsyms == BLOCK_SYMS)
+        flush_block(d, 0, 0);
+}
+
+static inline void emit_match(deflater *d, int len, int dist)
+{
+    int sym, nx, x;
+    d->sym_ll[d->nsyms] = (uint16_t)len;
+    d->sym_d[d->nsyms++] = (uint16_t)dist; /* 32768 fits in 16 bits */
+    len_sym(len, &sym, &nx, &x);
+    d->lfreq[sym]++;
+    dist_sym(dist, &sym, &nx, &x);
+    d->dfreq[sym]++;
+    d->covered += (size_t)len;
+    if (d->nsyms == BLOCK_SYMS)
+        flush_block(d, 0, 0);
+}
+
+static void lz_greedy(deflater *d)
+{
+    size_t n = d->n, pos = 0;
+    while (pos < n) {
+        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int ml = 0, md = 0;
+        if (hh >= 0)
+            ml = longest_match(d, pos, hh, 0, &md);
+        if (ml >= MIN_MATCH) {
+            emit_match(d, ml, md);
+            if (ml <= d->cfg.lazy)
+                for (size_t p = pos + 1; p < pos + (size_t)ml && p + 2 < n; p++)
+                    insert_pos(d, p);
+            pos += (size_t)ml;
+        } else {
+            emit_lit(d, d->in[pos]);
+            pos++;
+        }
+    }
+}
+
+/* zlib's lazy evaluation: a match found at pos-1 is emitted only if pos
+ * does not start a longer one; otherwise pos-1 becomes a literal. */
+static void lz_lazy(deflater *d)
+{
+    size_t n = d->n, pos = 0;
+    int match_len = 0, match_dist = 0, avail = 0;
+    while (pos < n) {
+        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int prev_len = match_len, prev_dist = match_dist;
+        match_len = 0;
+        if (hh >= 0 && prev_len < d->cfg.lazy) {
+            match_len = longest_match(d, pos, hh, prev_len, &match_dist);
+            if (match_len == MIN_MATCH && match_dist > TOO_FAR)
+                match_len = 0;
+        }
+        if (prev_len >= MIN_MATCH && match_len <= prev_len) {
+            emit_match(d, prev_len, prev_dist);
+            size_t end = pos - 1 + (size_t)prev_len;
+            for (size_t p = pos + 1; p < end && p + 2 < n; p++)
+                insert_pos(d, p);
+            pos = end;
+            avail = 0;
+            match_len = 0;
+        } else if (avail) {
+            emit_lit(d, d->in[pos - 1]);
+            pos++;
+        } else {
+            avail = 1;
+            pos++;
+        }
+    }
+    if (avail)
+        emit_lit(d, d->in[n - 1]);
+}
+
+static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w, rt_error *e)
+{
+    if (level < 0 || level > 9)
+        return rt_fail(e, RT_EINVAL, "deflate level %d is out of range (expected 0..9)", level);
+    deflater *d = calloc(1, sizeof *d);
+    if (!d)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
+    d->in = in;
+    d->n = n;
+    d->cfg = level_cfgs[level];
+    d->w = *w;
+    if (level > 0) {
+        d->head = malloc(HSIZE * sizeof *d->head);
+        d->prev = malloc(WSIZE * sizeof *d->prev);
+        d->sym_ll = malloc(BLOCK_SYMS * sizeof *d->sym_ll);
+        d->sym_d = malloc(BLOCK_SYMS * sizeof *d->sym_d);
+        if (!d->head || !d->prev || !d->sym_ll || !d->sym_d) {
+            free(d->head), free(d->prev), free(d->sym_ll), free(d->sym_d);
+            *w = d->w;
+            free(d);
+            return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
+        }
+        for (int i = 0; i < HSIZE; i++)
+            d->head[i] = -1;
+        for (int i = 0; i < WSIZE; i++)
+            d->prev[i] = -1;
+        if (d->cfg.lazy_mode)
+            lz_lazy(d);
+        else
+            lz_greedy(d);
+        flush_block(d, 1, 0);
+    } else {
+        d->covered = n; /* level 0: everything as stored blocks */
+        flush_block(d, 1, 1);
+    }
+    bw_align(&d->w);
+    *w = d->w;
+    free(d->head), free(d->prev), free(d->sym_ll), free(d->sym_d);
+    free(d);
+    if (w->failed)
+        return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
+    return RT_OK;
+}
+
+static rt_code append_out(bitw *w, bytebuf *out, rt_error *e)
+{
+    bytebuf_append(out, w->buf, w->len);
+    free(w->buf);
+    if (out->failed)
+        return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
+    return RT_OK;
+}
+
+rt_code deflate_raw(const unsigned char *in, size_t n, int level, bytebuf *out, rt_error *e)
+{
+    bitw w = {0};
+    rt_code c = deflate_to(in, n, level, &w, e);
+    if (c) {
+        free(w.buf);
+        return c;
+    }
+    return append_out(&w, out, e);
+}
+
+rt_code deflate_zlib(const unsigned char *in, size_t n, int level, bytebuf *out, rt_error *e)
+{
+    bitw w = {0};
+    /* CMF: method 8, 32 KiB window; FLG: level hint, no dictionary, and the
+     * check bits making CMF*256+FLG a multiple of 31 (RFC 1950 §2.2). */
+    unsigned cmf = 0x78, flevel = level <= 1 ? 0 : level <= 5 ? 1 : level == 6 ? 2 : 3;
+    unsigned flg = flevel << 6;
+    flg += (31 - (cmf * 256 + flg) % 31) % 31;
+    unsigned char hdr[2] = {(unsigned char)cmf, (unsigned char)flg};
+    bw_bytes(&w, hdr, 2);
+    rt_code c = deflate_to(in, n, level, &w, e);
+    if (c) {
+        free(w.buf);
+        return c;
+    }
+    uint32_t a = deflate_adler32(1, in, n);
+    unsigned char tr[4] = {(unsigned char)(a >> 24), (unsigned char)(a >> 16), (unsigned char)(a >> 8),
+                           (unsigned char)a};
+    bw_bytes(&w, tr, 4);
+    if (w.failed) {
+        free(w.buf);
+        return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
+    }
+    return append_out(&w, out, e);
+}

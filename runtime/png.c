@@ -1,0 +1,669 @@
+/* png.c — PNG encoder and decoder. Not from the seed papers: the format is
+ * the PNG specification (W3C, 2nd edition); section numbers below refer to
+ * it. Compression is our deflate.c / inflate.c. */
+#include "png.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "deflate.h"
+
+#define PNG_MAX_DIM 0x7FFFFFFFu /* §11.2.2: width and height fit in 31 bits */
+#define PNG_MAX_FILE ((size_t)1 << 31)
+
+static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+
+/* ---------------------------------------------------------- conversions */
+
+unsigned png_sample(float v, unsigned maxval)
+{
+    double d = v;
+    if (!(d > 0)) /* also NaN */
+        d = 0;
+    if (d > 1)
+        d = 1;
+    return (unsigned)floor(d * maxval + 0.5);
+}
+
+float png_luma(const float *px)
+{
+    /* ITU-R BT.709 luminance of linear RGB */
+    return (float)(0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2]);
+}
+
+/* ------------------------------------------------------------- encoding */
+
+static void put_chunk(bytebuf *out, const char *type, const unsigned char *data, size_t len)
+{
+    bytebuf_u32be(out, (uint32_t)len);
+    bytebuf_append(out, type, 4);
+    bytebuf_append(out, data, len);
+    uint32_t crc = deflate_crc32(0, type, 4);
+    crc = deflate_crc32(crc, data, len);
+    bytebuf_u32be(out, crc);
+}
+
+static int paeth(int a, int b, int c) /* §9.4 */
+{
+    int p = a + b - c;
+    int pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+    if (pa <= pb && pa <= pc)
+        return a;
+    return pb <= pc ? b : c;
+}
+
+/* Sum of |v| over bytes read as signed (§12.8's heuristic): |v| is
+ * min(v, 256 - v), a form compilers vectorise. */
+static uint64_t row_cost(const unsigned char *f, size_t rb)
+{
+    uint64_t cost = 0;
+    for (size_t i = 0; i < rb;) {
+        size_t end = rb - i > 4096 ? i + 4096 : rb; /* uint32 partial sums cannot overflow */
+        uint32_t part = 0;
+        for (; i < end; i++) {
+            unsigned char v = f[i], nv = (unsigned char)(0u - v);
+            part += v < nv ? v : nv;
+        }
+        cost += part;
+    }
+    return cost;
+}
+
+/* Filter row cur (prev = the previous row, all zero for the first) with
+ * type ft (§9.2) into dst. The first bpp bytes have no left neighbour
+ * (a = c = 0); the loops after them are branch-free so they vectorise. */
+static void filter_row(int ft, const unsigned char *cur, const unsigned char *prev, size_t rb,
+                       size_t bpp, unsigned char *dst)
+{
+    size_t i, k = bpp < rb ? bpp : rb;
+    switch (ft) {
+    case 0:
+        memcpy(dst, cur, rb);
+        break;
+    case 1:
+        for (i = 0; i < k; i++)
+            dst[i] = cur[i];
+        for (; i < rb; i++)
+            dst[i] = (unsigned char)(cur[i] - cur[i - bpp]);
+        break;
+    case 2:
+        for (i = 0; i < rb; i++)
+            dst[i] = (unsigned char)(cur[i] - prev[i]);
+        break;
+    case 3:
+        for (i = 0; i < k; i++)
+            dst[i] = (unsigned char)(cur[i] - (prev[i] >> 1));
+        for (; i < rb; i++)
+            dst[i] = (unsigned char)(cur[i] - ((cur[i - bpp] + prev[i]) >> 1));
+        break;
+    default:
+        for (i = 0; i < k; i++) /* Paeth(0, b, 0) = b */
+            dst[i] = (unsigned char)(cur[i] - prev[i]);
+        for (; i < rb; i++) {
+            int a = cur[i - bpp], b = prev[i], c = prev[i - bpp];
+            int pa = b - c, pb = a - c, pc = pa + pb; /* p - a, p - b, p - c */
+            pa = pa < 0 ? -pa : pa;
+            pb = pb < 0 ? -pb : pb;
+            pc = pc < 0 ? -pc : pc;
+            int pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
+            dst[i] = (unsigned char)(cur[i] - pred);
+        }
+        break;
+    }
+}
+
+static rt_code check_enc_args(int w, int h, int channels, int bits, rt_error *e)
+{
+    if (w < 1 || h < 1)
+        return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is empty", w, h);
+    if (channels < 1 || channels > 4)
+        return rt_fail(e, RT_EINVAL, "PNG channels %d is invalid (expected 1, 2, 3 or 4)",
+                       channels);
+    if (bits != 8 && bits != 16)
+        return rt_fail(e, RT_EINVAL, "PNG bit depth %d is invalid (expected 8 or 16)", bits);
+    return RT_OK;
+}
+
+rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels, int bits,
+                           int level, bytebuf *out, bytebuf *filtered, rt_error *e)
+{
+    rt_code c = check_enc_args(w, h, channels, bits, e);
+    if (c)
+        return c;
+    size_t bpp = (size_t)channels * (size_t)bits / 8;
+    size_t rb = rt_mul_size((size_t)w, bpp);
+    size_t total = rt_mul_size((size_t)h, rb + 1);
+    if (rb == 0 || total == 0)
+        return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is too large", w, h);
+    unsigned char *f = malloc(total), *tmp = malloc(5 * rb), *zero = calloc(1, rb);
+    if (!f || !tmp || !zero) {
+        free(f), free(tmp), free(zero);
+        return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", w, h);
+    }
+    /* adaptive filtering, §12.8: minimum sum of absolute differences */
+    for (int y = 0; y < h; y++) {
+        const unsigned char *cur = rows + (size_t)y * rb;
+        const unsigned char *prev = y ? cur - rb : zero;
+        unsigned char *dst = f + (size_t)y * (rb + 1);
+        uint64_t best = 0;
+        int bestft = 0;
+        for (int ft = 0; ft <= 4; ft++) {
+            filter_row(ft, cur, prev, rb, bpp, tmp + (size_t)ft * rb);
+            uint64_t cost = row_cost(tmp + (size_t)ft * rb, rb);
+            if (ft == 0 || cost < best) {
+                best = cost;
+                bestft = ft;
+            }
+        }
+        dst[0] = (unsigned char)bestft;
+        memcpy(dst + 1, tmp + (size_t)bestft * rb, rb);
+    }
+    free(zero);
+    free(tmp);
+    if (filtered)
+        bytebuf_append(filtered, f, total);
+
+    bytebuf z;
+    bytebuf_init(&z);
+    c = deflate_zlib(f, total, level, &z, e);
+    free(f);
+    if (c) {
+        bytebuf_free(&z);
+        return c;
+    }
+    static const int ctype[5] = {0, 0, 4, 2, 6};
+    unsigned char ihdr[13];
+    ihdr[0] = (unsigned char)(w >> 24), ihdr[1] = (unsigned char)(w >> 16);
+    ihdr[2] = (unsigned char)(w >> 8), ihdr[3] = (unsigned char)w;
+    ihdr[4] = (unsigned char)(h >> 24), ihdr[5] = (unsigned char)(h >> 16);
+    ihdr[6] = (unsigned char)(h >> 8), ihdr[7] = (unsigned char)h;
+    ihdr[8] = (unsigned char)bits;
+    ihdr[9] = (unsigned char)ctype[channels];
+    ihdr[10] = ihdr[11] = ihdr[12] = 0; /* deflate, adaptive filtering, no interlace */
+    bytebuf_append(out, png_sig, 8);
+    put_chunk(out, "IHDR", ihdr, 13);
+    const size_t piece = (size_t)1 << 20;
+    for (size_t off = 0; off < z.len; off += piece)
+        put_chunk(out, "IDAT", z.data + off, z.len - off < piece ? z.len - off : piece);
+    put_chunk(out, "IEND", NULL, 0);
+    bytebuf_free(&z);
+    if (out->failed || (filtered && filtered->failed))
+        return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", w, h);
+    return RT_OK;
+}
+
+rt_code png_encode(const image *im, int bits, int channels, bytebuf *out, rt_error *e)
+{
+    rt_code c = check_enc_args(im->w, im->h, channels, bits, e);
+    if (c)
+        return c;
+    size_t bps = (size_t)bits / 8, np = rt_mul_size((size_t)im->w, (size_t)im->h);
+    size_t n = rt_mul_size(np, (size_t)channels * bps);
+    if (n == 0)
+        return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is too large", im->w, im->h);
+    unsigned char *s = malloc(n);
+    if (!s)
+        return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", im->w, im->h);
+    unsigned maxval = bits == 16 ? 65535 : 255;
+    unsigned char *o = s;
+    for (size_t i = 0; i < np; i++) {
+        const float *p = im->px + 4 * i;
+        float v[4];
+        int k = 0;
+        if (channels <= 2)
+            v[k++] = png_luma(p);
+        else
+            v[k++] = p[0], v[k++] = p[1], v[k++] = p[2];
+        if (channels == 2 || channels == 4)
+            v[k++] = p[3];
+        for (int j = 0; j < k; j++) {
+            unsigned q = png_sample(v[j], maxval);
+            if (bits == 16)
+                *o++ = (unsigned char)(q >> 8);
+            *o++ = (unsigned char)q;
+        }
+    }
+    c = png_encode_samples(s, im->w, im->h, channels, bits, PNG_DEFAULT_LEVEL, out, NULL, e);
+    free(s);
+    return c;
+}
+
+rt_code png_save(const image *im, const char *path, int bits, int channels, rt_error *e)
+{
+    bytebuf b;
+    bytebuf_init(&b);
+    rt_code c = png_encode(im, bits, channels, &b, e);
+    if (!c)
+        c = fileio_write_atomic(path, b.data, b.len, e);
+    bytebuf_free(&b);
+    return c;
+}
+
+/* ------------------------------------------------------------- decoding */
+
+static uint32_t be32(const unsigned char *p)
+{
+    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+static rt_code check_sig(const unsigned char *d, size_t n, rt_error *e)
+{
+    if (n >= 8 && memcmp(d, png_sig, 8) == 0)
+        return RT_OK;
+    if (n >= 8 && d[0] == 0x89 && memcmp(d + 1, "PNG", 3) == 0)
+        return rt_fail(e, RT_EFORMAT,
+                       "bad PNG signature (bytes 5-8 are %02x %02x %02x %02x, expected 0d 0a 1a "
+                       "0a: altered by a text-mode transfer?)",
+                       d[4], d[5], d[6], d[7]);
+    return rt_fail(e, RT_EFORMAT, "not a PNG file (bad signature)");
+}
+
+/* Verify the chunk at d[pos..]: enough bytes, valid type, CRC. */
+static rt_code read_chunk(const unsigned char *d, size_t n, size_t pos, uint32_t *len,
+                          char type[5], rt_error *e)
+{
+    if (n - pos < 12)
+        return rt_fail(e, RT_EFORMAT, "PNG file is truncated (chunk header at byte %zu)", pos);
+    uint32_t l = be32(d + pos);
+    memcpy(type, d + pos + 4, 4);
+    type[4] = 0;
+    for (int i = 0; i < 4; i++) {
+        unsigned char ch = (unsigned char)type[i];
+        if (!((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z'))) {
+            return rt_fail(e, RT_EFORMAT, "invalid PNG chunk type (bytes %02x %02x %02x %02x) at byte %zu",
+                           d[pos + 4], d[pos + 5], d[pos + 6], d[pos + 7], pos);
+        }
+    }
+    if (l > 0x7FFFFFFFu)
+        return rt_fail(e, RT_EFORMAT, "PNG chunk '%s' length %u is too large", type, (unsigned)l);
+    if (n - pos - 12 < l)
+        return rt_fail(e, RT_EFORMAT, "PNG chunk '%s' is truncated (%u data bytes, %zu left)",
+                       type, (unsigned)l, n - pos - 12);
+    uint32_t stored = be32(d + pos + 8 + l), crc = deflate_crc32(0, d + pos + 4, (size_t)l + 4);
+    if (stored != crc)
+        return rt_fail(e, RT_EFORMAT, "CRC mismatch in PNG chunk '%s' (stored %08x, computed %08x)",
+                       type, (unsigned)stored, (unsigned)crc);
+    *len = l;
+    return RT_OK;
+}
+
+static rt_code parse_ihdr(const unsigned char *p, uint32_t len, png_info *info, rt_error *e)
+{
+    if (len != 13)
+        return rt_fail(e, RT_EFORMAT, "PNG IHDR has %u bytes (expected 13)", (unsigned)len);
+    uint32_t w = be32(p), h = be32(p + 4);
+    int depth = p[8], ct = p[9];
+    if (w == 0 || h == 0 || w > PNG_MAX_DIM || h > PNG_MAX_DIM)
+        return rt_fail(e, RT_EFORMAT, "invalid PNG image size %u×%u", (unsigned)w, (unsigned)h);
+    static const int chans[7] = {1, 0, 3, 1, 2, 0, 4};
+    if (ct > 6 || chans[ct] == 0)
+        return rt_fail(e, RT_EFORMAT, "invalid PNG colour type %d (expected 0, 2, 3, 4 or 6)", ct);
+    int ok;
+    const char *allowed;
+    switch (ct) {
+    case 0: ok = depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16;
+        allowed = "1, 2, 4, 8 or 16"; break;
+    case 3: ok = depth == 1 || depth == 2 || depth == 4 || depth == 8;
+        allowed = "1, 2, 4 or 8"; break;
+    default: ok = depth == 8 || depth == 16; allowed = "8 or 16"; break;
+    }
+    if (!ok)
+        return rt_fail(e, RT_EFORMAT, "invalid PNG bit depth %d for colour type %d (expected %s)",
+                       depth, ct, allowed);
+    if (p[10] != 0)
+        return rt_fail(e, RT_EFORMAT, "unknown PNG compression method %d", p[10]);
+    if (p[11] != 0)
+        return rt_fail(e, RT_EFORMAT, "unknown PNG filter method %d", p[11]);
+    if (p[12] > 1)
+        return rt_fail(e, RT_EFORMAT, "unknown PNG interlace method %d", p[12]);
+    info->w = (int)w;
+    info->h = (int)h;
+    info->bit_depth = depth;
+    info->color_type = ct;
+    info->interlace = p[12];
+    info->channels = chans[ct];
+    info->has_trns = 0;
+    return RT_OK;
+}
+
+rt_code png_read_info(const unsigned char *data, size_t n, png_info *info, rt_error *e)
+{
+    rt_code c = check_sig(data, n, e);
+    if (c)
+        return c;
+    uint32_t len;
+    char type[5];
+    if ((c = read_chunk(data, n, 8, &len, type, e)))
+        return c;
+    if (strcmp(type, "IHDR") != 0)
+        return rt_fail(e, RT_EFORMAT, "first PNG chunk is '%s', expected IHDR", type);
+    png_info tmp;
+    return parse_ihdr(data + 16, len, info ? info : &tmp, e);
+}
+
+typedef struct dec {
+    png_info info;
+    unsigned char pal[256][3];
+    int npal;
+    unsigned char trns_a[256];
+    int ntrns;
+    unsigned trns_key[3]; /* grey or RGB key colour, raw sample values */
+} dec;
+
+static size_t row_bytes(const png_info *f, size_t pw)
+{
+    return (pw * (size_t)f->channels * (size_t)f->bit_depth + 7) / 8;
+}
+
+/* Adam7 (§8.2): pass origin and step; pass 0 of a non-interlaced image is
+ * the whole image. */
+static const int a7[7][4] = {{0, 0, 8, 8}, {4, 0, 8, 8}, {0, 4, 4, 8}, {2, 0, 4, 4},
+                             {0, 2, 2, 4}, {1, 0, 2, 2}, {0, 1, 1, 2}};
+
+static void pass_dims(const png_info *f, int p, size_t *pw, size_t *ph, int g[4])
+{
+    if (!f->interlace) {
+        g[0] = g[1] = 0, g[2] = g[3] = 1;
+    } else
+        memcpy(g, a7[p], sizeof a7[p]);
+    size_t w = (size_t)f->w, h = (size_t)f->h;
+    *pw = w > (size_t)g[0] ? (w - (size_t)g[0] + (size_t)g[2] - 1) / (size_t)g[2] : 0;
+    *ph = h > (size_t)g[1] ? (h - (size_t)g[1] + (size_t)g[3] - 1) / (size_t)g[3] : 0;
+}
+
+static inline unsigned get_sample(const unsigned char *row, size_t i, int depth)
+{
+    if (depth == 8)
+        return row[i];
+    if (depth == 16)
+        return (unsigned)row[2 * i] << 8 | row[2 * i + 1];
+    size_t bit = i * (size_t)depth;
+    return (row[bit / 8] >> (8 - depth - (int)(bit % 8))) & ((1u << depth) - 1);
+}
+
+/* Unfilter (§9) and convert one pass into im. raw points at the pass data. */
+static rt_code decode_pass(const dec *D, int p, unsigned char *raw, image *im, rt_error *e)
+{
+    const png_info *f = &D->info;
+    size_t pw, ph;
+    int g[4];
+    pass_dims(f, p, &pw, &ph, g);
+    if (pw == 0 || ph == 0)
+        return RT_OK;
+    size_t rb = row_bytes(f, pw);
+    size_t bpp = (size_t)f->channels * (size_t)f->bit_depth / 8;
+    if (bpp == 0)
+        bpp = 1;
+    double maxv = (double)((1u << f->bit_depth) - 1);
+    unsigned char *prev = NULL;
+    for (size_t y = 0; y < ph; y++) {
+        unsigned char *row = raw + y * (rb + 1);
+        int ft = row[0];
+        unsigned char *cur = row + 1;
+        switch (ft) {
+        case 0: break;
+        case 1:
+            for (size_t i = bpp; i < rb; i++)
+                cur[i] = (unsigned char)(cur[i] + cur[i - bpp]);
+            break;
+        case 2:
+            if (prev)
+                for (size_t i = 0; i < rb; i++)
+                    cur[i] = (unsigned char)(cur[i] + prev[i]);
+            break;
+        case 3:
+            for (size_t i = 0; i < rb; i++) {
+                int a = i >= bpp ? cur[i - bpp] : 0, b = prev ? prev[i] : 0;
+                cur[i] = (unsigned char)(cur[i] + ((a + b) >> 1));
+            }
+            break;
+        case 4:
+            for (size_t i = 0; i < rb; i++) {
+                int a = i >= bpp ? cur[i - bpp] : 0, b = prev ? prev[i] : 0;
+                int c = prev && i >= bpp ? prev[i - bpp] : 0;
+                cur[i] = (unsigned char)(cur[i] + paeth(a, b, c));
+            }
+            break;
+        default:
+            return rt_fail(e, RT_EFORMAT, "invalid PNG filter type %d in row %zu%s", ft, y,
+                           f->interlace ? " of an Adam7 pass" : "");
+        }
+        prev = cur;
+        size_t yy = (size_t)g[1] + y * (size_t)g[3];
+        for (size_t x = 0; x < pw; x++) {
+            float *o = image_at(im, (int)((size_t)g[0] + x * (size_t)g[2]), (int)yy);
+            switch (f->color_type) {
+            case 0: {
+                unsigned s = get_sample(cur, x, f->bit_depth);
+                o[0] = o[1] = o[2] = (float)(s / maxv);
+                o[3] = D->ntrns && s == D->trns_key[0] ? 0.0f : 1.0f;
+                break;
+            }
+            case 2: {
+                unsigned r = get_sample(cur, 3 * x, f->bit_depth);
+                unsigned gg = get_sample(cur, 3 * x + 1, f->bit_depth);
+                unsigned b = get_sample(cur, 3 * x + 2, f->bit_depth);
+                o[0] = (float)(r / maxv), o[1] = (float)(gg / maxv), o[2] = (float)(b / maxv);
+                o[3] = D->ntrns && r == D->trns_key[0] && gg == D->trns_key[1] &&
+                               b == D->trns_key[2]
+                           ? 0.0f
+                           : 1.0f;
+                break;
+            }
+            case 3: {
+                unsigned k = get_sample(cur, x, f->bit_depth);
+                if ((int)k >= D->npal)
+                    return rt_fail(e, RT_EFORMAT,
+                                   "PNG palette index %u out of range (palette has %d entries)",
+                                   k, D->npal);
+                o[0] = (float)(D->pal[k][0] / 255.0);
+                o[1] = (float)(D->pal[k][1] / 255.0);
+                o[2] = (float)(D->pal[k][2] / 255.0);
+                o[3] = (int)k < D->ntrns ? (float)(D->trns_a[k] / 255.0) : 1.0f;
+                break;
+            }
+            case 4: {
+                unsigned s = get_sample(cur, 2 * x, f->bit_depth);
+                o[0] = o[1] = o[2] = (float)(s / maxv);
+                o[3] = (float)(get_sample(cur, 2 * x + 1, f->bit_depth) / maxv);
+                break;
+            }
+            default:
+                for (int j = 0; j < 4; j++)
+                    o[j] = (float)(get_sample(cur, 4 * x + (size_t)j, f->bit_depth) / maxv);
+                break;
+            }
+        }
+    }
+    return RT_OK;
+}
+
+static rt_code parse_trns(dec *D, const unsigned char *p, uint32_t len, rt_error *e)
+{
+    int ct = D->info.color_type;
+    if (ct == 3) {
+        if (D->npal == 0)
+            return rt_fail(e, RT_EFORMAT, "PNG tRNS chunk comes before PLTE");
+        if ((int)len > D->npal)
+            return rt_fail(e, RT_EFORMAT, "PNG tRNS has %u entries but the palette only %d",
+                           (unsigned)len, D->npal);
+        memcpy(D->trns_a, p, len);
+        D->ntrns = (int)len;
+    } else if (ct == 0 || ct == 2) {
+        uint32_t want = ct == 0 ? 2 : 6;
+        if (len != want)
+            return rt_fail(e, RT_EFORMAT, "PNG tRNS has %u bytes (expected %u for colour type %d)",
+                           (unsigned)len, (unsigned)want, ct);
+        for (uint32_t i = 0; i < want / 2; i++)
+            D->trns_key[i] = (unsigned)p[2 * i] << 8 | p[2 * i + 1];
+        D->ntrns = 1;
+    } else
+        return rt_fail(e, RT_EFORMAT, "PNG tRNS is not allowed for colour type %d", ct);
+    D->info.has_trns = 1;
+    return RT_OK;
+}
+
+rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *info, rt_error *e)
+{
+    im->w = im->h = 0;
+    im->px = NULL;
+    rt_code c = check_sig(data, n, e);
+    if (c)
+        return c;
+    dec *D = calloc(1, sizeof *D);
+    if (!D)
+        return rt_fail(e, RT_ENOMEM, "out of memory");
+    bytebuf idat, raw;
+    bytebuf_init(&idat);
+    bytebuf_init(&raw);
+    int idat_state = 0, seen_iend = 0; /* idat_state: 0 none yet, 1 in IDATs, 2 after */
+    size_t pos = 8;
+    while (!seen_iend) {
+        uint32_t len;
+        char type[5];
+        if (pos == n) {
+            c = rt_fail(e, RT_EFORMAT, "PNG file is truncated (no IEND chunk)");
+            goto fail;
+        }
+        if ((c = read_chunk(data, n, pos, &len, type, e)))
+            goto fail;
+        const unsigned char *p = data + pos + 8;
+        if (pos == 8) {
+            if (strcmp(type, "IHDR") != 0) {
+                c = rt_fail(e, RT_EFORMAT, "first PNG chunk is '%s', expected IHDR", type);
+                goto fail;
+            }
+            if ((c = parse_ihdr(p, len, &D->info, e)))
+                goto fail;
+        } else if (!strcmp(type, "IHDR")) {
+            c = rt_fail(e, RT_EFORMAT, "PNG has a second IHDR chunk");
+            goto fail;
+        } else if (!strcmp(type, "IDAT")) {
+            if (idat_state == 2) {
+                c = rt_fail(e, RT_EFORMAT, "PNG IDAT chunks are not consecutive");
+                goto fail;
+            }
+            idat_state = 1;
+            bytebuf_append(&idat, p, len);
+        } else {
+            if (idat_state == 1)
+                idat_state = 2;
+            if (!strcmp(type, "IEND")) {
+                seen_iend = 1;
+            } else if (!strcmp(type, "PLTE")) {
+                int ct = D->info.color_type;
+                if (idat_state) {
+                    c = rt_fail(e, RT_EFORMAT, "PNG PLTE chunk comes after IDAT");
+                    goto fail;
+                }
+                if (D->npal) {
+                    c = rt_fail(e, RT_EFORMAT, "PNG has a second PLTE chunk");
+                    goto fail;
+                }
+                if (ct == 0 || ct == 4) {
+                    c = rt_fail(e, RT_EFORMAT, "PNG PLTE is not allowed for grey colour type %d",
+                                ct);
+                    goto fail;
+                }
+                if (len == 0 || len % 3 || len > 768 ||
+                    (ct == 3 && (int)len / 3 > (1 << D->info.bit_depth))) {
+                    c = rt_fail(e, RT_EFORMAT, "PNG PLTE has an invalid length of %u bytes",
+                                (unsigned)len);
+                    goto fail;
+                }
+                D->npal = (int)len / 3;
+                memcpy(D->pal, p, len);
+            } else if (!strcmp(type, "tRNS")) {
+                if (idat_state) {
+                    c = rt_fail(e, RT_EFORMAT, "PNG tRNS chunk comes after IDAT");
+                    goto fail;
+                }
+                if ((c = parse_trns(D, p, len, e)))
+                    goto fail;
+            } else if (type[0] >= 'A' && type[0] <= 'Z') {
+                c = rt_fail(e, RT_EFORMAT, "unknown critical PNG chunk '%s'", type);
+                goto fail;
+            }
+            /* other ancillary chunks: skipped (CRC already checked) */
+        }
+        pos += 12 + (size_t)len;
+    }
+    if (idat_state == 0) {
+        c = rt_fail(e, RT_EFORMAT, "PNG has no IDAT chunk");
+        goto fail;
+    }
+    if (D->info.color_type == 3 && D->npal == 0) {
+        c = rt_fail(e, RT_EFORMAT, "PNG palette image has no PLTE chunk");
+        goto fail;
+    }
+    if (idat.failed) {
+        c = rt_fail(e, RT_ENOMEM, "out of memory");
+        goto fail;
+    }
+
+    /* expected size of the decompressed data */
+    size_t total = 0, off[8];
+    int npass = D->info.interlace ? 7 : 1;
+    for (int p = 0; p < npass; p++) {
+        size_t pw, ph;
+        int g[4];
+        pass_dims(&D->info, p, &pw, &ph, g);
+        off[p] = total;
+        if (pw && ph) {
+            size_t k = rt_mul_size(ph, row_bytes(&D->info, pw) + 1);
+            if (k == 0 || total + k < total) {
+                c = rt_fail(e, RT_EFORMAT, "PNG image size %d×%d is too large", D->info.w,
+                            D->info.h);
+                goto fail;
+            }
+            total += k;
+        }
+    }
+    c = inflate_zlib(idat.data, idat.len, total, &raw, e);
+    if (c) {
+        if (c == RT_EFORMAT) {
+            char m[sizeof e->msg];
+            memcpy(m, e->msg, sizeof m);
+            if (strstr(m, "exceed"))
+                rt_fail(e, RT_EFORMAT, "PNG image data are longer than the %zu bytes expected",
+                        total);
+            else
+                rt_fail(e, RT_EFORMAT, "PNG image data are corrupt: %s", m);
+        }
+        goto fail;
+    }
+    if (raw.len != total) {
+        c = rt_fail(e, RT_EFORMAT, "PNG image data are too short (%zu of %zu bytes)", raw.len,
+                    total);
+        goto fail;
+    }
+    if ((c = image_init(im, D->info.w, D->info.h, e)))
+        goto fail;
+    for (int p = 0; p < npass; p++)
+        if ((c = decode_pass(D, p, raw.data + off[p], im, e))) {
+            image_free(im);
+            goto fail;
+        }
+    if (info)
+        *info = D->info;
+fail:
+    bytebuf_free(&idat);
+    bytebuf_free(&raw);
+    free(D);
+    return c;
+}
+
+rt_code png_load(const char *path, image *im, png_info *info, rt_error *e)
+{
+    unsigned char *d;
+    size_t n;
+    im->w = im->h = 0;
+    im->px = NULL;
+    rt_code c = fileio_read_all(path, PNG_MAX_FILE, &d, &n, e);
+    if (c)
+        return c;
+    c = png_decode(d, n, im, info, e);
+    free(d);
+    return c;
+}
