@@ -212,7 +212,8 @@ static char **list_dir(const char *dir, const char *ext, int *n)
         v[(*n)++] = strdup(e->d_name);
     }
     closedir(d);
-    qsort(v, (size_t)*n, sizeof *v, cmp_str);
+    if (*n)
+        qsort(v, (size_t)*n, sizeof *v, cmp_str);
     return v;
 }
 

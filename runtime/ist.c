@@ -1,0 +1,668 @@
+/* ist.c — Iterated Shuffle Transformation: the list construction of seed 002
+ * §4.1 and its O(K) closed form for equal lengths and one M (SEEDS.md 002).
+ * The readings where the paper is silent are documented in ist.h. */
+#include "ist.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rng.h"
+
+static int imod(long a, int n)
+{
+    long r = a % n;
+    return (int)(r < 0 ? r + n : r);
+}
+
+/* ---- validation and set-up ---------------------------------------------- */
+
+static rt_code validate(const ist_spec *s, rt_error *e)
+{
+    if (s->n < 1)
+        return rt_fail(e, RT_EINVAL, "IST needs at least 1 base interval, got %d", s->n);
+    if (s->k < 0 || s->k > IST_MAX_K)
+        return rt_fail(e, RT_EINVAL, "IST iterations K = %d; expected 0..%d", s->k, IST_MAX_K);
+    if (s->axis != IST_TRANSLATION && s->axis != IST_CYCLIC)
+        return rt_fail(e, RT_EINVAL, "IST axis type %d; expected translation (0) or cyclic (1)",
+                       (int)s->axis);
+    if (s->bounds) {
+        for (int i = 0; i <= s->n; i++)
+            if (!isfinite(s->bounds[i]))
+                return rt_fail(e, RT_EINVAL, "IST bound %d is %g; expected a finite number", i,
+                               s->bounds[i]);
+        for (int i = 0; i < s->n; i++)
+            if (!(s->bounds[i + 1] > s->bounds[i]))
+                return rt_fail(e, RT_EINVAL,
+                               "IST bounds must increase: bound %d = %g is not greater than bound %d = %g",
+                               i + 1, s->bounds[i + 1], i, s->bounds[i]);
+    }
+    for (int i = 0; i < s->n; i++) {
+        int m = s->m_each ? s->m_each[i] : s->m;
+        if (m < 0 || m > 1000)
+            return rt_fail(e, RT_EINVAL, "IST crossing count M of interval %d is %d; expected 0..1000",
+                           i, m);
+    }
+    return RT_OK;
+}
+
+/* B^K if it is at most 2^52 (so sub-interval indices are exact in a double),
+ * else 0. */
+static uint64_t pow_small(int b, int k)
+{
+    uint64_t s = 1;
+    for (int i = 0; i < k; i++) {
+        if (s > ((uint64_t)1 << 52) / (uint64_t)b)
+            return 0;
+        s *= (uint64_t)b;
+    }
+    return s;
+}
+
+static void ist_zero(ist *t) { memset(t, 0, sizeof *t); }
+
+void ist_free(ist *t)
+{
+    free(t->bounds);
+    free(t->ms);
+    free(t->start);
+    free(t->x);
+    free(t->len);
+    free(t->cum);
+    free(t->total);
+    free(t->label);
+    free(t->slot);
+    free(t->owner);
+    free(t->by_x);
+    ist_zero(t);
+}
+
+rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
+{
+    ist_zero(t);
+    rt_code rc = validate(s, e);
+    if (rc)
+        return rc;
+    t->n = s->n;
+    t->k = s->k;
+    t->axis = s->axis;
+    t->bounds = malloc(sizeof(double) * (size_t)(s->n + 1));
+    t->ms = malloc(sizeof(int) * (size_t)s->n);
+    if (!t->bounds || !t->ms) {
+        ist_free(t);
+        return rt_fail(e, RT_ENOMEM, "out of memory for an IST of %d intervals", s->n);
+    }
+    for (int i = 0; i <= s->n; i++)
+        t->bounds[i] = s->bounds ? s->bounds[i] : (double)i;
+    int one_m = 1;
+    for (int i = 0; i < s->n; i++) {
+        t->ms[i] = s->m_each ? s->m_each[i] : s->m;
+        if (t->ms[i] != t->ms[0])
+            one_m = 0;
+    }
+    /* equal lengths: a_i = a_0 + i·h exactly */
+    double a0 = t->bounds[0], h = t->bounds[1] - t->bounds[0];
+    int equal = 1;
+    for (int i = 0; i <= s->n; i++)
+        if (t->bounds[i] != a0 + (double)i * h)
+            equal = 0;
+    uint64_t sk = pow_small(2 * t->ms[0] + 1, s->k);
+    int can_close = one_m && equal && sk != 0;
+    if (s->method == IST_CLOSED && !can_close) {
+        ist_free(t);
+        return rt_fail(e, RT_EINVAL,
+                       "IST closed form needs equal base intervals, one crossing count and (2M+1)^K <= 2^52");
+    }
+    if (can_close && s->method != IST_LISTS) {
+        t->closed = 1;
+        t->m = t->ms[0];
+        t->b = 2 * t->m + 1;
+        t->s = sk;
+        t->a0 = a0;
+        t->h = h;
+        return RT_OK;
+    }
+    rc = ist_build_lists(t, e);
+    if (rc)
+        ist_free(t);
+    return rc;
+}
+
+/* ---- the list construction (§4.1) ---------------------------------------- */
+
+/* One way a piece can arrive in a list: piece t of (every entry of) L_j goes
+ * to list i with order key d; f is its share of the entry, c where it starts. */
+typedef struct slotdef {
+    int i, j, t;
+    long d;
+    double f, c;
+} slotdef;
+
+static int slot_cmp(const void *pa, const void *pb)
+{
+    const slotdef *a = pa, *b = pb;
+    if (a->i != b->i)
+        return a->i < b->i ? -1 : 1;
+    if (a->d != b->d)
+        return a->d < b->d ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+static int target_of(const ist *t, int j, int piece, long *d)
+{
+    long g = (long)j - t->ms[j] + piece;
+    if (t->axis == IST_CYCLIC) {
+        *d = t->ms[j] - piece;
+        return imod(g, t->n);
+    }
+    if (g < 0 || g >= t->n) { /* beyond an end: the piece stays (ist.h) */
+        *d = 0;
+        return j;
+    }
+    *d = t->ms[j] - piece;
+    return (int)g;
+}
+
+/* qsort has no context argument in C11: sort (x, index) pairs instead. */
+typedef struct xi {
+    double x;
+    size_t i;
+} xi;
+
+static int xi_cmp(const void *pa, const void *pb)
+{
+    const xi *a = pa, *b = pb;
+    if (a->x != b->x)
+        return (a->x > b->x) - (a->x < b->x);
+    return (a->i > b->i) - (a->i < b->i);
+}
+
+rt_code ist_build_lists(ist *t, rt_error *e)
+{
+    if (t->x)
+        return RT_OK;
+    int n = t->n;
+    size_t nslot = 0;
+    for (int j = 0; j < n; j++)
+        nslot += (size_t)(2 * t->ms[j] + 1);
+    slotdef *sl = malloc(sizeof *sl * nslot);
+    size_t *sstart = malloc(sizeof(size_t) * (size_t)(n + 1));
+    size_t *cnt = calloc((size_t)n, sizeof(size_t)), *cnt2 = calloc((size_t)n, sizeof(size_t));
+    double *x0 = NULL, *l0 = NULL, *x1 = NULL, *l1 = NULL;
+    uint64_t *b0 = NULL, *b1 = NULL;
+    uint32_t *s1 = NULL, *o1 = NULL;
+    size_t *st0 = malloc(sizeof(size_t) * (size_t)(n + 1)), *st1 = malloc(sizeof(size_t) * (size_t)(n + 1));
+    rt_code rc = RT_OK;
+    if (!sl || !sstart || !cnt || !cnt2 || !st0 || !st1) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory building IST lists");
+        goto done;
+    }
+    /* the pieces of one round: shares in proportion to the target lengths */
+    size_t q = 0;
+    for (int j = 0; j < n; j++) {
+        int np = 2 * t->ms[j] + 1;
+        double w = 0;
+        for (int p = 0; p < np; p++) {
+            long d;
+            int i = target_of(t, j, p, &d);
+            w += t->bounds[i + 1] - t->bounds[i];
+        }
+        double c = 0;
+        for (int p = 0; p < np; p++) {
+            long d;
+            int i = target_of(t, j, p, &d);
+            double f = (t->bounds[i + 1] - t->bounds[i]) / w;
+            sl[q++] = (slotdef){i, j, p, d, f, c};
+            c += f;
+        }
+    }
+    qsort(sl, nslot, sizeof *sl, slot_cmp);
+    for (int i = 0, s = 0; i <= n; i++) {
+        while ((size_t)s < nslot && sl[s].i < i)
+            s++;
+        sstart[i] = (size_t)s;
+    }
+    /* entry counts per list, refusing before anything large is allocated */
+    for (int i = 0; i < n; i++)
+        cnt[i] = 1;
+    for (int k = 1; k <= t->k; k++) {
+        size_t tot = 0;
+        for (int i = 0; i < n; i++) {
+            size_t c = 0;
+            for (size_t s = sstart[i]; s < sstart[i + 1]; s++)
+                c += cnt[sl[s].j];
+            cnt2[i] = c;
+            tot += c;
+            if (c > IST_MAX_ENTRIES || tot > IST_MAX_ENTRIES) {
+                rc = rt_fail(e, RT_EINVAL,
+                             "IST lists would hold more than %zu small intervals at round %d of K = %d; "
+                             "lower K",
+                             IST_MAX_ENTRIES, k, t->k);
+                goto done;
+            }
+        }
+        memcpy(cnt, cnt2, sizeof(size_t) * (size_t)n);
+    }
+    size_t ne = 0;
+    for (int i = 0; i < n; i++)
+        ne += cnt[i];
+    int want_label = t->k <= 9;
+    for (int i = 0; i < n; i++)
+        if (t->ms[i] > 31)
+            want_label = 0;
+    x0 = malloc(sizeof(double) * ne);
+    l0 = malloc(sizeof(double) * ne);
+    x1 = malloc(sizeof(double) * ne);
+    l1 = malloc(sizeof(double) * ne);
+    b0 = calloc(ne, sizeof(uint64_t));
+    b1 = calloc(ne, sizeof(uint64_t));
+    s1 = calloc(ne, sizeof(uint32_t));
+    o1 = calloc(ne, sizeof(uint32_t));
+    if (!x0 || !l0 || !x1 || !l1 || !b0 || !b1 || !s1 || !o1) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu IST list entries", ne);
+        goto done;
+    }
+    /* L_i^0 = {A_i} */
+    for (int i = 0; i < n; i++) {
+        st0[i] = (size_t)i;
+        x0[i] = t->bounds[i];
+        l0[i] = t->bounds[i + 1] - t->bounds[i];
+        o1[i] = (uint32_t)i;
+    }
+    st0[n] = (size_t)n;
+    for (int k = 1; k <= t->k; k++) {
+        size_t w = 0;
+        for (int i = 0; i < n; i++) {
+            st1[i] = w;
+            for (size_t s = sstart[i]; s < sstart[i + 1]; s++) {
+                const slotdef *d = &sl[s];
+                for (size_t r = st0[d->j]; r < st0[d->j + 1]; r++) {
+                    x1[w] = x0[r] + l0[r] * d->c;
+                    l1[w] = l0[r] * d->f;
+                    b1[w] = (b0[r] << 6) | (uint64_t)d->t;
+                    s1[w] = (uint32_t)(s - sstart[i]);
+                    o1[w] = (uint32_t)i;
+                    w++;
+                }
+            }
+        }
+        st1[n] = w;
+        double *tx = x0; x0 = x1; x1 = tx;
+        double *tl = l0; l0 = l1; l1 = tl;
+        uint64_t *tb = b0; b0 = b1; b1 = tb;
+        size_t *ts = st0; st0 = st1; st1 = ts;
+    }
+    /* keep the final level */
+    t->ne = st0[n];
+    t->start = st0;
+    st0 = NULL;
+    t->x = x0;
+    t->len = l0;
+    x0 = l0 = NULL;
+    t->label = want_label ? b0 : NULL;
+    if (want_label)
+        b0 = NULL;
+    t->slot = s1;
+    t->owner = o1;
+    s1 = NULL;
+    o1 = NULL;
+    t->cum = malloc(sizeof(double) * (t->ne ? t->ne : 1));
+    t->total = malloc(sizeof(double) * (size_t)n);
+    t->by_x = malloc(sizeof(size_t) * (t->ne ? t->ne : 1));
+    xi *tmp = malloc(sizeof(xi) * (t->ne ? t->ne : 1));
+    if (!t->cum || !t->total || !t->by_x || !tmp) {
+        free(tmp);
+        rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu IST list entries", t->ne);
+        goto done;
+    }
+    if (t->k == 0) /* the round loop never ran: slots and owners are trivial */
+        for (int i = 0; i < n; i++)
+            t->owner[i] = (uint32_t)i, t->slot[i] = 0;
+    for (int i = 0; i < n; i++) {
+        double c = 0;
+        for (size_t r = t->start[i]; r < t->start[i + 1]; r++) {
+            t->cum[r] = c;
+            c += t->len[r];
+        }
+        t->total[i] = c;
+    }
+    for (size_t r = 0; r < t->ne; r++)
+        tmp[r] = (xi){t->x[r], r};
+    qsort(tmp, t->ne, sizeof *tmp, xi_cmp);
+    for (size_t r = 0; r < t->ne; r++)
+        t->by_x[r] = tmp[r].i;
+    free(tmp);
+done:
+    free(sl);
+    free(sstart);
+    free(cnt);
+    free(cnt2);
+    free(x0);
+    free(l0);
+    free(x1);
+    free(l1);
+    free(b0);
+    free(b1);
+    free(s1);
+    free(o1);
+    free(st0);
+    free(st1);
+    if (rc && t->x) { /* undo a partial final level, keep the spec */
+        free(t->start); free(t->x); free(t->len); free(t->cum); free(t->total);
+        free(t->label); free(t->slot); free(t->owner); free(t->by_x);
+        t->start = NULL; t->x = t->len = t->cum = t->total = NULL;
+        t->label = NULL; t->slot = t->owner = NULL; t->by_x = NULL; t->ne = 0;
+    }
+    return rc;
+}
+
+/* ---- evaluation ------------------------------------------------------------ */
+
+/* Bring u into [a, b) on a cyclic axis; *shift is what was subtracted. */
+static int locate(const ist *t, double u, double *uw, double *shift)
+{
+    double a = t->bounds[0], b = t->bounds[t->n];
+    *shift = 0;
+    if (t->axis == IST_CYCLIC) {
+        double p = b - a;
+        if (u < a || u >= b) {
+            double q = floor((u - a) / p);
+            *shift = q * p;
+            u -= *shift;
+            if (u >= b)
+                u = a; /* rounding put it on the far end: the same point */
+            if (u < a)
+                u = a;
+        }
+    } else if (!(u >= a && u < b)) {
+        return -1; /* identity outside a translation axis (and NaN) */
+    }
+    *uw = u;
+    return 0;
+}
+
+static int find_interval(const ist *t, double u)
+{
+    if (t->closed) {
+        int i = (int)floor((u - t->a0) / t->h);
+        return i < 0 ? 0 : i >= t->n ? t->n - 1 : i;
+    }
+    int lo = 0, hi = t->n - 1; /* last i with bounds[i] <= u */
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (t->bounds[mid] <= u)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Slot p of interval i on a translation axis with one M (the sorted slot
+ * list of ist_build_lists, in closed form): sets the next interval and the
+ * piece index. Order: left neighbours, own pieces held back at the left end,
+ * the own centre piece, own pieces held back at the right end, right
+ * neighbours. */
+static inline void slot_translation(int n, int m, int i, int p, int *j, int *piece)
+{
+    int l = i < m ? i : m, r = n - 1 - i < m ? n - 1 - i : m;
+    if (p < l) {
+        int d = p - l;
+        *j = i + d;
+        *piece = m - d;
+    } else if (p < m) {
+        *j = i;
+        *piece = p - l;
+    } else if (p == m) {
+        *j = i;
+        *piece = m;
+    } else {
+        int q = p - m - 1;
+        if (q < m - r) {
+            *j = i;
+            *piece = n - i + m + q;
+        } else {
+            int d = q - (m - r) + 1;
+            *j = i + d;
+            *piece = m - d;
+        }
+    }
+}
+
+/* The inverse of slot_translation: piece `piece` of interval j lands in
+ * interval *i at slot *p. */
+static inline void unslot_translation(int n, int m, int j, int piece, int *i, int *p)
+{
+    int g = j - m + piece;
+    if (g < 0 || g >= n) {
+        *i = j;
+        int l = j < m ? j : m;
+        *p = piece < m ? l + piece : m + 1 + (piece - (n - j + m));
+        return;
+    }
+    *i = g;
+    int l = g < m ? g : m, r = n - 1 - g < m ? n - 1 - g : m;
+    int d = j - g;
+    if (d < 0)
+        *p = d + l;
+    else if (d == 0)
+        *p = m;
+    else
+        *p = 2 * m - r + d;
+}
+
+static double inv_closed(const ist *t, int i, double r)
+{
+    /* r in [0, 1): offset in units of h */
+    double y = r * (double)t->s;
+    uint64_t idx = (uint64_t)y;
+    if (idx >= t->s)
+        idx = t->s - 1;
+    double rem = y - (double)idx;
+    uint64_t b = (uint64_t)t->b, src = 0;
+    int j;
+    /* away from the ends of a translation axis (K·M intervals) the slots are
+     * those of a cyclic axis and no wrap happens */
+    int interior = t->axis == IST_CYCLIC ||
+                   ((long)i >= (long)t->k * t->m && (long)i + (long)t->k * t->m <= (long)t->n - 1);
+    if (interior && t->s <= UINT32_MAX) { /* 32-bit division is much cheaper */
+        uint32_t id32 = (uint32_t)idx, b32 = (uint32_t)t->b, s32 = 0, m2 = (uint32_t)(2 * t->m);
+        long sumd = 0;
+        for (int q = 0; q < t->k; q++) {
+            uint32_t p = id32 % b32;
+            id32 /= b32;
+            sumd += (long)p;
+            s32 = s32 * b32 + m2 - p;
+        }
+        sumd -= (long)t->k * t->m;
+        j = t->axis == IST_CYCLIC ? imod((long)i + sumd, t->n) : (int)((long)i + sumd);
+        src = s32;
+    } else if (interior) {
+        long sumd = 0;
+        for (int q = 0; q < t->k; q++) { /* digits p_K, p_{K-1}, …, p_1 */
+            uint64_t p = idx % b;
+            idx /= b;
+            sumd += (long)p - t->m;
+            src = src * b + (uint64_t)(2 * t->m) - p; /* t_m = 2M - p_m */
+        }
+        j = imod((long)i + sumd, t->n);
+    } else {
+        int dig[IST_MAX_K];
+        for (int q = t->k - 1; q >= 0; q--) {
+            dig[q] = (int)(idx % b);
+            idx /= b;
+        }
+        int pc[IST_MAX_K];
+        j = i;
+        for (int q = 0; q < t->k; q++)
+            slot_translation(t->n, t->m, j, dig[q], &j, &pc[q]);
+        for (int q = t->k - 1; q >= 0; q--) /* source digits t_K … t_1 */
+            src = src * b + (uint64_t)pc[q];
+    }
+    return t->a0 + (double)j * t->h + t->h * (((double)src + rem) / (double)t->s);
+}
+
+static double fwd_closed(const ist *t, int j, double r)
+{
+    double y = r * (double)t->s;
+    uint64_t idx = (uint64_t)y;
+    if (idx >= t->s)
+        idx = t->s - 1;
+    double rem = y - (double)idx;
+    uint64_t b = (uint64_t)t->b;
+    int dig[IST_MAX_K]; /* source digits s_1..s_K = t_K..t_1 */
+    for (int q = t->k - 1; q >= 0; q--) {
+        dig[q] = (int)(idx % b);
+        idx /= b;
+    }
+    uint64_t dst = 0, pw = 1;
+    int i = j;
+    for (int q = 0; q < t->k; q++) { /* t_K first: gives p_K, the last digit */
+        int p;
+        if (t->axis == IST_CYCLIC) {
+            i = imod((long)i - (t->m - dig[q]), t->n);
+            p = 2 * t->m - dig[q];
+        } else {
+            unslot_translation(t->n, t->m, i, dig[q], &i, &p);
+        }
+        dst += (uint64_t)p * pw;
+        pw *= b;
+    }
+    return t->a0 + (double)i * t->h + t->h * (((double)dst + rem) / (double)t->s);
+}
+
+double ist_inv(const ist *t, double u)
+{
+    double uw, shift;
+    if (locate(t, u, &uw, &shift))
+        return u;
+    int i = find_interval(t, uw);
+    if (t->closed) {
+        double r = (uw - (t->a0 + (double)i * t->h)) / t->h;
+        if (r < 0)
+            r = 0;
+        return inv_closed(t, i, r) + shift;
+    }
+    double a = t->bounds[i], w = t->bounds[i + 1] - a;
+    double pos = (uw - a) / w * t->total[i];
+    size_t lo = t->start[i], hi = t->start[i + 1] - 1; /* last entry with cum <= pos */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (t->cum[mid] <= pos)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    double off = pos - t->cum[lo];
+    if (off < 0)
+        off = 0;
+    return t->x[lo] + off + shift;
+}
+
+double ist_fwd(const ist *t, double u)
+{
+    double uw, shift;
+    if (locate(t, u, &uw, &shift))
+        return u;
+    if (t->closed) {
+        int j = find_interval(t, uw);
+        double r = (uw - (t->a0 + (double)j * t->h)) / t->h;
+        if (r < 0)
+            r = 0;
+        return fwd_closed(t, j, r) + shift;
+    }
+    size_t lo = 0, hi = t->ne - 1; /* last entry (by source) starting at or before uw */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (t->x[t->by_x[mid]] <= uw)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    size_t r = t->by_x[lo];
+    int i = (int)t->owner[r];
+    double a = t->bounds[i], w = t->bounds[i + 1] - a;
+    double off = uw - t->x[r];
+    if (off < 0)
+        off = 0;
+    return a + (t->cum[r] + off) * (w / t->total[i]) + shift;
+}
+
+/* ---- printing (Fig. 2 notation) ------------------------------------------- */
+
+rt_code ist_print(ist *t, bytebuf *out, rt_error *e)
+{
+    if (t->k > 9)
+        return rt_fail(e, RT_EINVAL, "IST printing needs K <= 9, got K = %d", t->k);
+    int bmax = 0;
+    for (int i = 0; i < t->n; i++) {
+        if (t->ms[i] > 31)
+            return rt_fail(e, RT_EINVAL, "IST printing needs M <= 31, interval %d has M = %d", i,
+                           t->ms[i]);
+        if (2 * t->ms[i] + 1 > bmax)
+            bmax = 2 * t->ms[i] + 1;
+    }
+    rt_code rc = ist_build_lists(t, e);
+    if (rc)
+        return rc;
+    int compact = t->n <= 10 && bmax <= 10;
+    for (int i = 0; i < t->n; i++) {
+        bytebuf_printf(out, "L%d:", i);
+        for (size_t r = t->start[i]; r < t->start[i + 1]; r++) {
+            if (r > t->start[i] && t->slot[r] != t->slot[r - 1])
+                bytebuf_printf(out, " |");
+            /* source base interval: the list the entry came from at round 0
+             * is recovered from its position x */
+            int j = find_interval(t, t->x[r]);
+            uint64_t lab = t->label ? t->label[r] : 0;
+            bytebuf_printf(out, compact ? " %d" : " %d:", j);
+            for (int q = t->k - 1; q >= 0; q--) {
+                int d = (int)((lab >> (6 * q)) & 63);
+                if (compact)
+                    bytebuf_printf(out, "%d", d);
+                else
+                    bytebuf_printf(out, q == t->k - 1 ? "%d" : ".%d", d);
+            }
+        }
+        bytebuf_printf(out, "\n");
+    }
+    if (out->failed)
+        return rt_fail(e, RT_ENOMEM, "out of memory printing IST lists");
+    return RT_OK;
+}
+
+/* ---- adaptive sampling (§5.2, eq. 12-14) ---------------------------------- */
+
+uint64_t ist_sample_index(int b, int k, int ki, uint64_t m)
+{
+    uint64_t step = 1;
+    for (int q = ki; q < k; q++)
+        step *= (uint64_t)b;
+    return (step - 1) / 2 + m * step;
+}
+
+size_t ist_sample_positions(const ist *t, const int *ki, int jitter, uint64_t seed, double *out,
+                            size_t cap)
+{
+    size_t w = 0;
+    for (int i = 0; i < t->n; i++) {
+        int b = 2 * t->ms[i] + 1;
+        int kk = ki[i] < 0 ? 0 : ki[i] > t->k ? t->k : ki[i];
+        uint64_t si = pow_small(b, kk);
+        uint64_t step = pow_small(b, t->k - kk);
+        if (!si || !step)
+            return (size_t)-1; /* too many: the caller's K is unreasonable */
+        double a = t->bounds[i], len = t->bounds[i + 1] - a;
+        double sub = len / ((double)si * (double)step);
+        rng r;
+        rng_init(&r, seed, (uint64_t)i);
+        for (uint64_t m = 0; m < si; m++, w++) {
+            if (w >= cap)
+                continue;
+            uint64_t idx = (step - 1) / 2 + m * step;
+            double c = jitter ? rng_uniform(&r) : 0.5;
+            out[w] = a + ((double)idx + c) * sub;
+        }
+    }
+    return w;
+}

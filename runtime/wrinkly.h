@@ -1,0 +1,151 @@
+/* wrinkly.h — wrinkly curves and surfaces (seed 002 §5, eq. 7-11) and their
+ * adaptive tessellation (§5.2) into a coloured triangle mesh.
+ *
+ * Control points ("wrinkly control points") carry a position, a height h
+ * (displacement along the unit normal, world units), a colour and an
+ * opacity. Curves are 2-D (pos[0], pos[1]); surfaces are a grid of nu × nv
+ * points, pts[j*nu + i], i along u, j along v.
+ *
+ * Base curve (§5.1, our exact construction). Control point p_i owns the
+ * parameter interval [i, i+1) (the paper's [i-1, i) with 1-based i). Its
+ * cubic Bézier runs from the midpoint m_i = (p_{i-1}+p_i)/2 to
+ * m_{i+1} = (p_i+p_{i+1})/2; the inner Bézier points lie on the segments
+ * p_{i-1}p_i and p_ip_{i+1}: b1 = m_i + λ(p_i - m_i), b2 = m_{i+1} + λ(p_i - m_{i+1}).
+ * The tangent at each joint is along p_{i+1} - p_i from both sides, so the
+ * curve is G1 (in fact C1). λ = `tension` (default 2/3, which makes the base
+ * curve the uniform quadratic B-spline). The base point at the centre
+ * u = i + 1/2 is ((4 - 3λ)(m_i + m_{i+1}) + 6λ p_i)/8, i.e.
+ * (p_{i-1} + 6p_i + p_{i+1})/8 for λ = 2/3; the IST keeps u = i + 1/2 fixed,
+ * so the wrinkly curve passes through that point displaced by h_i·N
+ * (the fixed point q_i of §5.3, with H(i+1/2) as built below).
+ * Open ends (translation axis): positions use a reflected phantom point
+ * p_{-1} = 2p_0 - p_1 (and p_n = 2p_{n-1} - p_{n-2}), so the curve runs half a
+ * segment beyond the first and last control points' midpoints symmetrically;
+ * heights, colours and opacities use a repeated phantom (p_{-1} = p_0) so they
+ * never overshoot. Cyclic axes wrap.
+ * The height function H and the colour/opacity functions are built the same
+ * way from the scalars (eq. 8). The point is eq. (10)/(11):
+ *     R(u) = P(u) + H(F^{-1}(u)) N(u),   R(u,v) = P(u,v) + H(F_u^{-1}(u), F_v^{-1}(v)) N(u,v)
+ * where the attributes flagged in `shuffle` use F^{-1} and the others use
+ * (u, v) directly, and an axis with ist = 0 is plain spline interpolation
+ * (Fig. 10 e, f). N is the unit normal of the base: (-P'_y, P'_x)/|P'| for
+ * curves, P_u × P_v/|P_u × P_v| for surfaces.
+ *
+ * Adaptive sampling (§5.2). For each base interval of each axis a level K_i:
+ *  - with a camera: the smallest K_i with (projected length of the interval)
+ *    / (2M+1)^{K_i} <= `pixel` pixels. On a surface the length is measured on
+ *    a 5×5 grid of base points of every patch along the axis and the maximum
+ *    over the patches of the strip is taken, so all rows share one set of u
+ *    samples: the mesh is a conforming tensor grid, no T-junctions;
+ *  - else with tol > 0 the same with world length and tol;
+ *  - else K_i = k for every interval.
+ * K = max K_i (eq. 12), capped by kmax. Samples: ist_sample_positions (the
+ * ((S/S_i+1)/2)-th sub-interval and every (S/S_i)-th after it), at the
+ * centre or, with jitter, at a seeded random point inside it (Fig. 8b);
+ * `extra` > 0 evaluates F^{-1} with K + extra rounds for the same samples
+ * (structural jitter, Fig. 8c). A translation axis also gets its two end
+ * points (which the IST keeps fixed). Samples are joined into quads, two
+ * triangles each, counter-clockwise seen from the side N points to; vertex
+ * normals are central differences of the displaced grid; vertex colour is
+ * (r, g, b, opacity).
+ *
+ * Cracks at base-interval joints (§6, Fig. 11 d, the paper's open problem).
+ * F^{-1} jumps farthest at u = i (digits 00…0 against (2M)(2M)…), so the
+ * displacement steps there. Remedy (crack_band = w > 0): within distance w
+ * (parameter units) of a joint, every shuffled attribute is blended toward
+ * its unshuffled spline value with weight s = smoothstep(dist / w) (s = 0 at
+ * the joint): A = s·A(F_u^{-1}(u), F_v^{-1}(v)) + (1 - s)·A(u, v), with
+ * s = s_u·s_v on surfaces. At a joint both sides then meet the same spline
+ * value, so the step closes; w = 0 switches it off (side-by-side renders).
+ */
+#ifndef WRINKLY_H
+#define WRINKLY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "camera.h"
+#include "mesh.h"
+#include "rt.h"
+
+typedef struct wrinkly_point {
+    double pos[3];
+    double h;
+    double rgb[3];
+    double opacity;
+} wrinkly_point;
+
+enum { WRINKLY_HEIGHT = 1, WRINKLY_COLOUR = 2, WRINKLY_OPACITY = 4 };
+
+typedef struct wrinkly_axis {
+    int cyclic; /* 0 translation (open), 1 cyclic (closed) */
+    int ist;    /* 1: shuffle along this axis; 0: plain spline */
+    int m;      /* crossing count M >= 0 (also sets the sampling base 2M+1) */
+} wrinkly_axis;
+
+typedef struct wrinkly_opts {
+    double tension;         /* λ in (0, 1]; default 2/3 */
+    unsigned shuffle;       /* WRINKLY_* bits: attributes that follow the IST */
+    const camera *cam;      /* set up (camera_setup); NULL: world tolerance or fixed k */
+    int width, height;      /* image size for cam */
+    double pixel;           /* target projected sub-interval size, pixels (default 1) */
+    double tol;             /* world-space sub-interval size when cam is NULL */
+    int k;                  /* level of every interval when neither cam nor tol */
+    int kmax;               /* cap on K (default 8) */
+    int extra;              /* extra IST rounds (structural jitter) */
+    int jitter;             /* 1: random point inside each sampled sub-interval */
+    uint64_t seed;
+    double crack_band;      /* 0: off; else half-width of the blend band at joints */
+} wrinkly_opts;
+
+void wrinkly_opts_default(wrinkly_opts *o);
+
+/* ---- curves (2-D) ---- */
+typedef struct wrinkly_curve {
+    const wrinkly_point *pts;
+    int n;
+    wrinkly_axis ax;
+} wrinkly_curve;
+
+/* Base curve P(u) and P'(u) (eq. 7). */
+void wrinkly_curve_base(const wrinkly_curve *c, double tension, double u, double p[2], double dp[2]);
+/* Attribute function built like H (eq. 8): which = 0 height, 1..3 rgb, 4 opacity. */
+double wrinkly_curve_attr(const wrinkly_curve *c, double tension, int which, double u);
+
+typedef struct wrinkly_polyline {
+    size_t n;
+    double *xy;  /* n × 2 */
+    double *u;   /* parameter of each point */
+    float *rgba; /* n × 4 */
+    int closed;  /* last point joins the first */
+    int k;       /* K used */
+} wrinkly_polyline;
+
+/* Sample R(u) (eq. 10) adaptively into a polyline. */
+rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrinkly_polyline *out,
+                             rt_error *e);
+void wrinkly_polyline_free(wrinkly_polyline *p);
+
+/* ---- surfaces ---- */
+typedef struct wrinkly_surface {
+    const wrinkly_point *pts; /* nu * nv, pts[j*nu + i] */
+    int nu, nv;
+    wrinkly_axis au, av;
+} wrinkly_surface;
+
+/* Base surface P(u, v) and its unit normal (zero if undefined). */
+void wrinkly_surface_base(const wrinkly_surface *s, double tension, double u, double v, double p[3],
+                          double n[3]);
+
+typedef struct wrinkly_info {
+    int k[2];          /* K on u and v */
+    size_t samples[2]; /* vertices along u and v */
+    size_t vertices, triangles;
+} wrinkly_info;
+
+/* Tessellate eq. (11) into out (initialised here; free with mesh_free).
+ * Parallel over rows of vertices; byte-identical for any thread count. */
+rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, const rt_run *run,
+                             mesh *out, wrinkly_info *info, rt_error *e);
+
+#endif

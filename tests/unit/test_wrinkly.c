@@ -1,0 +1,234 @@
+/* test_wrinkly.c — wrinkly curves and surfaces (seed 002 §5). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "mesh.h"
+#include "rng.h"
+#include "wrinkly.h"
+
+static void make_curve_pts(wrinkly_point *p, int n, double rad)
+{
+    for (int i = 0; i < n; i++) {
+        double a = 6.283185307179586 * i / n;
+        memset(&p[i], 0, sizeof p[i]);
+        p[i].pos[0] = rad * cos(a) * (1 + 0.2 * (i % 3));
+        p[i].pos[1] = rad * sin(a);
+        p[i].h = 0.1 * ((i * 7) % 5) - 0.2;
+        p[i].rgb[0] = i / (double)n;
+        p[i].rgb[1] = 0.5;
+        p[i].rgb[2] = 1 - i / (double)n;
+        p[i].opacity = 1;
+    }
+}
+
+static void unit2(double v[2])
+{
+    double l = hypot(v[0], v[1]);
+    v[0] /= l, v[1] /= l;
+}
+
+static void test_curve(void)
+{
+    enum { N = 7 };
+    wrinkly_point p[N];
+    make_curve_pts(p, N, 2.0);
+    for (int cyc = 0; cyc < 2; cyc++) {
+        wrinkly_curve c = {p, N, {cyc, 1, 1}};
+        /* G1: at the joint u = i both segments are tangent to p_i - p_{i-1} */
+        for (int i = 1; i < N; i++) {
+            double q[2], dl[2], dr[2];
+            wrinkly_curve_base(&c, 2.0 / 3, i - 1e-13, q, dl);
+            wrinkly_curve_base(&c, 2.0 / 3, i, q, dr);
+            double t[2] = {p[i].pos[0] - p[i - 1].pos[0], p[i].pos[1] - p[i - 1].pos[1]};
+            unit2(dl), unit2(dr), unit2(t);
+            CHECK(fabs(dl[0] * t[1] - dl[1] * t[0]) < 1e-9 && dl[0] * t[0] + dl[1] * t[1] > 0, "left tangent at %d", i);
+            CHECK(fabs(dr[0] * t[1] - dr[1] * t[0]) < 1e-9 && dr[0] * t[0] + dr[1] * t[1] > 0, "right tangent at %d", i);
+            CHECK_NEAR(q[0], 0.5 * (p[i].pos[0] + p[i - 1].pos[0]), 1e-12, "joint at the midpoint");
+        }
+        /* fixed points: R(i + 1/2) = (p_{i-1} + 6p_i + p_{i+1})/8 + H N with
+         * H = (h_{i-1} + 6h_i + h_{i+1})/8 and N ⊥ (p_{i+1} - p_{i-1})
+         * (uniform quadratic B-spline, λ = 2/3) */
+        wrinkly_opts o;
+        wrinkly_opts_default(&o);
+        o.k = 3;
+        wrinkly_polyline pl;
+        rt_error e;
+        CHECK(wrinkly_curve_sample(&c, &o, &pl, &e) == RT_OK, "sample: %s", e.msg);
+        CHECK(pl.n == (size_t)N * 27 + (cyc ? 0 : 2), "Σ S_i samples (+2 ends): %zu", pl.n);
+        CHECK(pl.closed == cyc, "closed flag");
+        int found = 0;
+        for (size_t q = 0; q < pl.n; q++) {
+            double u = pl.u[q];
+            int i = (int)floor(u);
+            if (fabs(u - (i + 0.5)) > 1e-12 || i < 1 || i > N - 2)
+                continue;
+            found++;
+            const wrinkly_point *a = &p[i - 1], *b = &p[i], *d = &p[i + 1];
+            double P[2], T[2], H = (a->h + 6 * b->h + d->h) / 8;
+            for (int k = 0; k < 2; k++) {
+                P[k] = (a->pos[k] + 6 * b->pos[k] + d->pos[k]) / 8;
+                T[k] = d->pos[k] - a->pos[k];
+            }
+            unit2(T);
+            CHECK_NEAR(pl.xy[2 * q], P[0] - H * T[1], 1e-9, "fixed point x");
+            CHECK_NEAR(pl.xy[2 * q + 1], P[1] + H * T[0], 1e-9, "fixed point y");
+            CHECK_NEAR(pl.rgba[4 * q], (a->rgb[0] + 6 * b->rgb[0] + d->rgb[0]) / 8, 1e-6, "fixed colour");
+        }
+        CHECK(found == N - 2, "fixed points sampled: %d", found);
+        /* crack remedy: the height step across a joint shrinks */
+        double step[2];
+        for (int band = 0; band < 2; band++) {
+            o.k = 4;
+            o.crack_band = band ? 0.2 : 0;
+            wrinkly_polyline p2;
+            wrinkly_curve_sample(&c, &o, &p2, &e);
+            double worst = 0;
+            for (size_t q = 1; q < p2.n; q++) {
+                if (floor(p2.u[q]) == floor(p2.u[q - 1]) || floor(p2.u[q]) <= 0 || floor(p2.u[q]) >= N)
+                    continue;
+                double d = hypot(p2.xy[2 * q] - p2.xy[2 * q - 2], p2.xy[2 * q + 1] - p2.xy[2 * q - 1]);
+                worst = d > worst ? d : worst;
+            }
+            step[band] = worst;
+            wrinkly_polyline_free(&p2);
+        }
+        CHECK(step[1] < 0.5 * step[0], "crack band narrows the joint step: %g vs %g", step[1], step[0]);
+        o.crack_band = 0;
+        /* world tolerance: every sub-interval at most tol long → K_i from lengths */
+        o.tol = 0.05;
+        wrinkly_polyline p3;
+        CHECK(wrinkly_curve_sample(&c, &o, &p3, &e) == RT_OK, "tol");
+        CHECK(p3.k >= 2 && p3.k <= 4, "K from tolerance: %d", p3.k);
+        wrinkly_polyline_free(&p3);
+        wrinkly_polyline_free(&pl);
+    }
+}
+
+/* Torus-like control mesh: major radius 3, minor 1. */
+static wrinkly_point *torus(int nu, int nv, uint64_t seed)
+{
+    wrinkly_point *p = calloc((size_t)nu * nv, sizeof *p);
+    rng r;
+    rng_init(&r, seed, 0);
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            double a = 6.283185307179586 * i / nu, b = 6.283185307179586 * j / nv;
+            wrinkly_point *q = &p[j * nu + i];
+            q->pos[0] = (3 + cos(b)) * cos(a);
+            q->pos[1] = sin(b);
+            q->pos[2] = (3 + cos(b)) * sin(a);
+            q->h = 0.3 * rng_uniform(&r);
+            q->rgb[0] = rng_uniform(&r), q->rgb[1] = 0.6, q->rgb[2] = 0.3;
+            q->opacity = 1;
+        }
+    return p;
+}
+
+static void test_surface(void)
+{
+    int nu = 8, nv = 6;
+    wrinkly_point *p = torus(nu, nv, 5);
+    for (int kind = 0; kind < 3; kind++) {
+        /* 0 torus (closed both ways), 1 tube (v open), 2 sheet (both open) */
+        wrinkly_surface s = {p, nu, nv, {kind < 2, 1, 1}, {kind == 0, kind != 1, 1}};
+        wrinkly_opts o;
+        wrinkly_opts_default(&o);
+        o.k = 2;
+        mesh m;
+        wrinkly_info info;
+        rt_error e;
+        CHECK(wrinkly_surface_mesh(&s, &o, NULL, &m, &info, &e) == RT_OK, "mesh: %s", e.msg);
+        size_t su = (size_t)nu * 9 + (kind < 2 ? 0 : 2), sv = (size_t)nv * 9 + (kind == 0 ? 0 : 2);
+        CHECK(info.samples[0] == su && info.samples[1] == sv, "samples %zu × %zu", info.samples[0],
+              info.samples[1]);
+        CHECK(m.nv == su * sv, "vertex count");
+        mesh_stats st;
+        mesh_compute_stats(&m, &st, &e);
+        CHECK(st.degenerate == 0, "kind %d: %zu degenerate triangles", kind, st.degenerate);
+        CHECK(st.nonmanifold_edges == 0, "kind %d: non-manifold", kind);
+        if (kind == 0) {
+            CHECK(st.boundary_edges == 0, "torus is watertight: %zu boundary edges", st.boundary_edges);
+            CHECK(st.euler == 0, "torus Euler characteristic %ld", st.euler);
+        } else if (kind == 1) {
+            CHECK(st.boundary_edges == 2 * su, "tube has two boundary loops: %zu", st.boundary_edges);
+            CHECK(st.euler == 0, "tube Euler characteristic %ld", st.euler);
+        } else {
+            CHECK(st.boundary_edges == 2 * (su - 1) + 2 * (sv - 1), "sheet boundary: %zu", st.boundary_edges);
+            CHECK(st.euler == 1, "sheet Euler characteristic %ld", st.euler);
+        }
+        if (kind == 0) {
+            /* outward winding: the face normal of a triangle points away from the torus axis ring */
+            const uint32_t *t = m.tri;
+            const float *a = m.pos + 3 * t[0], *b = m.pos + 3 * t[1], *c = m.pos + 3 * t[2];
+            double u1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, u2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double n[3] = {u1[1] * u2[2] - u1[2] * u2[1], u1[2] * u2[0] - u1[0] * u2[2], u1[0] * u2[1] - u1[1] * u2[0]};
+            double ring = hypot(a[0], a[2]);
+            double out[3] = {a[0] - 3 * a[0] / ring, a[1], a[2] - 3 * a[2] / ring};
+            double dot = n[0] * out[0] + n[1] * out[1] + n[2] * out[2];
+            /* this torus has P_u = (-sin a, 0, cos a), P_v = (0, 1, 0) at b = 0, so
+             * P_u × P_v = (-cos a, 0, -sin a) points inward: triangles follow it */
+            CHECK(dot < 0, "triangles wind counter-clockwise about P_u × P_v: %g", dot);
+            /* byte-identical for threads 1, 2, 4 */
+            for (int th = 2; th <= 4; th += 2) {
+                rt_run run = {th, NULL, 0};
+                mesh m2;
+                wrinkly_opts o2 = o;
+                o2.jitter = 1;
+                o2.extra = 1;
+                o2.seed = 9;
+                mesh m1;
+                wrinkly_surface_mesh(&s, &o2, NULL, &m1, NULL, &e);
+                CHECK(wrinkly_surface_mesh(&s, &o2, &run, &m2, NULL, &e) == RT_OK, "threads");
+                CHECK(m1.nv == m2.nv && m1.nt == m2.nt && !memcmp(m1.pos, m2.pos, m1.nv * 12) &&
+                          !memcmp(m1.col, m2.col, m1.nv * 16) && !memcmp(m1.nrm, m2.nrm, m1.nv * 12) &&
+                          !memcmp(m1.tri, m2.tri, m1.nt * 12),
+                      "threads %d identical", th);
+                mesh_free(&m1);
+                mesh_free(&m2);
+            }
+        }
+        mesh_free(&m);
+    }
+    /* LOD: a camera farther away needs fewer triangles; counts follow the
+     * pixel area, not (2M+1)^K */
+    wrinkly_surface s = {p, nu, nv, {1, 1, 1}, {1, 1, 1}};
+    size_t prev = (size_t)-1;
+    for (int q = 0; q < 4; q++) {
+        double dist = 8.0 * pow(3.0, q);
+        camera cam;
+        camera_orbit(&cam, (double[3]){0, 0, 0}, dist, 20, 30, 40);
+        wrinkly_opts o;
+        wrinkly_opts_default(&o);
+        o.cam = &cam;
+        o.width = o.height = 200;
+        o.kmax = 6;
+        mesh m;
+        wrinkly_info info;
+        rt_error e;
+        CHECK(wrinkly_surface_mesh(&s, &o, NULL, &m, &info, &e) == RT_OK, "lod: %s", e.msg);
+        CHECK(m.nt < prev, "distance %g: %zu triangles, fewer than %zu", dist, m.nt, prev);
+        CHECK(m.nt <= 40 * 200 * 200, "distance %g: %zu triangles within 40× the pixel count", dist, m.nt);
+        if (getenv("WRINKLY_VERBOSE"))
+            printf("distance %g: K %d,%d, %zu triangles\n", dist, info.k[0], info.k[1], m.nt);
+        prev = m.nt;
+        mesh_free(&m);
+    }
+    /* validation */
+    wrinkly_surface bad = {p, 0, nv, {1, 1, 1}, {1, 1, 1}};
+    wrinkly_opts o;
+    wrinkly_opts_default(&o);
+    mesh m;
+    rt_error e;
+    CHECK(wrinkly_surface_mesh(&bad, &o, NULL, &m, NULL, &e) == RT_EINVAL, "nu = 0 refused");
+    CHECK(strcmp(e.msg, "wrinkly surface (u axis) needs at least 1 control point, got 0") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    free(p);
+}
+
+int main(void)
+{
+    test_curve();
+    test_surface();
+    return check_done("test_wrinkly");
+}
