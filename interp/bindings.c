@@ -2,8 +2,8 @@
  * Each engine's binding lives in its own interp/bind_NAME.c. */
 #include "builtin.h"
 
+int bind_volume_init(interp *I);
 int bindings_init(interp *I)
 {
-    (void)I;
-    return 0;
+    return bind_volume_init(I);
 }

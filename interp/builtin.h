@@ -48,6 +48,7 @@ int builtins_core_init(interp *I);
 int builtins_image_init(interp *I);
 /* Engine bindings (interp/bind_*.c), registered by bindings.c. */
 int bindings_init(interp *I);
+int bind_volume_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
 int call_value(interp *I, value fn, const value *args, int nargs, value *out);

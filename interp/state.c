@@ -217,8 +217,12 @@ int interp_add_source(interp *I, const char *name, const char *text, size_t len)
     const char *slash = strrchr(name, '/');
     s->first_line = 1;
     s->dir = slash ? dup_str(I, name, (size_t)(slash - name)) : dup_str(I, ".", 1);
-    if (!s->name || !s->text || !s->dir)
+    if (!s->name || !s->text || !s->dir) {
+        mem_free(I, s->name);
+        mem_free(I, s->text);
+        mem_free(I, s->dir);
         return -1;
+    }
     return I->nsrc++;
 }
 

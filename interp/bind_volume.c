@@ -1,0 +1,455 @@
+/* bind_volume.c — volumes and meshes as language values: summaries, fields,
+ * saving by extension, loading, slices and mesh statistics. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "fileio.h"
+#include "lang_image.h"
+#include "lang_objects.h"
+#include "mesh_io.h"
+#include "volume_io.h"
+
+/* ---- colour ramps -------------------------------------------------------------- */
+
+int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
+{
+    if (v.k == V_NIL) {
+        *out = ramp_grey();
+        return 0;
+    }
+    if (v.k != V_LIST || AS_LIST(v)->n < 1 || AS_LIST(v)->n > RAMP_MAX_STOPS)
+        return err_at(I, NULL, ERR_TYPE,
+                      "%s must be a palette: a list of 1 to %d colours [r, g, b], or rows [t, r, g, b]",
+                      what, RAMP_MAX_STOPS);
+    vlist *l = AS_LIST(v);
+    memset(out, 0, sizeof *out);
+    out->n = (int)l->n;
+    double prev = -INFINITY;
+    for (size_t i = 0; i < l->n; i++) {
+        double c[5] = {0, 0, 0, 0, 1};
+        value it = l->items[i];
+        size_t k = it.k == V_LIST ? AS_LIST(it)->n : 0;
+        if (k == 3) {
+            if (get_vec(I, it, c + 1, 3, what))
+                return -1;
+            c[0] = l->n == 1 ? 0 : (double)i / (double)(l->n - 1);
+        } else if (k == 4 || k == 5) {
+            if (get_vec(I, it, c, k, what))
+                return -1;
+            if (k == 4)
+                c[4] = 1;
+        } else {
+            return err_at(I, NULL, ERR_VALUE,
+                          "%s: stop %zu must be [r, g, b] or [t, r, g, b] or [t, r, g, b, a], got %s", what, i,
+                          it.k == V_LIST ? "a list of another length" : val_type_name(it));
+        }
+        if (c[0] < prev)
+            return err_at(I, NULL, ERR_VALUE, "%s: stop positions must not decrease (stop %zu at %g after %g)",
+                          what, i, c[0], prev);
+        prev = c[0];
+        out->pos[i] = c[0];
+        for (int j = 0; j < 4; j++)
+            out->rgba[i][j] = (float)c[j + 1];
+    }
+    return 0;
+}
+
+int opt_num(interp *I, value rec, const char *key, double *out)
+{
+    if (rec.k != V_REC)
+        return 0;
+    const char *k = intern(I, key, strlen(key));
+    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
+    if (!v)
+        return 0;
+    if (v->k == V_NUM) {
+        *out = v->u.n;
+        return 1;
+    }
+    if (v->k == V_BOOL) {
+        *out = v->u.b;
+        return 1;
+    }
+    return err_at(I, NULL, ERR_TYPE, "option '%s' must be a number, got %s", key, val_type_name(*v));
+}
+
+/* ---- volumes ------------------------------------------------------------------------ */
+
+typedef struct vol_payload {
+    volume v;
+    size_t bytes; /* reserved from the interpreter's budget */
+    interp *I;
+} vol_payload;
+
+static void volume_destroy(void *p)
+{
+    vol_payload *vp = p;
+    mem_release(vp->I, vp->bytes);
+    volume_free(&vp->v);
+    free(vp);
+}
+
+static void volume_summary(const void *p, bytebuf *out)
+{
+    const volume *v = &((const vol_payload *)p)->v;
+    size_t n = (size_t)v->nx * v->ny * v->nz;
+    double mn = INFINITY, mx = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        mn = v->v[i] < mn ? v->v[i] : mn;
+        mx = v->v[i] > mx ? v->v[i] : mx;
+    }
+    bytebuf_printf(out, "volume %d×%d×%d over [%g, %g]×[%g, %g]×[%g, %g], values %g to %g", v->nx, v->ny,
+                   v->nz, v->lo[0], v->hi[0], v->lo[1], v->hi[1], v->lo[2], v->hi[2], mn, mx);
+}
+
+static int vec_value(interp *I, const double *x, int n, value *out)
+{
+    value l = val_list(I, (size_t)n);
+    if (l.k == V_NIL)
+        return -1;
+    for (int i = 0; i < n; i++)
+        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
+            val_unref(I, l);
+            return -1;
+        }
+    *out = l;
+    return 0;
+}
+
+static int volume_get(interp *I, const void *p, const char *name, value *out)
+{
+    const volume *v = &((const vol_payload *)p)->v;
+    if (strcmp(name, "size") == 0) {
+        double s[3] = {v->nx, v->ny, v->nz};
+        return vec_value(I, s, 3, out);
+    }
+    if (strcmp(name, "lo") == 0)
+        return vec_value(I, v->lo, 3, out);
+    if (strcmp(name, "hi") == 0)
+        return vec_value(I, v->hi, 3, out);
+    return 1;
+}
+
+static int save_type(interp *I, value opts, int *type)
+{
+    double bits = 32;
+    if (opt_num(I, opts, "bits", &bits) < 0)
+        return -1;
+    if (bits == 8)
+        *type = VIO_UCHAR;
+    else if (bits == 16)
+        *type = VIO_USHORT;
+    else if (bits == 32)
+        *type = VIO_FLOAT;
+    else
+        return err_at(I, NULL, ERR_VALUE, "save: bits must be 8, 16 or 32 (float) for a volume, got %g", bits);
+    return 0;
+}
+
+static int volume_save(interp *I, const void *p, const char *path, value opts)
+{
+    const volume *v = &((const vol_payload *)p)->v;
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    int type = VIO_FLOAT;
+    if (save_type(I, opts, &type))
+        return -1;
+    rt_error e;
+    rt_code c;
+    if (strcmp(ext, "nrrd") == 0) {
+        c = vio_save_nrrd(path, v, type, &e);
+    } else if (strcmp(ext, "nhdr") == 0 || strcmp(ext, "raw") == 0) {
+        /* a raw file with a detached NRRD header beside it */
+        char base[4096], nhdr[4200], raw[4200];
+        snprintf(base, sizeof base, "%.*s", (int)(strlen(path) - strlen(ext) - 1), path);
+        snprintf(nhdr, sizeof nhdr, "%s.nhdr", base);
+        snprintf(raw, sizeof raw, "%s.raw", base);
+        c = vio_save_nhdr(nhdr, raw, v, type, &e);
+    } else if (strcmp(ext, "vtk") == 0) {
+        if (type != VIO_FLOAT)
+            return err_at(I, NULL, ERR_VALUE, "save: VTK volumes are written as float (drop the bits option)");
+        c = vio_save_vtk(path, v, &e);
+    } else {
+        return err_at(I, NULL, ERR_VALUE,
+                      "save: cannot save a volume as '.%s' (use .nrrd, .nhdr/.raw or .vtk)", ext);
+    }
+    if (c)
+        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+    return 0;
+}
+
+const obj_class volume_class = {
+    .name = "volume",
+    .destroy = volume_destroy,
+    .summary = volume_summary,
+    .get = volume_get,
+    .save = volume_save,
+};
+
+int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3], volume **out)
+{
+    *out = NULL;
+    double voxels = (double)nx * ny * nz;
+    if (nx < 1 || ny < 1 || nz < 1)
+        return err_at(I, NULL, ERR_VALUE, "volume size %d×%d×%d must be at least 1 on each axis", nx, ny, nz);
+    if (voxels > I->lim.max_voxels)
+        return err_at(I, NULL, ERR_LIMIT,
+                      "volume of %d×%d×%d voxels exceeds the limit of %.0f voxels (raise it with --max-voxels)",
+                      nx, ny, nz, I->lim.max_voxels);
+    for (int i = 0; i < 3; i++)
+        if (!(hi[i] > lo[i]) || !isfinite(lo[i]) || !isfinite(hi[i]))
+            return err_at(I, NULL, ERR_VALUE, "volume bounds must have lo < hi on every axis");
+    double bytes = voxels * sizeof(float);
+    if (mem_reserve(I, bytes, "the volume"))
+        return -1;
+    vol_payload *vp = calloc(1, sizeof *vp);
+    rt_error e;
+    if (!vp || volume_init(&vp->v, nx, ny, nz, lo, hi, &e)) {
+        free(vp);
+        mem_release(I, (size_t)bytes);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory for a %d×%d×%d volume", nx, ny, nz);
+    }
+    vp->bytes = (size_t)bytes;
+    vp->I = I;
+    *out = &vp->v;
+    return 0;
+}
+
+int lang_volume_value(interp *I, volume *v, value *out)
+{
+    /* v is the first member of its payload */
+    *out = val_obj(I, &volume_class, v);
+    return out->k == V_NIL ? -1 : 0;
+}
+
+volume *lang_as_volume(value v)
+{
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &volume_class ? &((vol_payload *)AS_OBJ(v)->payload)->v : NULL;
+}
+
+/* ---- meshes --------------------------------------------------------------------------- */
+
+static void mesh_destroy(void *p)
+{
+    mesh_free(p);
+    free(p);
+}
+
+static void mesh_summary(const void *p, bytebuf *out)
+{
+    const mesh *m = p;
+    if (m->nt == 0)
+        bytebuf_printf(out, "point cloud: %zu points", m->nv);
+    else
+        bytebuf_printf(out, "mesh: %zu vertices, %zu triangles%s%s", m->nv, m->nt, m->nrm ? ", normals" : "",
+                       m->col ? ", colours" : "");
+}
+
+static int mesh_get(interp *I, const void *p, const char *name, value *out)
+{
+    const mesh *m = p;
+    (void)I;
+    if (strcmp(name, "vertices") == 0)
+        *out = val_num((double)m->nv);
+    else if (strcmp(name, "triangles") == 0)
+        *out = val_num((double)m->nt);
+    else
+        return 1;
+    return 0;
+}
+
+static int mesh_save_hook(interp *I, const void *p, const char *path, value opts)
+{
+    const mesh *m = p;
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    double ascii = 0;
+    if (opt_num(I, opts, "ascii", &ascii) < 0)
+        return -1;
+    rt_error e;
+    rt_code c;
+    if (strcmp(ext, "ply") == 0)
+        c = mio_save_ply(path, m, ascii != 0, &e);
+    else if (strcmp(ext, "obj") == 0 || strcmp(ext, "stl") == 0)
+        c = mio_save(path, m, &e);
+    else
+        return err_at(I, NULL, ERR_VALUE, "save: cannot save a mesh as '.%s' (use .ply, .obj or .stl)", ext);
+    if (c)
+        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+    return 0;
+}
+
+const obj_class mesh_class = {
+    .name = "mesh",
+    .destroy = mesh_destroy,
+    .summary = mesh_summary,
+    .get = mesh_get,
+    .save = mesh_save_hook,
+};
+
+int lang_mesh_value(interp *I, mesh *m, value *out)
+{
+    if (m->failed) {
+        mesh_destroy(m);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory building a mesh");
+    }
+    *out = val_obj(I, &mesh_class, m);
+    return out->k == V_NIL ? -1 : 0;
+}
+
+mesh *lang_as_mesh(value v)
+{
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &mesh_class ? AS_OBJ(v)->payload : NULL;
+}
+
+/* ---- builtins ----------------------------------------------------------------------------- */
+
+static void script_path(interp *I, const char *p, char *buf, size_t n)
+{
+    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
+    if (p[0] == '/' || strcmp(dir, ".") == 0)
+        snprintf(buf, n, "%s", p);
+    else
+        snprintf(buf, n, "%s/%s", dir, p);
+}
+
+static int b_load_volume(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    char path[4096], ext[16];
+    script_path(I, AS_STR(a[0])->s, path, sizeof path);
+    fileio_ext(path, ext, sizeof ext);
+    volume tmp;
+    rt_error e;
+    rt_code c = strcmp(ext, "vtk") == 0 ? vio_load_vtk(path, &tmp, &e) : vio_load_nrrd(path, &tmp, &e);
+    if (c)
+        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_volume: %s", e.msg);
+    volume *v;
+    if (lang_volume_new(I, tmp.nx, tmp.ny, tmp.nz, tmp.lo, tmp.hi, &v)) {
+        volume_free(&tmp);
+        return -1;
+    }
+    memcpy(v->v, tmp.v, (size_t)tmp.nx * tmp.ny * tmp.nz * sizeof(float));
+    volume_free(&tmp);
+    return lang_volume_value(I, v, out);
+}
+
+static int b_load_mesh(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    char path[4096];
+    script_path(I, AS_STR(a[0])->s, path, sizeof path);
+    mesh *m = malloc(sizeof *m);
+    if (!m)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    rt_error e;
+    rt_code c = mio_load(path, m, &e);
+    if (c) {
+        free(m);
+        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_mesh: %s", e.msg);
+    }
+    return lang_mesh_value(I, m, out);
+}
+
+static int b_mesh_stats(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    mesh_stats st;
+    rt_error e;
+    if (mesh_compute_stats(lang_as_mesh(a[0]), &st, &e))
+        return err_at(I, NULL, ERR_MEMORY, "%s", e.msg);
+    value r = val_rec(I);
+    if (r.k == V_NIL)
+        return -1;
+    const struct {
+        const char *k;
+        double v;
+    } f[] = {{"vertices", (double)st.vertices},
+             {"triangles", (double)st.triangles},
+             {"edges", (double)st.edges},
+             {"boundary_edges", (double)st.boundary_edges},
+             {"nonmanifold_edges", (double)st.nonmanifold_edges},
+             {"degenerate", (double)st.degenerate},
+             {"euler", (double)st.euler},
+             {"area", st.area},
+             {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0}};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+        const char *k = intern(I, f[i].k, strlen(f[i].k));
+        value v = i == 8 ? val_bool(f[i].v != 0) : val_num(f[i].v);
+        if (!k || rec_set(I, AS_REC(r), k, v)) {
+            val_unref(I, r);
+            return -1;
+        }
+    }
+    *out = r;
+    return 0;
+}
+
+static int axis_of(interp *I, value v, int *axis)
+{
+    if (v.k == V_STR && AS_STR(v)->len == 1 && strchr("xyz", AS_STR(v)->s[0])) {
+        *axis = AS_STR(v)->s[0] - 'x';
+        return 0;
+    }
+    return err_at(I, NULL, ERR_VALUE, "axis must be \"x\", \"y\" or \"z\"");
+}
+
+static int b_slice(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    volume *v = lang_as_volume(a[0]);
+    int axis = 2;
+    if (axis_of(I, a[1], &axis))
+        return -1;
+    int len = axis == 0 ? v->nx : axis == 1 ? v->ny : v->nz;
+    long index = len / 2;
+    if (a[2].k != V_NIL && get_int(I, a[2], 0, len - 1, &index, "slice: index"))
+        return -1;
+    ramp r;
+    if (lang_get_ramp(I, a[3], &r, "slice: palette"))
+        return -1;
+    double lo = a[4].u.n, hi = a[5].u.n;
+    if (a[4].k == V_NIL || a[5].k == V_NIL) {
+        /* default: the volume's own range */
+        size_t cnt = (size_t)v->nx * v->ny * v->nz;
+        double mn = INFINITY, mx = -INFINITY;
+        for (size_t i = 0; i < cnt; i++) {
+            mn = v->v[i] < mn ? v->v[i] : mn;
+            mx = v->v[i] > mx ? v->v[i] : mx;
+        }
+        if (a[4].k == V_NIL)
+            lo = mn;
+        if (a[5].k == V_NIL)
+            hi = mx > lo ? mx : lo + 1;
+    }
+    image *im = malloc(sizeof *im);
+    if (!im)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    rt_error e;
+    if (volume_slice_axis(v, axis, (int)index, &r, lo, hi, im, &e)) {
+        free(im);
+        return err_at(I, NULL, ERR_VALUE, "slice: %s", e.msg);
+    }
+    return lang_image_value(I, im, out);
+}
+
+static const bparam p_path[] = {{"path", "str", NULL}};
+static const bparam p_mesh[] = {{"mesh", "mesh", NULL}};
+static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str", "\"z\""}, {"index", "int", "nil"},
+                                 {"palette", "list", "nil"},  {"lo", "num", "nil"},    {"hi", "num", "nil"}};
+
+static const builtin volume_builtins[] = {
+    BUILTIN("load_volume", b_load_volume, p_path, "Load a volume from .nrrd, .nhdr or .vtk (relative to the script)."),
+    BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
+    BUILTIN("mesh_stats", b_mesh_stats, p_mesh,
+            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight}."),
+    BUILTIN("slice", b_slice, p_slice,
+            "An axis-aligned slice of a volume as an image: axis \"x\", \"y\" or \"z\", index (default: the middle), values lo..hi (default: the volume's range) through a palette."),
+};
+
+int bind_volume_init(interp *I)
+{
+    return builtins_register(I, volume_builtins, (int)(sizeof volume_builtins / sizeof volume_builtins[0]));
+}

@@ -1,0 +1,31 @@
+/* lang_objects.h — engine objects shared by several bindings: volumes,
+ * meshes, colour ramps. Each binding file (bind_*.c) wraps runtime objects
+ * with these helpers so every engine's output can be saved, sliced and
+ * printed the same way. */
+#ifndef LANG_OBJECTS_H
+#define LANG_OBJECTS_H
+
+#include "mesh.h"
+#include "ramp.h"
+#include "state.h"
+#include "volume.h"
+
+extern const obj_class volume_class;
+extern const obj_class mesh_class;
+
+/* Check the voxel limit and the memory budget, then allocate. */
+int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3], volume **out);
+int lang_volume_value(interp *I, volume *v, value *out); /* takes ownership */
+volume *lang_as_volume(value v);
+
+int lang_mesh_value(interp *I, mesh *m, value *out); /* takes ownership (m malloc'd) */
+mesh *lang_as_mesh(value v);
+
+/* A colour ramp from a list of colours (evenly spaced stops) or a table of
+ * rows [t, r, g, b] / [t, r, g, b, a]; nil gives grey. */
+int lang_get_ramp(interp *I, value v, ramp *out, const char *what);
+
+/* Read an optional number/int/bool field of an options record. */
+int opt_num(interp *I, value rec, const char *key, double *out);
+
+#endif
