@@ -75,6 +75,23 @@ int opt_num(interp *I, value rec, const char *key, double *out)
     return err_at(I, NULL, ERR_TYPE, "option '%s' must be a number, got %s", key, val_type_name(*v));
 }
 
+rt_run lang_run(interp *I)
+{
+    rt_run r;
+    r.threads = I->threads > 0 ? I->threads : 1;
+    r.cancel = I->interrupt;
+    r.progress = I->progress && !I->quiet;
+    return r;
+}
+
+int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
+{
+    err_kind k = c == RT_EIO ? ERR_IO : c == RT_ENOMEM ? ERR_MEMORY : c == RT_ECANCEL ? ERR_INTERRUPT : ERR_VALUE;
+    if (c == RT_ECANCEL)
+        return err_at(I, NULL, k, "%s: interrupted", what);
+    return err_at(I, NULL, k, "%s: %s", what, e->msg);
+}
+
 /* ---- volumes ------------------------------------------------------------------------ */
 
 typedef struct vol_payload {

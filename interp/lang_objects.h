@@ -6,6 +6,7 @@
 #define LANG_OBJECTS_H
 
 #include "mesh.h"
+#include "rt.h"
 #include "ramp.h"
 #include "state.h"
 #include "volume.h"
@@ -25,7 +26,15 @@ mesh *lang_as_mesh(value v);
  * rows [t, r, g, b] / [t, r, g, b, a]; nil gives grey. */
 int lang_get_ramp(interp *I, value v, ramp *out, const char *what);
 
-/* Read an optional number/int/bool field of an options record. */
+/* Read an optional number/int/bool field of an options record: 1 found,
+ * 0 absent, -1 error. */
 int opt_num(interp *I, value rec, const char *key, double *out);
+
+/* How engines run for this session: threads, Ctrl-C flag, progress bar. */
+rt_run lang_run(interp *I);
+/* Turn a runtime failure into a script error: RT_EIO -> ERR_IO, RT_ENOMEM ->
+ * ERR_MEMORY, RT_ECANCEL -> ERR_INTERRUPT, others -> ERR_VALUE. The message
+ * is "WHAT: e->msg". Returns -1. */
+int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what);
 
 #endif
