@@ -92,6 +92,101 @@ int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
     return err_at(I, NULL, k, "%s: %s", what, e->msg);
 }
 
+/* ---- cameras ------------------------------------------------------------------------ */
+
+static int rec_vec3(interp *I, value rec, const char *key, double out[3], int required, const char *what)
+{
+    const char *k = intern(I, key, strlen(key));
+    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
+    if (!v) {
+        if (required)
+            return err_at(I, NULL, ERR_VALUE, "%s: the camera record needs '%s'", what, key);
+        return 1;
+    }
+    char w[128];
+    snprintf(w, sizeof w, "%s: camera %s", what, key);
+    return get_vec(I, *v, out, 3, w);
+}
+
+int lang_get_camera(interp *I, value v, camera *cam, const char *what)
+{
+    if (v.k != V_REC)
+        return err_at(I, NULL, ERR_TYPE, "%s: camera must be a record like orbit(30, 20) gives, got %s", what,
+                      val_type_name(v));
+    memset(cam, 0, sizeof *cam);
+    cam->up[1] = 1;
+    cam->fov = 40;
+    if (rec_vec3(I, v, "eye", cam->eye, 1, what) < 0 || rec_vec3(I, v, "target", cam->target, 1, what) < 0 ||
+        rec_vec3(I, v, "up", cam->up, 0, what) < 0)
+        return -1;
+    double fov;
+    int r = opt_num(I, v, "fov", &fov);
+    if (r < 0)
+        return -1;
+    if (r == 1) {
+        if (!(fov > 0 && fov < 179))
+            return err_at(I, NULL, ERR_VALUE, "%s: camera fov must be between 0 and 179 degrees, got %g", what, fov);
+        cam->fov = fov;
+    }
+    if (camera_setup(cam))
+        return err_at(I, NULL, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view", what);
+    return 0;
+}
+
+static int camera_record(interp *I, const double eye[3], const double target[3], const double up[3], double fov,
+                         value *out)
+{
+    value r = val_rec(I);
+    if (r.k == V_NIL)
+        return -1;
+    const char *names[3] = {"eye", "target", "up"};
+    const double *vals[3] = {eye, target, up};
+    for (int i = 0; i < 3; i++) {
+        value l = val_list(I, 3);
+        if (l.k == V_NIL)
+            goto fail;
+        for (int j = 0; j < 3; j++)
+            if (list_push(I, AS_LIST(l), val_num(vals[i][j]))) {
+                val_unref(I, l);
+                goto fail;
+            }
+        if (rec_set(I, AS_REC(r), intern(I, names[i], strlen(names[i])), l))
+            goto fail;
+    }
+    if (rec_set(I, AS_REC(r), intern(I, "fov", 3), val_num(fov)))
+        goto fail;
+    *out = r;
+    return 0;
+fail:
+    val_unref(I, r);
+    return -1;
+}
+
+static int b_orbit(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double target[3];
+    if (get_vec(I, a[3], target, 3, "orbit: target"))
+        return -1;
+    if (!(a[2].u.n > 0))
+        return err_at(I, NULL, ERR_VALUE, "orbit: distance must be positive, got %g", a[2].u.n);
+    camera c;
+    camera_orbit(&c, target, a[2].u.n, a[0].u.n, a[1].u.n, a[4].u.n);
+    if (fabs(a[1].u.n) >= 90)
+        return err_at(I, NULL, ERR_VALUE, "orbit: elevation must be between -90 and 90 degrees, got %g", a[1].u.n);
+    return camera_record(I, c.eye, c.target, c.up, a[4].u.n, out);
+}
+
+static int b_look_at(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double eye[3], target[3], up[3];
+    if (get_vec(I, a[0], eye, 3, "look_at: eye") || get_vec(I, a[1], target, 3, "look_at: target") ||
+        get_vec(I, a[2], up, 3, "look_at: up"))
+        return -1;
+    return camera_record(I, eye, target, up, a[3].u.n, out);
+}
+
 /* ---- volumes ------------------------------------------------------------------------ */
 
 typedef struct vol_payload {
@@ -457,7 +552,15 @@ static const bparam p_mesh[] = {{"mesh", "mesh", NULL}};
 static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str", "\"z\""}, {"index", "int", "nil"},
                                  {"palette", "list", "nil"},  {"lo", "num", "nil"},    {"hi", "num", "nil"}};
 
+static const bparam p_orbit[] = {{"azimuth", "num", "30"}, {"elevation", "num", "20"}, {"distance", "num", "3"},
+                                 {"target", "vec", "[0, 0, 0]"}, {"fov", "num", "40"}};
+static const bparam p_look_at[] = {{"eye", "vec", NULL}, {"target", "vec", "[0, 0, 0]"}, {"up", "vec", "[0, 1, 0]"},
+                                   {"fov", "num", "40"}};
+
 static const builtin volume_builtins[] = {
+    BUILTIN("orbit", b_orbit, p_orbit,
+            "A camera looking at `target` from `distance`, turned `azimuth` degrees around +y (0: from +z) and raised `elevation` degrees; fov is the vertical field of view. Returns a record {eye, target, up, fov}."),
+    BUILTIN("look_at", b_look_at, p_look_at, "A camera at `eye` looking at `target` (a record {eye, target, up, fov})."),
     BUILTIN("load_volume", b_load_volume, p_path, "Load a volume from .nrrd, .nhdr or .vtk (relative to the script)."),
     BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
     BUILTIN("mesh_stats", b_mesh_stats, p_mesh,

@@ -49,6 +49,10 @@ int builtins_image_init(interp *I);
 /* Engine bindings (interp/bind_*.c), registered by bindings.c. */
 int bindings_init(interp *I);
 int bind_volume_init(interp *I);
+int bind_field_init(interp *I);
+int bind_ifs_init(interp *I);
+int bind_solid_init(interp *I);
+int bind_wrinkly_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
 int call_value(interp *I, value fn, const value *args, int nargs, value *out);

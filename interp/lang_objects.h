@@ -5,6 +5,7 @@
 #ifndef LANG_OBJECTS_H
 #define LANG_OBJECTS_H
 
+#include "camera.h"
 #include "mesh.h"
 #include "rt.h"
 #include "ramp.h"
@@ -29,6 +30,10 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what);
 /* Read an optional number/int/bool field of an options record: 1 found,
  * 0 absent, -1 error. */
 int opt_num(interp *I, value rec, const char *key, double *out);
+
+/* A camera from a record {eye: [x,y,z], target: [x,y,z], up: [0,1,0],
+ * fov: 40} (what orbit() and look_at() return). */
+int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
