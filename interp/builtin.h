@@ -23,6 +23,15 @@ typedef struct bparam {
 
 #define MAX_ARGS 32
 
+/* Operation codes passed to obj_class.arith beyond the operator tokens
+ * (T_PLUS…, '-' unary minus): math functions applied to an object (fields
+ * build graph nodes, images apply per pixel), min/max and atan2. */
+enum {
+    OP_SQRT = 256, OP_EXP, OP_LOG, OP_SIN, OP_COS, OP_TAN, OP_ABS, OP_FLOOR, OP_CEIL, OP_ROUND, OP_SIGN,
+    OP_ASIN, OP_ACOS, OP_ATAN,
+    OP_MAX = 512, OP_MIN = 513, OP_ATAN2 = 514, OP_NEG = 515
+};
+
 /* args: one slot per declared parameter, in declaration order (defaults
  * filled in; borrowed). For variadic builtins, args[0..nargs-1] are the
  * positional arguments followed by the named parameters. Write the result

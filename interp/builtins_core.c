@@ -141,9 +141,6 @@ static double d_abs(double x) { return fabs(x); }
 static double d_round(double x) { return floor(x + 0.5); }
 static double d_sign(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
 
-/* Op codes for unary math passed to arith hooks: 256 + index. */
-enum { M_SQRT = 256, M_EXP, M_LOG, M_SIN, M_COS, M_TAN, M_ABS, M_FLOOR, M_CEIL, M_ROUND, M_SIGN,
-       M_ASIN, M_ACOS, M_ATAN };
 
 #define MATH1(cname, fname, f, code)                                               \
     static int cname(interp *I, value *a, int n, value *out)                      \
@@ -151,20 +148,20 @@ enum { M_SQRT = 256, M_EXP, M_LOG, M_SIN, M_COS, M_TAN, M_ABS, M_FLOOR, M_CEIL, 
         (void)n;                                                                   \
         return apply1(I, a[0], f, code, out);                                     \
     }
-MATH1(b_sqrt, "sqrt", sqrt, M_SQRT)
-MATH1(b_exp, "exp", exp, M_EXP)
-MATH1(b_log, "log", log, M_LOG)
-MATH1(b_sin, "sin", sin, M_SIN)
-MATH1(b_cos, "cos", cos, M_COS)
-MATH1(b_tan, "tan", tan, M_TAN)
-MATH1(b_asin, "asin", asin, M_ASIN)
-MATH1(b_acos, "acos", acos, M_ACOS)
-MATH1(b_atan, "atan", atan, M_ATAN)
-MATH1(b_abs, "abs", d_abs, M_ABS)
-MATH1(b_floor, "floor", floor, M_FLOOR)
-MATH1(b_ceil, "ceil", ceil, M_CEIL)
-MATH1(b_round, "round", d_round, M_ROUND)
-MATH1(b_sign, "sign", d_sign, M_SIGN)
+MATH1(b_sqrt, "sqrt", sqrt, OP_SQRT)
+MATH1(b_exp, "exp", exp, OP_EXP)
+MATH1(b_log, "log", log, OP_LOG)
+MATH1(b_sin, "sin", sin, OP_SIN)
+MATH1(b_cos, "cos", cos, OP_COS)
+MATH1(b_tan, "tan", tan, OP_TAN)
+MATH1(b_asin, "asin", asin, OP_ASIN)
+MATH1(b_acos, "acos", acos, OP_ACOS)
+MATH1(b_atan, "atan", atan, OP_ATAN)
+MATH1(b_abs, "abs", d_abs, OP_ABS)
+MATH1(b_floor, "floor", floor, OP_FLOOR)
+MATH1(b_ceil, "ceil", ceil, OP_CEIL)
+MATH1(b_round, "round", d_round, OP_ROUND)
+MATH1(b_sign, "sign", d_sign, OP_SIGN)
 
 static int b_pow(interp *I, value *a, int n, value *out)
 {
@@ -178,6 +175,12 @@ static int b_atan2(interp *I, value *a, int n, value *out)
     if (a[0].k == V_NUM && a[1].k == V_NUM) {
         *out = val_num(atan2(a[0].u.n, a[1].u.n));
         return 0;
+    }
+    vobj *o = a[0].k == V_OBJ ? AS_OBJ(a[0]) : a[1].k == V_OBJ ? AS_OBJ(a[1]) : NULL;
+    if (o && o->cls->arith) {
+        int r = o->cls->arith(I, OP_ATAN2, a[0], a[1], out);
+        if (r != 0)
+            return r < 0 ? -1 : 0;
     }
     return err_at(I, NULL, ERR_TYPE, "atan2 expects two numbers, got %s and %s", val_type_name(a[0]),
                   val_type_name(a[1]));
@@ -205,7 +208,7 @@ static int minmax(interp *I, value *a, int n, value *out, int want_max)
         }
         /* fields and images: element-wise through the arith hook */
         value r;
-        int op = want_max ? 512 : 513;
+        int op = want_max ? OP_MAX : OP_MIN;
         vobj *o = best.k == V_OBJ ? AS_OBJ(best) : x.k == V_OBJ ? AS_OBJ(x) : NULL;
         int h = o && o->cls->arith ? o->cls->arith(I, op, best, x, &r) : 0;
         if (h < 0) {
@@ -725,7 +728,7 @@ static int b_seed(interp *I, value *a, int n, value *out)
 
 static const bparam p_x[] = {{"x", "num|list|field|image", NULL}};
 static const bparam p_xy[] = {{"x", "any", NULL}, {"y", "any", NULL}};
-static const bparam p_yx[] = {{"y", "num", NULL}, {"x", "num", NULL}};
+static const bparam p_yx[] = {{"y", "num|field", NULL}, {"x", "num|field", NULL}};
 static const bparam p_clamp[] = {{"x", "any", NULL}, {"lo", "any", "0"}, {"hi", "any", "1"}};
 static const bparam p_lerp[] = {{"a", "any", NULL}, {"b", "any", NULL}, {"t", "any", NULL}};
 static const bparam p_none[] = {{"_unused", "nil", "nil"}};

@@ -126,8 +126,8 @@ static float fop(int op, float x, float y)
     case T_STAR: return x * y;
     case T_SLASH: return x / y;
     case T_CARET: return powf(x, y);
-    case 512: return x > y ? x : y;
-    case 513: return x < y ? x : y;
+    case OP_MAX: return x > y ? x : y;
+    case OP_MIN: return x < y ? x : y;
     default: return x;
     }
 }
@@ -136,8 +136,8 @@ static int image_arith(interp *I, int op, value a, value b, value *out)
 {
     image *x = lang_as_image(a), *y = lang_as_image(b);
     int binary = op == T_PLUS || op == T_MINUS || op == T_STAR || op == T_SLASH || op == T_CARET ||
-                 op == 512 || op == 513;
-    if (op == '-' && x && b.k == V_NIL) {
+                 op == OP_MAX || op == OP_MIN;
+    if (op == OP_NEG && x && b.k == V_NIL) {
         b = val_num(-1);
         op = T_STAR;
         binary = 1;

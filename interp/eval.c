@@ -150,7 +150,7 @@ static int eval_unary(interp *I, int op, value a, value *out, const node *at)
     if (a.k == V_LIST)
         return eval_binary(I, T_STAR, a, val_num(-1), out, at);
     int handled;
-    if (obj_arith(I, '-', a, val_nil(), out, &handled))
+    if (obj_arith(I, OP_NEG, a, val_nil(), out, &handled))
         return -1;
     if (handled)
         return 0;

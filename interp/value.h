@@ -99,7 +99,7 @@ typedef struct obj_class {
     void (*destroy)(void *payload);
     void (*summary)(const void *payload, struct bytebuf *out); /* one line */
     /* Optional: arithmetic where either operand is of this class (op is the
-     * token type: T_PLUS…, or '-' 'n' for unary minus/not with b nil).
+     * token type: T_PLUS…, or an OP_* code of builtin.h with b nil for unary ones).
      * Return 1 if handled (result in *out), 0 to fall through to the
      * generic "cannot add image and string" error, -1 on error. */
     int (*arith)(struct interp *I, int op, value a, value b, value *out);

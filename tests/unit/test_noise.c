@@ -1,0 +1,199 @@
+/* test_noise.c — Perlin's improved noise, fBm and turbulence (noise.h). */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "check.h"
+#include "noise.h"
+#include "rng.h"
+
+#define NPTS 20000
+
+static double px[NPTS], py[NPTS], pz[NPTS], o1[NPTS], o2[NPTS];
+
+static void random_points(uint64_t seed, double scale)
+{
+    rng r;
+    rng_init(&r, seed, 1);
+    for (int i = 0; i < NPTS; i++) {
+        px[i] = (rng_uniform(&r) * 2 - 1) * scale;
+        py[i] = (rng_uniform(&r) * 2 - 1) * scale;
+        pz[i] = (rng_uniform(&r) * 2 - 1) * scale;
+    }
+}
+
+static void test_reference(void)
+{
+    noise_perm np;
+    noise_perm_reference(&np);
+    /* Perlin's table is a permutation of 0..255, doubled. */
+    int seen[256] = {0}, dup = 0;
+    for (int i = 0; i < 256; i++) {
+        dup += seen[np.p[i]]++ != 0;
+        dup += np.p[i] != np.p[i + 256];
+    }
+    CHECK(dup == 0, "reference table is not a doubled permutation (%d bad)", dup);
+
+    /* Published values of the 2002 reference (Java, doubles): e.g. Rosetta
+     * Code's "Perlin noise" task, n(3.14, 42, 7) = 0.13691995878400012. */
+    CHECK(noise_reference3(3.14, 42, 7) == 0.13691995878400012, "ref(3.14,42,7) = %.17g",
+          noise_reference3(3.14, 42, 7));
+    CHECK(noise_reference3(-4.2, 10, 6) == 0.14208000000000043, "ref(-4.2,10,6) = %.17g",
+          noise_reference3(-4.2, 10, 6));
+    CHECK(noise_perlin3(&np, 3.14, 42, 7) == 0.13691995878400012, "ours(3.14,42,7) = %.17g",
+          noise_perlin3(&np, 3.14, 42, 7));
+    CHECK(noise_perlin3(&np, -4.2, 10, 6) == 0.14208000000000043, "ours(-4.2,10,6) = %.17g",
+          noise_perlin3(&np, -4.2, 10, 6));
+
+    /* By hand, n(0.25, 0, 0) with Perlin's table: X = Y = Z = 0, so
+     * A = P[0] = 151, AA = P[151] = 17, B = P[1] = 160, BA = P[160] = 119;
+     * v = w = fade(0) = 0, so n = lerp(u, grad(P[17], .25,0,0),
+     * grad(P[119], -.75,0,0)). P[17] = 36, 36 & 15 = 4: x + z = 0.25.
+     * P[119] = 86, 86 & 15 = 6: x - z = -0.75. u = fade(0.25) =
+     * 0.25^3 (0.25 (1.5 - 15) + 10) = 0.015625 * 6.625 = 0.103515625.
+     * n = 0.25 + 0.103515625 * (-0.75 - 0.25) = 0.146484375 (exact). */
+    CHECK(np.p[17] == 36 && np.p[119] == 86 && np.p[151] == 17 && np.p[160] == 119,
+          "table entries %d %d %d %d", np.p[17], np.p[119], np.p[151], np.p[160]);
+    CHECK(noise_perlin3(&np, 0.25, 0, 0) == 0.146484375, "n(.25,0,0) = %.17g",
+          noise_perlin3(&np, 0.25, 0, 0));
+    CHECK(noise_reference3(0.25, 0, 0) == 0.146484375, "ref(.25,0,0) = %.17g",
+          noise_reference3(0.25, 0, 0));
+
+    /* With the reference permutation, ours equals the transcription. */
+    random_points(7, 300);
+    int bad = 0;
+    for (int i = 0; i < NPTS; i++)
+        bad += noise_perlin3(&np, px[i], py[i], pz[i]) != noise_reference3(px[i], py[i], pz[i]);
+    CHECK(bad == 0, "%d of %d points differ from the reference", bad, NPTS);
+}
+
+static void test_properties(void)
+{
+    noise_perm a, b, a2;
+    noise_perm_init(&a, 1);
+    noise_perm_init(&a2, 1);
+    noise_perm_init(&b, 2);
+    CHECK(memcmp(&a, &a2, sizeof a) == 0, "same seed, different permutation");
+    CHECK(memcmp(&a, &b, sizeof a) != 0, "seeds 1 and 2 give the same permutation");
+    int seen[256] = {0}, dup = 0;
+    for (int i = 0; i < 256; i++)
+        dup += seen[a.p[i]]++ != 0 || a.p[i] != a.p[i + 256];
+    CHECK(dup == 0, "seeded table is not a doubled permutation");
+
+    /* Zero at every integer lattice point (also negative and far ones). */
+    int nz = 0;
+    for (int i = -6; i <= 6; i++)
+        for (int j = -6; j <= 6; j++)
+            for (int k = -6; k <= 6; k++)
+                nz += noise_perlin3(&a, i * 37, j * 3 + 1000, k - 1e6) != 0;
+    CHECK(nz == 0, "%d lattice points with non-zero noise", nz);
+
+    /* Bounded: |n| <= 1.04 for 3-D improved noise (we check 1.05), and not
+     * degenerate (values of both signs above 0.5 in magnitude occur). */
+    random_points(3, 50);
+    double mx = -9, mn = 9;
+    int differ = 0;
+    for (int i = 0; i < NPTS; i++) {
+        double v = noise_perlin3(&a, px[i], py[i], pz[i]);
+        mx = v > mx ? v : mx;
+        mn = v < mn ? v : mn;
+        differ += v != noise_perlin3(&b, px[i], py[i], pz[i]);
+    }
+    CHECK(mx <= 1.05 && mn >= -1.05, "range [%g, %g]", mn, mx);
+    CHECK(mx > 0.5 && mn < -0.5, "range [%g, %g] too small", mn, mx);
+    CHECK(differ > NPTS * 9 / 10, "seeds 1 and 2 agree at %d of %d points", NPTS - differ, NPTS);
+
+    /* Lipschitz. n = sum_c w_c (g_c . (p - c)); per axis the fade
+     * derivative is at most 30/16 = 1.875 and |g . (p - c)| <= 2, the two
+     * weights along an axis give 2 * 1.875 * 2 = 7.5, plus sum w |g_x| <= 1:
+     * |dn/dx| <= 8.5, |grad n| <= 8.5 sqrt(3) < 14.8. Steps that cross cell
+     * faces (x near an integer) would show a discontinuity as a huge ratio. */
+    double worst = 0;
+    for (int i = 0; i < NPTS; i++) {
+        double x = px[i], y = py[i], z = pz[i];
+        if (i % 4 == 0)
+            x = floor(x) - 5e-8; /* straddle a face */
+        double h = 1e-7, dx = h * 0.6, dy = -h * 0.48, dz = h * 0.64;
+        double d = fabs(noise_perlin3(&a, x + dx, y + dy, z + dz) - noise_perlin3(&a, x, y, z));
+        double ratio = d / sqrt(dx * dx + dy * dy + dz * dz);
+        worst = ratio > worst ? ratio : worst;
+    }
+    CHECK(worst < 14.8, "Lipschitz ratio %g", worst);
+    CHECK(worst > 0.1, "noise looks constant (ratio %g)", worst);
+
+    /* Large and non-finite coordinates: defined, bounded. */
+    double big = noise_perlin3(&a, 1e15 + 0.5, -3e12 + 0.25, 7.5);
+    CHECK(isfinite(big) && fabs(big) <= 1.05, "far value %g", big);
+    CHECK(isnan(noise_perlin3(&a, NAN, 0.5, 0.5)), "NaN in, NaN out");
+    CHECK(isnan(noise_perlin3(&a, INFINITY, 0.5, 0.5)), "inf in, NaN out");
+}
+
+static void test_octaves(void)
+{
+    noise_perm np;
+    noise_perm_reference(&np);
+    /* Turbulence = sum |n(2^i p)| / 2^i. At p = (1.57, 21, 3.5) octave 1 is
+     * n(3.14, 42, 7) = 0.13691995878400012 (published), octave 0 comes from
+     * the reference transcription, octave 2 likewise at 4p. */
+    double n0 = noise_reference3(1.57, 21, 3.5), n2 = noise_reference3(6.28, 84, 14);
+    double t2 = fabs(n0) + 0.13691995878400012 / 2;
+    CHECK_NEAR(noise_turbulence3(&np, 2, 1.57, 21, 3.5), t2, 1e-15, "turbulence 2 octaves");
+    CHECK_NEAR(noise_turbulence3(&np, 3, 1.57, 21, 3.5), t2 + fabs(n2) / 4, 1e-15,
+               "turbulence 3 octaves");
+    CHECK(noise_turbulence3(&np, 0, 1.57, 21, 3.5) == 0, "0 octaves");
+    /* fBm(lac 2, gain 0.5) differs from turbulence only by the abs. */
+    CHECK_NEAR(noise_fbm3(&np, 2, 2, 0.5, 1.57, 21, 3.5), n0 + 0.5 * 0.13691995878400012, 1e-15,
+               "fbm 2 octaves");
+    /* lacunarity 3, gain 0.25: n(p) + 0.25 n(3p) + 0.0625 n(9p). */
+    double f3 = noise_reference3(0.3, 0.7, 1.1) + 0.25 * noise_reference3(0.9, 2.1, 3.3) +
+                0.0625 * noise_reference3(2.7, 6.3, 9.9);
+    CHECK_NEAR(noise_fbm3(&np, 3, 3, 0.25, 0.3, 0.7, 1.1), f3, 1e-14, "fbm lac 3");
+
+    /* Turbulence of 6 octaves lies in [0, 1.05 * (2 - 1/32)]. */
+    noise_perm s;
+    noise_perm_init(&s, 99);
+    random_points(5, 10);
+    double mx = 0;
+    int neg = 0;
+    for (int i = 0; i < NPTS; i++) {
+        double t = noise_turbulence3(&s, 6, px[i], py[i], pz[i]);
+        neg += !(t >= 0);
+        mx = t > mx ? t : mx;
+    }
+    CHECK(neg == 0, "%d negative turbulence values", neg);
+    CHECK(mx <= 1.05 * (2 - 1.0 / 32) && mx > 0.3, "turbulence max %g", mx);
+}
+
+static void test_blocks(void)
+{
+    noise_perm np;
+    noise_perm_init(&np, 12345);
+    random_points(11, 1000);
+    for (int i = 0; i < 100; i++) /* include far points and lattice points */
+        px[i] = i < 50 ? 1e11 * (i + 0.37) : (double)(i - 75);
+    noise_perlin3_block(&np, NPTS, px, py, pz, o1);
+    for (int i = 0; i < NPTS; i++)
+        o2[i] = noise_perlin3(&np, px[i], py[i], pz[i]);
+    CHECK(memcmp(o1, o2, sizeof o1) == 0, "block perlin differs from scalar");
+    noise_fbm3_block(&np, 5, 2.1, 0.55, NPTS, px, py, pz, o1);
+    for (int i = 0; i < NPTS; i++)
+        o2[i] = noise_fbm3(&np, 5, 2.1, 0.55, px[i], py[i], pz[i]);
+    CHECK(memcmp(o1, o2, sizeof o1) == 0, "block fbm differs from scalar");
+    noise_turbulence3_block(&np, 6, NPTS, px, py, pz, o1);
+    for (int i = 0; i < NPTS; i++)
+        o2[i] = noise_turbulence3(&np, 6, px[i], py[i], pz[i]);
+    CHECK(memcmp(o1, o2, sizeof o1) == 0, "block turbulence differs from scalar");
+    /* n = 0 and odd n work */
+    noise_perlin3_block(&np, 0, px, py, pz, o1);
+    noise_perlin3_block(&np, 3, px + 200, py + 200, pz + 200, o1);
+    CHECK(o1[2] == noise_perlin3(&np, px[202], py[202], pz[202]), "short block");
+}
+
+int main(void)
+{
+    test_reference();
+    test_properties();
+    test_octaves();
+    test_blocks();
+    return check_done("test_noise");
+}
