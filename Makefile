@@ -65,10 +65,15 @@ $(BUILD)/runner: tests/runner.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_BASE) -O1 $< -o $@ $(LDLIBS)
 
+# Drives interactive programs on a pseudo-terminal (REPL tests).
+$(BUILD)/ptyrun: tests/ptyrun.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_BASE) -O1 $< -o $@
+
 unit: $(UNIT_BIN)
 
-test: $(BUILD)/frac $(UNIT_BIN) $(BUILD)/runner
-	$(BUILD)/runner --frac $(BUILD)/frac --unit $(BUILD)/tests
+test: $(BUILD)/frac $(UNIT_BIN) $(BUILD)/runner $(BUILD)/ptyrun
+	$(BUILD)/runner --frac $(BUILD)/frac --unit $(BUILD)/tests --ptyrun $(BUILD)/ptyrun
 
 asan:
 	$(MAKE) BUILD=build-asan OPT=-O1 SAN="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" test

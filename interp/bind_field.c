@@ -44,12 +44,14 @@ static void fv_summary(const void *p, bytebuf *out)
 }
 
 static int fv_arith(interp *I, int op, value a, value b, value *out);
+static int fv_preview(interp *I, const void *p, image **out);
 
 const obj_class field_class = {
     .name = "field",
     .destroy = fv_destroy,
     .summary = fv_summary,
     .arith = fv_arith,
+    .preview = fv_preview,
 };
 
 static field_val *as_fv(value v)
@@ -134,6 +136,48 @@ static const field_prog *fv_prog(interp *I, field_val *fv)
             lang_rt_error(I, e.code, &e, "field");
     }
     return fv->prog;
+}
+
+/* The slice z = 0 over [-1, 1]^2 (y up), grey from the slice's min to max. */
+static int fv_preview(interp *I, const void *p, image **out)
+{
+    field_val *fv = (field_val *)p;
+    const field_prog *prog = fv_prog(I, fv);
+    if (!prog)
+        return -1;
+    enum { N = 128 };
+    image *im;
+    if (lang_image_new(I, N, N, &im))
+        return -1;
+    double *v = malloc(sizeof(double) * N * N);
+    if (!v) {
+        image_free(im);
+        free(im);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    }
+    double xs[N], ys[N], zs[N];
+    for (int j = 0; j < N; j++) {
+        for (int i = 0; i < N; i++) {
+            xs[i] = -1 + 2 * (i + 0.5) / N;
+            ys[i] = 1 - 2 * (j + 0.5) / N;
+            zs[i] = 0;
+        }
+        field_prog_eval(prog, N, xs, ys, zs, v + (size_t)j * N);
+    }
+    double mn = INFINITY, mx = -INFINITY;
+    for (int i = 0; i < N * N; i++)
+        if (isfinite(v[i])) {
+            mn = v[i] < mn ? v[i] : mn;
+            mx = v[i] > mx ? v[i] : mx;
+        }
+    for (int i = 0; i < N * N; i++) {
+        float g = mx > mn && isfinite(v[i]) ? (float)((v[i] - mn) / (mx - mn)) : 0.0f;
+        im->px[4 * i] = im->px[4 * i + 1] = im->px[4 * i + 2] = g;
+        im->px[4 * i + 3] = 1;
+    }
+    free(v);
+    *out = im;
+    return 0;
 }
 
 static int fv_arith(interp *I, int op, value a, value b, value *out)

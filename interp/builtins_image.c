@@ -45,7 +45,6 @@ const obj_class image_class = {
     .summary = image_summary,
     .arith = image_arith,
     .get = image_get,
-    .show = NULL,
     .save = image_save_hook,
 };
 

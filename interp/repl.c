@@ -17,45 +17,42 @@
 #include "builtin.h"
 #include "eval.h"
 #include "fileio.h"
+#include "lineedit.h"
+#include "parser.h"
 #include "session.h"
 
 typedef struct repl {
     interp *I;
+    lineedit *le;
     int tty;
     int line_no; /* session line number of the next input line */
     int failed;
 } repl;
 
-/* Read one line (without the newline) into a malloc'd string; NULL at EOF. */
-static char *read_line(repl *r, const char *prompt)
+/* Read one line (without the newline) into a malloc'd string; NULL at the
+ * end of input. Ctrl-C on a terminal cancels the line: *cancelled is set and
+ * an empty line is returned. */
+static char *read_line(repl *r, const char *prompt, int *cancelled)
 {
-    if (r->tty) {
-        fputs(prompt, stdout);
-        fflush(stdout);
-    }
-    size_t cap = 256, n = 0;
-    char *buf = malloc(cap);
-    if (!buf)
-        return NULL;
-    int c;
-    while ((c = fgetc(stdin)) != EOF && c != '\n') {
-        if (n + 1 == cap) {
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                return NULL;
-            }
-            buf = nb;
-            cap *= 2;
+    *cancelled = 0;
+    char *line = NULL;
+    for (;;) {
+        lineedit_result res = lineedit_read(r->le, prompt, &line);
+        if (res == LINEEDIT_LINE)
+            return line;
+        if (res == LINEEDIT_INTERRUPT) {
+            if (!r->tty)
+                continue;
+            *cancelled = 1;
+            line = malloc(1);
+            if (line)
+                line[0] = 0;
+            return line;
         }
-        buf[n++] = (char)c;
-    }
-    if (c == EOF && n == 0) {
-        free(buf);
+        if (res == LINEEDIT_ERROR)
+            fprintf(stderr, "frac: %s\n", lineedit_errmsg(r->le));
         return NULL;
     }
-    buf[n] = 0;
-    return buf;
 }
 
 static void print_value(repl *r, value v)
@@ -217,15 +214,30 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
     r.tty = isatty(0) && isatty(1);
     r.line_no = 1;
     I->is_repl = 1;
+    char hist[4096] = "";
+    const char *home = getenv("HOME");
+    if (r.tty && home && *home)
+        snprintf(hist, sizeof hist, "%s/.frac_history", home);
+    r.le = lineedit_new(0, 1, hist[0] ? hist : NULL, 1000);
+    if (!r.le) {
+        fprintf(stderr, "frac: out of memory\n");
+        return 70;
+    }
     if (r.tty)
-        printf("frac %s — type :help for help, :quit to leave\n", FRAC_VERSION);
+        printf("frac %s — type :help for help, :quit or Ctrl-D to leave\n", FRAC_VERSION);
     for (;;) {
         *interrupted = 0;
-        char *line = read_line(&r, "frac> ");
+        int cancelled;
+        char *line = read_line(&r, "frac> ", &cancelled);
         if (!line)
             break;
+        if (cancelled || line[0] == 0) {
+            free(line);
+            continue;
+        }
         int first = r.line_no++;
         if (line[0] == ':') {
+            lineedit_history_add(r.le, line);
             int quit = run_command(&r, line);
             free(line);
             if (quit)
@@ -235,20 +247,23 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         /* accumulate continuation lines while the input is incomplete */
         size_t len = strlen(line);
         char *text = line;
+        int dropped = 0;
         for (;;) {
             int src = interp_add_source(I, "<repl>", text, len);
             node *prog;
-            (void)prog;
             if (src < 0)
                 break;
             I->srcs[src].first_line = first;
-            extern int parse_source(interp *, int, node **);
             if (parse_source(I, src, &prog) == 0 || !I->err.incomplete)
                 break;
             err_clear(I);
-            char *more = read_line(&r, "..    ");
-            if (!more)
+            char *more = read_line(&r, "..    ", &cancelled);
+            if (!more || cancelled) {
+                /* Ctrl-C or end of input abandons the unfinished entry */
+                free(more);
+                dropped = 1;
                 break;
+            }
             r.line_no++;
             size_t ml = strlen(more);
             char *nt = realloc(text, len + ml + 2);
@@ -262,14 +277,16 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             len += ml + 1;
             free(more);
         }
-        if (I->err.active) {
+        lineedit_history_add(r.le, text);
+        if (dropped) {
+            err_clear(I);
+        } else if (I->err.active) {
             report(&r);
         } else {
             eval_entry(&r, text, first, 0);
         }
         free(text);
     }
-    if (r.tty)
-        printf("\n");
+    lineedit_free(r.le);
     return r.failed && !r.tty ? 65 : 0;
 }

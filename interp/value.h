@@ -23,6 +23,7 @@
 struct interp;
 struct node;
 struct bytebuf;
+struct image;
 
 typedef enum vkind { V_NIL, V_BOOL, V_NUM, V_STR, V_LIST, V_REC, V_FUNC, V_BUILTIN, V_OBJ } vkind;
 
@@ -105,8 +106,9 @@ typedef struct obj_class {
     int (*arith)(struct interp *I, int op, value a, value b, value *out);
     /* Optional: obj.name (a new reference in *out; 0 ok, 1 no such field, -1 error). */
     int (*get)(struct interp *I, const void *payload, const char *name, value *out);
-    /* Optional: show in the terminal (REPL); NULL: not showable. */
-    int (*show)(struct interp *I, const void *payload, value self);
+    /* Optional: a picture of the object for show() in the terminal: a new
+     * malloc'd image in *out (0), or -1 after an error. */
+    int (*preview)(struct interp *I, const void *payload, struct image **out);
     /* Optional: save to a file (path already joined with --out-dir; the
      * extension picks the format). 0 ok, -1 error. */
     int (*save)(struct interp *I, const void *payload, const char *path, value opts);

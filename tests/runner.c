@@ -2,7 +2,7 @@
  * sessions and golden tests of the examples. Its last line is
  * "N passed, N failed".
  *
- *   runner --frac build/frac [--unit build/tests] [--update-golden] [FILTER]
+ *   runner --frac build/frac [--unit build/tests] [--ptyrun build/ptyrun] [--update-golden] [FILTER]
  *
  * Language tests (.frac files under tests/lang/ and tests/regression/) carry their
  * expectations as comments:
@@ -441,6 +441,46 @@ static void run_repl_dir(const char *frac, const char *dir)
 
 static int rm_tree(const char *dir);
 
+/* ---- interactive sessions on a pseudo-terminal ---------------------------------------
+ * tests/pty/NAME.pty are ptyrun scripts played against `frac repl` on a
+ * pty, in name order, with HOME pointing at one fresh folder (so history
+ * carries from one script to the next). ptyrun must exit 0 and report
+ * exit=0 and termios=same (raw mode restored). */
+static void run_pty_dir(const char *frac, const char *ptyrun)
+{
+    int n;
+    char **names = list_dir("tests/pty", ".pty", &n);
+    char tmpl[] = "/tmp/frac-home-XXXXXX";
+    char *home = mkdtemp(tmpl);
+    const char *old_home = getenv("HOME");
+    char *saved = old_home ? strdup(old_home) : NULL;
+    if (home)
+        setenv("HOME", home, 1);
+    for (int i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "tests/pty/%s", names[i]);
+        if (matches_filter(path)) {
+            char *argv[] = {(char *)ptyrun, "--check-termios", "--timeout", "20", path, "--",
+                            (char *)frac, "repl", NULL};
+            buf out = {0}, err = {0}, why = {0};
+            int rc = run(argv, NULL, &out, &err, 120);
+            int ok = rc == 0 && strstr(out.d, "exit=0") && strstr(out.d, "termios=same");
+            if (!ok)
+                buf_fmt(&why, "  ptyrun exit %d\n  stdout: %s\n  stderr: %.3000s", rc, out.d, err.d);
+            result(path, ok, &why);
+            free(out.d); free(err.d); free(why.d);
+        }
+        free(names[i]);
+    }
+    free(names);
+    if (saved) {
+        setenv("HOME", saved, 1);
+        free(saved);
+    }
+    if (home)
+        rm_tree(home);
+}
+
 /* ---- allocation failure ----------------------------------------------------------
  * Run a script failing the N-th interpreter allocation, for every N until the
  * script no longer runs out: each run must end with exit 70 and an "out of
@@ -623,13 +663,15 @@ static void run_golden(const char *frac, int update)
 
 int main(int argc, char **argv)
 {
-    const char *frac = NULL, *unit = NULL;
+    const char *frac = NULL, *unit = NULL, *ptyrun = NULL;
     int update = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--frac") == 0 && i + 1 < argc)
             frac = argv[++i];
         else if (strcmp(argv[i], "--unit") == 0 && i + 1 < argc)
             unit = argv[++i];
+        else if (strcmp(argv[i], "--ptyrun") == 0 && i + 1 < argc)
+            ptyrun = argv[++i];
         else if (strcmp(argv[i], "--update-golden") == 0)
             update = 1;
         else if (strcmp(argv[i], "--timeout") == 0 && i + 1 < argc)
@@ -655,6 +697,11 @@ int main(int argc, char **argv)
     run_lang_dir(fracabs, "tests/lang");
     run_lang_dir(fracabs, "tests/regression");
     run_repl_dir(fracabs, "tests/repl");
+    if (ptyrun) {
+        static char ptyabs[4096];
+        if (realpath(ptyrun, ptyabs))
+            run_pty_dir(fracabs, ptyabs);
+    }
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
