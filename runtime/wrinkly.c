@@ -226,20 +226,12 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
     return RT_OK;
 }
 
-rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrinkly_polyline *out,
-                             rt_error *e)
+void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki)
 {
-    memset(out, 0, sizeof *out);
-    rt_code rc = check_axis("curve", c->n, &c->ax, e);
-    if (rc)
-        return rc;
     double lam = lam_of(o->tension);
-    int n = c->n, b = 2 * c->ax.m + 1;
+    int b = 2 * c->ax.m + 1;
     int kmax = o->kmax > 0 ? o->kmax : 8;
-    int *ki = malloc(sizeof(int) * (size_t)n);
-    if (!ki)
-        return rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly curve");
-    for (int i = 0; i < n; i++) {
+    for (int i = 0; i < c->n; i++) {
         if (o->tol > 0 && b > 1) {
             double len = 0, p0[2], p1[2], d[2];
             wrinkly_curve_base(c, lam, i, p0, d);
@@ -253,6 +245,21 @@ rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrin
             ki[i] = o->k < 0 ? 0 : o->k > kmax ? kmax : o->k;
         }
     }
+}
+
+rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrinkly_polyline *out,
+                             rt_error *e)
+{
+    memset(out, 0, sizeof *out);
+    rt_code rc = check_axis("curve", c->n, &c->ax, e);
+    if (rc)
+        return rc;
+    double lam = lam_of(o->tension);
+    int n = c->n;
+    int *ki = malloc(sizeof(int) * (size_t)n);
+    if (!ki)
+        return rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly curve");
+    wrinkly_curve_levels(c, o, ki);
     ist map;
     double *pos;
     size_t np;
@@ -433,8 +440,9 @@ static double proj_len(const wrinkly_opts *o, const double a[3], const double b[
 }
 
 /* K_i per base interval of both axes (§5.2, wrinkly.h). */
-static void surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, double lam, int *ku, int *kv)
+void wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int *ku, int *kv)
 {
+    double lam = lam_of(o->tension);
     int kmax = o->kmax > 0 ? o->kmax : 8;
     int bu = 2 * s->au.m + 1, bv = 2 * s->av.m + 1;
     int adaptive = o->cam || o->tol > 0;
@@ -521,7 +529,7 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         rc = rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly surface");
         goto done;
     }
-    surface_levels(s, o, lam, ku, kv);
+    wrinkly_surface_levels(s, o, ku, kv);
     rc = make_axis(s->nu, &s->au, ku, o, lam, 1, &su, &nu, &k[0], e);
     if (!rc)
         rc = make_axis(s->nv, &s->av, kv, o, lam, 2, &sv, &nv, &k[1], e);
