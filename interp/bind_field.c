@@ -301,7 +301,7 @@ static int shape(interp *I, density_shape *s, value *out)
 {
     rt_error e;
     if (density_check(s, &e))
-        return err_at(I, NULL, ERR_VALUE, "%s: %s", density_name(s->kind), e.msg);
+        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     return field_value(I, field_density(s), out);
 }
 
@@ -374,10 +374,10 @@ static int b_perlin(interp *I, value *a, int n, value *out)
     return noise_common(I, field_perlin(seed), a[0].u.n, out);
 }
 
-static int octaves_arg(interp *I, value v, int *oct)
+static int octaves_arg(interp *I, value v, int *oct, const char *what)
 {
     long o;
-    if (get_int(I, v, 1, 30, &o, "octaves"))
+    if (get_int(I, v, 1, 30, &o, what))
         return -1;
     *oct = (int)o;
     return 0;
@@ -388,7 +388,7 @@ static int b_fbm(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct) || seed_arg(I, a[4], &seed))
+    if (octaves_arg(I, a[0], &oct, "fbm: octaves") || seed_arg(I, a[4], &seed))
         return -1;
     return noise_common(I, field_fbm(seed, oct, a[2].u.n, a[3].u.n), a[1].u.n, out);
 }
@@ -398,7 +398,7 @@ static int b_turbulence(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct) || seed_arg(I, a[2], &seed))
+    if (octaves_arg(I, a[0], &oct, "turbulence: octaves") || seed_arg(I, a[2], &seed))
         return -1;
     return noise_common(I, field_turbulence(seed, oct), a[1].u.n, out);
 }
@@ -410,7 +410,7 @@ static int b_bias(interp *I, value *a, int n, value *out)
     double b = a[1].u.n;
     rt_error e;
     if (dmf_check_bias(b, &e))
-        return err_at(I, NULL, ERR_VALUE, "bias: %s", e.msg);
+        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     if (a[0].k == V_NUM) {
         *out = val_num(dmf_bias(b, a[0].u.n));
         return 0;
@@ -425,7 +425,7 @@ static int b_gain(interp *I, value *a, int n, value *out)
     double g = a[1].u.n;
     rt_error e;
     if (dmf_check_gain(g, &e))
-        return err_at(I, NULL, ERR_VALUE, "gain: %s", e.msg);
+        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     if (a[0].k == V_NUM) {
         *out = val_num(dmf_gain(g, a[0].u.n));
         return 0;
