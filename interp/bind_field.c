@@ -60,7 +60,7 @@ static field_val *as_fv(value v)
 }
 
 /* Wrap a new node (consumes it). */
-static int field_value(interp *I, field *f, value *out)
+int lang_field_value(interp *I, field *f, value *out)
 {
     if (!f)
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
@@ -98,7 +98,7 @@ static void vol_release(void *ctx)
 
 /* A new reference to the field node for a field, number or volume value;
  * NULL (with an error) otherwise. */
-static field *to_field(interp *I, value v, const char *what)
+field *lang_to_field(interp *I, value v, const char *what)
 {
     field_val *fv = as_fv(v);
     if (fv)
@@ -217,23 +217,23 @@ static int fv_arith(interp *I, int op, value a, value b, value *out)
     default: return 0;
     }
     if (unop >= 0) {
-        field *fa = to_field(I, a, "operand");
+        field *fa = lang_to_field(I, a, "operand");
         if (!fa)
             return -1;
-        return field_value(I, field_unary((field_unop)unop, fa), out) ? -1 : 1;
+        return lang_field_value(I, field_unary((field_unop)unop, fa), out) ? -1 : 1;
     }
     /* only fields, numbers and volumes combine with fields */
     if (!(as_fv(a) || a.k == V_NUM || lang_as_volume(a)) || !(as_fv(b) || b.k == V_NUM || lang_as_volume(b)))
         return 0;
-    field *fa = to_field(I, a, "left operand");
+    field *fa = lang_to_field(I, a, "left operand");
     if (!fa)
         return -1;
-    field *fb = to_field(I, b, "right operand");
+    field *fb = lang_to_field(I, b, "right operand");
     if (!fb) {
         field_unref(fa);
         return -1;
     }
-    return field_value(I, field_binary((field_binop)binop, fa, fb), out) ? -1 : 1;
+    return lang_field_value(I, field_binary((field_binop)binop, fa, fb), out) ? -1 : 1;
 }
 
 /* ---- helpers for builtins ------------------------------------------------------- */
@@ -293,8 +293,8 @@ static int get_grid(interp *I, value v, int n[3], const char *what)
 static int b_field(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    field *f = to_field(I, a[0], "field: value");
-    return f ? field_value(I, f, out) : -1;
+    field *f = lang_to_field(I, a[0], "field: value");
+    return f ? lang_field_value(I, f, out) : -1;
 }
 
 static int shape(interp *I, density_shape *s, value *out)
@@ -302,7 +302,7 @@ static int shape(interp *I, density_shape *s, value *out)
     rt_error e;
     if (density_check(s, &e))
         return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
-    return field_value(I, field_density(s), out);
+    return lang_field_value(I, field_density(s), out);
 }
 
 static int b_sphere(interp *I, value *a, int n, value *out)
@@ -362,7 +362,7 @@ static int noise_common(interp *I, field *f, double freq, value *out)
     }
     if (freq != 1)
         f = field_scale(f, 1.0 / freq); /* child evaluated at P * freq */
-    return field_value(I, f, out);
+    return lang_field_value(I, f, out);
 }
 
 static int b_perlin(interp *I, value *a, int n, value *out)
@@ -415,8 +415,8 @@ static int b_bias(interp *I, value *a, int n, value *out)
         *out = val_num(dmf_bias(b, a[0].u.n));
         return 0;
     }
-    field *t = to_field(I, a[0], "bias: t");
-    return t ? field_value(I, field_bias(t, b), out) : -1;
+    field *t = lang_to_field(I, a[0], "bias: t");
+    return t ? lang_field_value(I, field_bias(t, b), out) : -1;
 }
 
 static int b_gain(interp *I, value *a, int n, value *out)
@@ -430,8 +430,8 @@ static int b_gain(interp *I, value *a, int n, value *out)
         *out = val_num(dmf_gain(g, a[0].u.n));
         return 0;
     }
-    field *t = to_field(I, a[0], "gain: t");
-    return t ? field_value(I, field_gain(t, g), out) : -1;
+    field *t = lang_to_field(I, a[0], "gain: t");
+    return t ? lang_field_value(I, field_gain(t, g), out) : -1;
 }
 
 static int b_smoothstep(interp *I, value *a, int n, value *out)
@@ -444,8 +444,8 @@ static int b_smoothstep(interp *I, value *a, int n, value *out)
         *out = val_num(dmf_smoothstep(e0, e1, a[0].u.n));
         return 0;
     }
-    field *t = to_field(I, a[0], "smoothstep: t");
-    return t ? field_value(I, field_smoothstep(t, e0, e1), out) : -1;
+    field *t = lang_to_field(I, a[0], "smoothstep: t");
+    return t ? lang_field_value(I, field_smoothstep(t, e0, e1), out) : -1;
 }
 
 static int b_step(interp *I, value *a, int n, value *out)
@@ -455,8 +455,8 @@ static int b_step(interp *I, value *a, int n, value *out)
         *out = val_num(dmf_step(a[1].u.n, a[0].u.n));
         return 0;
     }
-    field *t = to_field(I, a[0], "step: t");
-    return t ? field_value(I, field_step(t, a[1].u.n), out) : -1;
+    field *t = lang_to_field(I, a[0], "step: t");
+    return t ? lang_field_value(I, field_step(t, a[1].u.n), out) : -1;
 }
 
 static int b_select(interp *I, value *a, int n, value *out)
@@ -467,15 +467,15 @@ static int b_select(interp *I, value *a, int n, value *out)
         val_ref(*out);
         return 0;
     }
-    field *c = to_field(I, a[0], "select: cond");
-    field *x = c ? to_field(I, a[1], "select: a") : NULL;
-    field *y = x ? to_field(I, a[2], "select: b") : NULL;
+    field *c = lang_to_field(I, a[0], "select: cond");
+    field *x = c ? lang_to_field(I, a[1], "select: a") : NULL;
+    field *y = x ? lang_to_field(I, a[2], "select: b") : NULL;
     if (!y) {
         field_unref(c);
         field_unref(x);
         return -1;
     }
-    return field_value(I, field_select(c, x, y), out);
+    return lang_field_value(I, field_select(c, x, y), out);
 }
 
 static int b_smooth_union(interp *I, value *a, int n, value *out)
@@ -483,13 +483,13 @@ static int b_smooth_union(interp *I, value *a, int n, value *out)
     (void)n;
     if (!(a[2].u.n > 0))
         return err_at(I, NULL, ERR_VALUE, "smooth_union: k must be positive, got %g", a[2].u.n);
-    field *x = to_field(I, a[0], "smooth_union: a");
-    field *y = x ? to_field(I, a[1], "smooth_union: b") : NULL;
+    field *x = lang_to_field(I, a[0], "smooth_union: a");
+    field *y = x ? lang_to_field(I, a[1], "smooth_union: b") : NULL;
     if (!y) {
         field_unref(x);
         return -1;
     }
-    return field_value(I, field_smooth_union(x, y, a[2].u.n), out);
+    return lang_field_value(I, field_smooth_union(x, y, a[2].u.n), out);
 }
 
 static int b_translate(interp *I, value *a, int n, value *out)
@@ -498,8 +498,8 @@ static int b_translate(interp *I, value *a, int n, value *out)
     double d[3];
     if (get_vec(I, a[1], d, 3, "translate: by"))
         return -1;
-    field *f = to_field(I, a[0], "translate: field");
-    return f ? field_value(I, field_translate(f, d[0], d[1], d[2]), out) : -1;
+    field *f = lang_to_field(I, a[0], "translate: field");
+    return f ? lang_field_value(I, field_translate(f, d[0], d[1], d[2]), out) : -1;
 }
 
 static int b_scale(interp *I, value *a, int n, value *out)
@@ -507,8 +507,8 @@ static int b_scale(interp *I, value *a, int n, value *out)
     (void)n;
     if (!(a[1].u.n != 0) || !isfinite(a[1].u.n))
         return err_at(I, NULL, ERR_VALUE, "scale: the factor must be a non-zero number, got %g", a[1].u.n);
-    field *f = to_field(I, a[0], "scale: field");
-    return f ? field_value(I, field_scale(f, a[1].u.n), out) : -1;
+    field *f = lang_to_field(I, a[0], "scale: field");
+    return f ? lang_field_value(I, field_scale(f, a[1].u.n), out) : -1;
 }
 
 /* rotate(f, axis, degrees): the field turned about an axis through the
@@ -530,24 +530,24 @@ static int b_rotate(interp *I, value *a, int n, value *out)
     double m[12] = {c + x * x * C,     x * y * C - z * s, x * z * C + y * s, 0,
                     y * x * C + z * s, c + y * y * C,     y * z * C - x * s, 0,
                     z * x * C - y * s, z * y * C + x * s, c + z * z * C,     0};
-    field *f = to_field(I, a[0], "rotate: field");
-    return f ? field_value(I, field_transform(f, m), out) : -1;
+    field *f = lang_to_field(I, a[0], "rotate: field");
+    return f ? lang_field_value(I, field_transform(f, m), out) : -1;
 }
 
 static int b_warp(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    field *f = to_field(I, a[0], "warp: field");
-    field *fx = f ? to_field(I, a[1], "warp: x") : NULL;
-    field *fy = fx ? to_field(I, a[2], "warp: y") : NULL;
-    field *fz = fy ? to_field(I, a[3], "warp: z") : NULL;
+    field *f = lang_to_field(I, a[0], "warp: field");
+    field *fx = f ? lang_to_field(I, a[1], "warp: x") : NULL;
+    field *fy = fx ? lang_to_field(I, a[2], "warp: y") : NULL;
+    field *fz = fy ? lang_to_field(I, a[3], "warp: z") : NULL;
     if (!fz) {
         field_unref(f);
         field_unref(fx);
         field_unref(fy);
         return -1;
     }
-    return field_value(I, field_warp(f, fx, fy, fz), out);
+    return lang_field_value(I, field_warp(f, fx, fy, fz), out);
 }
 
 static int b_at(interp *I, value *a, int n, value *out)
@@ -576,8 +576,8 @@ static int b_at(interp *I, value *a, int n, value *out)
 }
 
 /* The field's compiled program as an rt_field_fn (for numbers: a constant). */
-static int field_fn_of(interp *I, value v, field **tmp, field_prog **own, const field_prog **prog,
-                       const char *what)
+int lang_field_fn(interp *I, value v, field **tmp, field_prog **own, const field_prog **prog,
+                  const char *what)
 {
     *tmp = NULL;
     *own = NULL;
@@ -586,7 +586,7 @@ static int field_fn_of(interp *I, value v, field **tmp, field_prog **own, const 
         *prog = fv_prog(I, fv);
         return *prog ? 0 : -1;
     }
-    *tmp = to_field(I, v, what);
+    *tmp = lang_to_field(I, v, what);
     if (!*tmp)
         return -1;
     rt_error e;
@@ -599,7 +599,7 @@ static int field_fn_of(interp *I, value v, field **tmp, field_prog **own, const 
     return 0;
 }
 
-static void field_fn_done(field *tmp, field_prog *own)
+void lang_field_fn_done(field *tmp, field_prog *own)
 {
     field_prog_free(own);
     field_unref(tmp);
@@ -615,22 +615,22 @@ static int b_sample(interp *I, value *a, int n, value *out)
     field *tmp;
     field_prog *own;
     const field_prog *prog;
-    if (field_fn_of(I, a[0], &tmp, &own, &prog, "sample"))
+    if (lang_field_fn(I, a[0], &tmp, &own, &prog, "sample"))
         return -1;
     volume *vol;
     if (lang_volume_new(I, g[0], g[1], g[2], lo, hi, &vol)) {
-        field_fn_done(tmp, own);
+        lang_field_fn_done(tmp, own);
         return -1;
     }
     value res;
     if (lang_volume_value(I, vol, &res)) {
-        field_fn_done(tmp, own);
+        lang_field_fn_done(tmp, own);
         return -1;
     }
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c = field_sample_volume(field_prog_fn, prog, vol, &run, &e);
-    field_fn_done(tmp, own);
+    lang_field_fn_done(tmp, own);
     if (c) {
         val_unref(I, res);
         return lang_rt_error(I, c, &e, "sample");
@@ -652,7 +652,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
     const field_prog *cprog = NULL;
     if (a[5].k != V_NIL) {
         if (lang_get_ramp(I, a[6], &r, "isosurface: palette") ||
-            field_fn_of(I, a[5], &ctmp, &cown, &cprog, "isosurface: colour"))
+            lang_field_fn(I, a[5], &ctmp, &cown, &cprog, "isosurface: colour"))
             return -1;
         o.colour_mode = ISO_COLOUR_RAMP;
         o.colour_fn[0] = field_prog_fn;
@@ -661,7 +661,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
     }
     mesh *m = malloc(sizeof *m);
     if (!m) {
-        field_fn_done(ctmp, cown);
+        lang_field_fn_done(ctmp, cown);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_run run = lang_run(I);
@@ -677,15 +677,15 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         field_prog *own;
         const field_prog *prog;
         if (get_grid(I, a[2], g, "isosurface: grid") || get_bounds(I, a[3], a[4], lo, hi, "isosurface") ||
-            field_fn_of(I, a[0], &tmp, &own, &prog, "isosurface")) {
+            lang_field_fn(I, a[0], &tmp, &own, &prog, "isosurface")) {
             free(m);
-            field_fn_done(ctmp, cown);
+            lang_field_fn_done(ctmp, cown);
             return -1;
         }
         c = iso_from_field(field_prog_fn, prog, lo, hi, g, &o, &run, m, &e);
-        field_fn_done(tmp, own);
+        lang_field_fn_done(tmp, own);
     }
-    field_fn_done(ctmp, cown);
+    lang_field_fn_done(ctmp, cown);
     if (c) {
         free(m);
         return lang_rt_error(I, c, &e, "isosurface");
@@ -757,12 +757,12 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     if (vol) {
         c = rm_render(rm_volume_field, vol, &cam, &o, &run, im, &e);
     } else {
-        if (field_fn_of(I, a[0], &tmp, &own, &prog, "raymarch")) {
+        if (lang_field_fn(I, a[0], &tmp, &own, &prog, "raymarch")) {
             val_unref(I, res);
             return -1;
         }
         c = rm_render(field_prog_fn, prog, &cam, &o, &run, im, &e);
-        field_fn_done(tmp, own);
+        lang_field_fn_done(tmp, own);
     }
     if (c) {
         val_unref(I, res);
@@ -844,7 +844,7 @@ int bind_field_init(interp *I)
     const char *names[3] = {"X", "Y", "Z"};
     for (int i = 0; i < 3; i++) {
         value v;
-        if (field_value(I, field_coord(i), &v) || env_define(I, root, intern(I, names[i], 1), v))
+        if (lang_field_value(I, field_coord(i), &v) || env_define(I, root, intern(I, names[i], 1), v))
             return -1;
     }
     return builtins_register(I, field_builtins, (int)(sizeof field_builtins / sizeof field_builtins[0]));

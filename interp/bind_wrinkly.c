@@ -751,8 +751,11 @@ static void curve_bounds(const curve_obj *c, double lo[2], double hi[2])
         }
         hm = fabs(c->pts[i].h) > hm ? fabs(c->pts[i].h) : hm;
     }
+    double seg = 0; /* an open curve runs on beyond its end points */
+    for (int i = 0; i + 1 < c->n; i++)
+        seg = fmax(seg, hypot(c->pts[i + 1].pos[0] - c->pts[i].pos[0], c->pts[i + 1].pos[1] - c->pts[i].pos[1]));
     double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
-    double pad = hm + 0.05 * (ext > 0 ? ext : 1) + (ext > 0 ? 0 : 0.5);
+    double pad = hm + (c->ax.cyclic ? 0 : 0.5 * seg) + 0.05 * (ext > 0 ? ext : 1) + (ext > 0 ? 0 : 0.5);
     for (int d = 0; d < 2; d++) {
         lo[d] -= pad;
         hi[d] += pad;
@@ -849,3 +852,611 @@ static int polyline_shape(interp *I, const wrinkly_polyline *pl, int closed, det
     return 0;
 }
 
+/* wrinkly_draw(curve, size, bounds, width, colour, fill, background, onto, pixel, iterations, kmax) */
+static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "wrinkly_draw";
+    const curve_obj *c = AS_OBJ(a[0])->payload;
+    int w, h;
+    image *onto = a[7].k == V_NIL ? NULL : lang_as_image(a[7]);
+    if (onto) {
+        w = onto->w;
+        h = onto->h;
+    } else if (get_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
+        return -1;
+    }
+    draw_view v;
+    if (get_view(I, c, a[2], w, h, &v, W))
+        return -1;
+    if (!(a[3].u.n >= 0 && a[3].u.n <= 1000))
+        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: width must be between 0 and 1000 pixels, got %g", a[3].u.n);
+    if (!(a[8].u.n > 0))
+        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: pixel must be a positive number of pixels, got %g", a[8].u.n);
+    float stroke[4] = {1, 1, 1, 1}, fill[4] = {1, 1, 1, 1}, bg[4];
+    if ((a[4].k != V_NIL && lang_get_colour(I, a[4], stroke, "wrinkly_draw: colour")) ||
+        (a[5].k != V_NIL && lang_get_colour(I, a[5], fill, "wrinkly_draw: fill")) ||
+        lang_get_colour(I, a[6], bg, "wrinkly_draw: background"))
+        return -1;
+    if (a[5].k != V_NIL && !c->ax.cyclic)
+        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: fill needs a closed curve (wrinkly_curve(…, closed: true))");
+    lod l;
+    value tol = a[9].k == V_NIL ? val_num(a[8].u.n / v.sx) : val_nil();
+    if (get_lod(I, a[9], tol, a[10], &l, W))
+        return -1;
+    image *im;
+    if (lang_image_new(I, w, h, &im))
+        return -1;
+    rt_error e;
+    if (onto) {
+        memcpy(im->px, onto->px, sizeof(float) * 4 * (size_t)w * (size_t)h);
+    } else {
+        draw_clear(im, bg);
+    }
+    wrinkly_polyline pl;
+    if (curve_sample(I, c, &l, &pl, W)) {
+        image_free(im);
+        free(im);
+        return -1;
+    }
+    detiter_shape s;
+    int rc = polyline_shape(I, &pl, pl.closed, &s);
+    if (!rc && a[5].k != V_NIL) {
+        draw_style st = {{fill[0], fill[1], fill[2], fill[3]}, 0, 0, 1};
+        if (draw_shape(im, &v, &s, &st, &e))
+            rc = lang_rt_error(I, e.code, &e, W);
+    }
+    if (!rc && a[3].u.n > 0) {
+        if (a[4].k == V_NIL) {
+            rc = stroke_coloured(I, im, &v, &pl, a[3].u.n);
+        } else {
+            draw_style st = {{stroke[0], stroke[1], stroke[2], stroke[3]}, a[3].u.n, a[3].u.n / 2, 0};
+            if (draw_shape(im, &v, &s, &st, &e))
+                rc = lang_rt_error(I, e.code, &e, W);
+        }
+    }
+    if (!rc || s.v)
+        detiter_shape_free(&s);
+    wrinkly_polyline_free(&pl);
+    if (rc) {
+        image_free(im);
+        free(im);
+        return -1;
+    }
+    return lang_image_value(I, im, out);
+}
+
+/* save(curve, "x.svg", {size: 512, width: 1.5, iterations: K}) */
+static int curve_save(interp *I, const void *p, const char *path, value opts)
+{
+    const curve_obj *c = p;
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    if (strcmp(ext, "svg") != 0)
+        return err_at(I, NULL, ERR_VALUE,
+                      "save: a wrinkly curve is saved as .svg (draw it with wrinkly_draw for a picture), got '.%s'", ext);
+    double size = 512, width = 1.5, iters = -1;
+    if (opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
+        opt_num(I, opts, "iterations", &iters) < 0)
+        return -1;
+    if (!(size >= 1 && size <= 1e6) || size != floor(size))
+        return err_at(I, NULL, ERR_VALUE, "save: size must be a whole number of pixels between 1 and 1000000, got %g", size);
+    if (!(width > 0 && width <= 1000))
+        return err_at(I, NULL, ERR_VALUE, "save: width must be between 0 and 1000 pixels, got %g", width);
+    draw_view v;
+    if (get_view(I, c, val_nil(), (int)size, (int)size, &v, "save"))
+        return -1;
+    lod l;
+    if (get_lod(I, iters >= 0 ? val_num(iters) : val_nil(), iters >= 0 ? val_nil() : val_num(1 / v.sx), val_num(8),
+                &l, "save"))
+        return -1;
+    wrinkly_polyline pl;
+    if (curve_sample(I, c, &l, &pl, "save"))
+        return -1;
+    detiter_shape s;
+    if (polyline_shape(I, &pl, pl.closed, &s)) {
+        wrinkly_polyline_free(&pl);
+        return -1;
+    }
+    wrinkly_polyline_free(&pl);
+    draw_style st = {{0, 0, 0, 1}, width, width / 2, 0};
+    bytebuf b;
+    bytebuf_init(&b);
+    rt_error e;
+    rt_code rc = draw_svg(&b, &v, &s, &st, NULL, 3, &e);
+    detiter_shape_free(&s);
+    if (!rc)
+        rc = b.failed ? rt_fail(&e, RT_ENOMEM, "out of memory writing SVG") : fileio_write_atomic(path, b.data, b.len, &e);
+    bytebuf_free(&b);
+    if (rc)
+        return err_at(I, NULL, rc == RT_EIO ? ERR_IO : rc == RT_ENOMEM ? ERR_MEMORY : ERR_VALUE, "save: %s", e.msg);
+    return 0;
+}
+
+/* ---- surfaces ------------------------------------------------------------------------ */
+
+typedef struct surf_obj {
+    wrinkly_point *pts;
+    int nu, nv;
+    wrinkly_axis au, av;
+    wrinkly_opts style;
+} surf_obj;
+
+static void surf_destroy(void *p)
+{
+    surf_obj *s = p;
+    free(s->pts);
+    free(s);
+}
+
+static void axis_summary(const wrinkly_axis *a, bytebuf *out)
+{
+    bytebuf_printf(out, "%s, M = %d, %s", a->cyclic ? "cyclic" : "open", a->m, a->ist ? "IST" : "spline");
+}
+
+static void surf_summary(const void *p, bytebuf *out)
+{
+    const surf_obj *s = p;
+    bytebuf_printf(out, "wrinkly surface: %d×%d control points; u: ", s->nu, s->nv);
+    axis_summary(&s->au, out);
+    bytebuf_printf(out, "; v: ");
+    axis_summary(&s->av, out);
+    style_summary(&s->style, out);
+}
+
+static int surf_get(interp *I, const void *p, const char *name, value *out)
+{
+    const surf_obj *s = p;
+    (void)I;
+    if (strcmp(name, "nu") == 0)
+        *out = val_num(s->nu);
+    else if (strcmp(name, "nv") == 0)
+        *out = val_num(s->nv);
+    else
+        return 1;
+    return 0;
+}
+
+static const obj_class surf_class = {
+    .name = "wrinkly_surface",
+    .destroy = surf_destroy,
+    .summary = surf_summary,
+    .get = surf_get,
+};
+
+/* An axis record {cyclic: false, crossings: 1, ist: true}. */
+static int get_axis(interp *I, value v, wrinkly_axis *ax, const char *what, const char *name)
+{
+    ax->cyclic = 0;
+    ax->m = 1;
+    ax->ist = 1;
+    if (v.k == V_NIL)
+        return 0;
+    vrec *r = AS_REC(v);
+    for (size_t i = 0; i < r->n; i++) {
+        const char *k = r->keys[i];
+        value x = r->vals[i];
+        if (strcmp(k, "cyclic") == 0 || strcmp(k, "ist") == 0) {
+            if (x.k != V_BOOL)
+                return err_at(I, NULL, ERR_TYPE, "%s: %s.%s must be true or false, got %s", what, name, k,
+                              val_type_name(x));
+            if (k[0] == 'c')
+                ax->cyclic = x.u.b;
+            else
+                ax->ist = x.u.b;
+        } else if (strcmp(k, "crossings") == 0) {
+            long m;
+            char w[96];
+            snprintf(w, sizeof w, "%s: %s.crossings", what, name);
+            if (get_int(I, x, 0, MAX_M, &m, w))
+                return -1;
+            ax->m = (int)m;
+        } else {
+            return err_at(I, NULL, ERR_VALUE, "%s: %s has no option '%s' (expected cyclic, crossings, ist)", what,
+                          name, k);
+        }
+    }
+    return 0;
+}
+
+/* wrinkly_surface(control, heights, colours, opacity, u, v, shuffle, tension, crack_band, jitter, extra, seed) */
+static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "wrinkly_surface";
+    vlist *rows = AS_LIST(a[0]);
+    if (rows->n < 1 || rows->n > MAX_CONTROL || rows->items[0].k != V_LIST || AS_LIST(rows->items[0])->n < 1)
+        return err_at(I, NULL, ERR_VALUE,
+                      "wrinkly_surface: control must be a grid: a list of rows, each a list of points [x, y, z]");
+    size_t nu = AS_LIST(rows->items[0])->n, nv = rows->n;
+    if (nu > MAX_CONTROL || (double)nu * (double)nv > 1e7)
+        return err_at(I, NULL, ERR_LIMIT, "wrinkly_surface: %zu×%zu control points are too many (at most 10000000)", nu,
+                      nv);
+    surf_obj *s = calloc(1, sizeof *s);
+    if (s)
+        s->pts = calloc(nu * nv, sizeof *s->pts);
+    if (!s || !s->pts) {
+        free(s);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    }
+    s->nu = (int)nu;
+    s->nv = (int)nv;
+    for (size_t j = 0; j < nv; j++) {
+        value row = rows->items[j];
+        if (row.k != V_LIST || AS_LIST(row)->n != nu) {
+            err_at(I, NULL, ERR_VALUE, "wrinkly_surface: control row %zu has %zu points, but row 0 has %zu (every row needs the same number)",
+                   j, row.k == V_LIST ? AS_LIST(row)->n : 0, nu);
+            goto fail;
+        }
+        for (size_t i = 0; i < nu; i++) {
+            char w[96];
+            snprintf(w, sizeof w, "wrinkly_surface: control point [%zu][%zu]", j, i);
+            double *p = s->pts[j * nu + i].pos;
+            if (get_vec(I, AS_LIST(row)->items[i], p, 3, w))
+                goto fail;
+            if (!isfinite(p[0] + p[1] + p[2])) {
+                err_at(I, NULL, ERR_VALUE, "%s is not finite", w);
+                goto fail;
+            }
+        }
+    }
+    if (fill_scalar(I, a[1], s->nv, s->nu, s->pts, 0, W, "heights") ||
+        fill_colours(I, a[2], s->nv, s->nu, s->pts, W) || fill_scalar(I, a[3], s->nv, s->nu, s->pts, 4, W, "opacity") ||
+        get_axis(I, a[4], &s->au, W, "u") || get_axis(I, a[5], &s->av, W, "v") ||
+        get_style(I, a[7], a[6], a[8], a[9], a[10], a[11], &s->style, W))
+        goto fail;
+    *out = val_obj(I, &surf_class, s);
+    return out->k == V_NIL ? -1 : 0;
+fail:
+    surf_destroy(s);
+    return -1;
+}
+
+static surf_obj *as_surf(value v)
+{
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &surf_class ? AS_OBJ(v)->payload : NULL;
+}
+
+/* Tessellate after checking the vertex count (--max-points) and the memory
+ * the engine needs (--max-memory). cam may be NULL. */
+static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
+                     mesh **out, const char *what)
+{
+    wrinkly_surface ws = {so->pts, so->nu, so->nv, so->au, so->av};
+    wrinkly_opts o = so->style;
+    o.cam = cam;
+    o.width = w;
+    o.height = h;
+    o.pixel = pixel;
+    o.tol = l->tol;
+    o.k = l->k;
+    o.kmax = l->kmax;
+    int *ku = malloc(sizeof(int) * (size_t)so->nu), *kv = malloc(sizeof(int) * (size_t)so->nv);
+    if (!ku || !kv) {
+        free(ku);
+        free(kv);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    }
+    wrinkly_surface_levels(&ws, &o, ku, kv);
+    double cu = so->au.cyclic ? 0 : 2, cv = so->av.cyclic ? 0 : 2;
+    for (int i = 0; i < so->nu; i++)
+        cu += pow(2.0 * so->au.m + 1, ku[i]);
+    for (int j = 0; j < so->nv; j++)
+        cv += pow(2.0 * so->av.m + 1, kv[j]);
+    free(ku);
+    free(kv);
+    double nvert = cu * cv;
+    if (nvert > I->lim.max_points || nvert >= 4294967295.0)
+        return err_at(I, NULL, ERR_LIMIT,
+                      "%s: the surface would have %.0f × %.0f = %.0f vertices, more than the limit of %.0f points (raise it with --max-points, or lower iterations/kmax)",
+                      what, cu, cv, nvert, fmin(I->lim.max_points, 4294967294.0));
+    /* positions, normals, colours (floats), the displaced grid (doubles),
+     * two triangles per vertex */
+    double bytes = nvert * (12 + 12 + 16 + 24 + 24);
+    if (mem_reserve(I, bytes, "the wrinkly mesh"))
+        return -1;
+    mesh *m = malloc(sizeof *m);
+    if (!m) {
+        mem_release(I, (size_t)bytes);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    }
+    rt_run run = lang_run(I);
+    rt_error e;
+    rt_code rc = wrinkly_surface_mesh(&ws, &o, &run, m, NULL, &e);
+    mem_release(I, (size_t)bytes);
+    if (rc) {
+        mesh_free(m);
+        free(m);
+        return lang_rt_error(I, rc, &e, what);
+    }
+    *out = m;
+    return 0;
+}
+
+static int get_camera_lod(interp *I, value cam, value tol, value iters, camera *c, int *use_cam, const char *what)
+{
+    *use_cam = cam.k != V_NIL;
+    if (!*use_cam)
+        return 0;
+    if (tol.k != V_NIL || iters.k != V_NIL)
+        return err_at(I, NULL, ERR_VALUE,
+                      "%s: with a camera the level of detail follows the pixels; drop tolerance and iterations (or the camera)",
+                      what);
+    return lang_get_camera(I, cam, c, what);
+}
+
+/* tessellate(surface, camera, size, pixel, tolerance, iterations, kmax) */
+static int b_tessellate(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "tessellate";
+    const surf_obj *so = AS_OBJ(a[0])->payload;
+    camera cam;
+    int use_cam, w = 256, h = 256;
+    lod l;
+    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || get_size2(I, a[2], &w, &h, "tessellate: size") ||
+        get_lod(I, a[5], a[4], a[6], &l, W))
+        return -1;
+    if (!(a[3].u.n > 0))
+        return err_at(I, NULL, ERR_VALUE, "tessellate: pixel must be a positive number of pixels, got %g", a[3].u.n);
+    mesh *m;
+    if (surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, &m, W))
+        return -1;
+    return lang_mesh_value(I, m, out);
+}
+
+/* ---- rasterising ------------------------------------------------------------------- */
+
+/* Bounding box of a scene item: a mesh's vertices, or a surface's control
+ * points widened by the largest |height|. */
+static void item_box(value v, double lo[3], double hi[3])
+{
+    mesh *m = lang_as_mesh(v);
+    surf_obj *s = as_surf(v);
+    if (m) {
+        for (size_t i = 0; i < m->nv; i++)
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fmin(lo[d], m->pos[3 * i + d]);
+                hi[d] = fmax(hi[d], m->pos[3 * i + d]);
+            }
+    } else if (s) {
+        double hm = 0;
+        for (size_t i = 0; i < (size_t)s->nu * (size_t)s->nv; i++) {
+            hm = fmax(hm, fabs(s->pts[i].h));
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fmin(lo[d], s->pts[i].pos[d] - hm);
+                hi[d] = fmax(hi[d], s->pts[i].pos[d] + hm);
+            }
+        }
+        for (int d = 0; d < 3; d++) {
+            lo[d] -= hm;
+            hi[d] += hm;
+        }
+    }
+}
+
+/* Append src to dst (with fallback colour for meshes without colours). */
+static void mesh_append(mesh *dst, const mesh *src, const float colour[4])
+{
+    uint32_t base = (uint32_t)dst->nv;
+    static const float up[3] = {0, 1, 0};
+    for (size_t i = 0; i < src->nv; i++)
+        mesh_add_vertex(dst, src->pos + 3 * i, src->nrm ? src->nrm + 3 * i : up, src->col ? src->col + 4 * i : colour);
+    for (size_t t = 0; t < src->nt; t++)
+        mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
+}
+
+/* rasterize(scene, camera, size, background, light, ambient, diffuse, flat, unlit, colour, pixel, kmax) */
+static int b_rasterize(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "rasterize";
+    value scene = a[0];
+    size_t nitems = scene.k == V_LIST ? AS_LIST(scene)->n : 1;
+    if (nitems == 0)
+        return err_at(I, NULL, ERR_VALUE, "rasterize: the scene list is empty");
+    for (size_t i = 0; i < nitems; i++) {
+        value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
+        if (!lang_as_mesh(it) && !as_surf(it))
+            return err_at(I, NULL, ERR_TYPE,
+                          "rasterize: the scene must be a mesh, a wrinkly_surface or a list of them, but item %zu is %s",
+                          i, val_type_name(it));
+    }
+    int w, h;
+    if (get_size2(I, a[2], &w, &h, "rasterize: size"))
+        return -1;
+    raster_opts ro;
+    raster_opts_default(&ro);
+    if (lang_get_colour(I, a[3], ro.background, "rasterize: background") ||
+        lang_get_colour(I, a[9], ro.colour, "rasterize: colour"))
+        return -1;
+    if (a[4].k != V_NIL) {
+        if (get_vec(I, a[4], ro.light, 3, "rasterize: light"))
+            return -1;
+        if (ro.light[0] == 0 && ro.light[1] == 0 && ro.light[2] == 0)
+            return err_at(I, NULL, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
+    }
+    if (!(a[5].u.n >= 0) || !(a[6].u.n >= 0))
+        return err_at(I, NULL, ERR_VALUE, "rasterize: ambient and diffuse must be >= 0, got %g and %g", a[5].u.n,
+                      a[6].u.n);
+    ro.ambient = a[5].u.n;
+    ro.diffuse = a[6].u.n;
+    ro.flat = a[7].u.b;
+    ro.unlit = a[8].u.b;
+    if (!(a[10].u.n > 0))
+        return err_at(I, NULL, ERR_VALUE, "rasterize: pixel must be a positive number of pixels, got %g", a[10].u.n);
+    lod l;
+    if (get_lod(I, val_nil(), val_nil(), a[11], &l, W))
+        return -1;
+    camera cam;
+    if (a[1].k != V_NIL) {
+        if (lang_get_camera(I, a[1], &cam, W))
+            return -1;
+    } else {
+        /* frame the scene: orbit(30, 20) around the centre of its box */
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
+        for (size_t i = 0; i < nitems; i++)
+            item_box(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene, lo, hi);
+        double r = 0;
+        for (int d = 0; d < 3; d++) {
+            if (!(hi[d] >= lo[d]))
+                lo[d] = hi[d] = 0;
+            c[d] = 0.5 * (lo[d] + hi[d]);
+            r += 0.25 * (hi[d] - lo[d]) * (hi[d] - lo[d]);
+        }
+        r = sqrt(r);
+        double fov = 40, half = 0.5 * fov * 3.14159265358979323846 / 180;
+        if (w < h)
+            half = atan(tan(half) * w / h);
+        camera_orbit(&cam, c, r > 0 ? 1.05 * r / sin(half) : 1, 30, 20, fov);
+        if (camera_setup(&cam))
+            return err_at(I, NULL, ERR_VALUE, "rasterize: cannot frame the scene");
+    }
+    /* one mesh to draw: a mesh as given, or the tessellations (LOD from this
+     * camera) and meshes merged in order */
+    mesh *single = nitems == 1 ? lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[0] : scene) : NULL;
+    mesh *merged = NULL;
+    int rc = -1;
+    image *im = NULL;
+    if (!single) {
+        int normals = 1;
+        double tv = 0;
+        for (size_t i = 0; i < nitems; i++) {
+            mesh *m = lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene);
+            if (m && !m->nrm && m->nt)
+                normals = 0;
+            tv += m ? (double)m->nv : 0;
+        }
+        merged = malloc(sizeof *merged);
+        if (!merged)
+            return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        mesh_init(merged, normals, 1);
+        for (size_t i = 0; i < nitems; i++) {
+            value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
+            mesh *m = lang_as_mesh(it), *t = NULL;
+            if (!m) {
+                if (surf_mesh(I, as_surf(it), &cam, w, h, a[10].u.n, &l, &t, W))
+                    goto done;
+                m = t;
+            }
+            tv += t ? (double)t->nv : 0;
+            if (tv >= 4294967295.0 || tv > I->lim.max_points) {
+                if (t) {
+                    mesh_free(t);
+                    free(t);
+                }
+                err_at(I, NULL, ERR_LIMIT,
+                       "rasterize: the scene has more than %.0f vertices (raise it with --max-points)",
+                       fmin(I->lim.max_points, 4294967294.0));
+                goto done;
+            }
+            mesh_append(merged, m, ro.colour);
+            if (t) {
+                mesh_free(t);
+                free(t);
+            }
+            if (merged->failed) {
+                err_at(I, NULL, ERR_MEMORY, "out of memory merging the scene");
+                goto done;
+            }
+        }
+        single = merged;
+    }
+    if (lang_image_new(I, w, h, &im))
+        goto done;
+    rt_run run = lang_run(I);
+    rt_error e;
+    rt_code c = raster_render(single, &cam, &ro, &run, im, &e);
+    if (c) {
+        lang_rt_error(I, c, &e, W);
+        goto done;
+    }
+    rc = lang_image_value(I, im, out);
+    im = NULL;
+done:
+    if (im) {
+        image_free(im);
+        free(im);
+    }
+    if (merged) {
+        mesh_free(merged);
+        free(merged);
+    }
+    return rc;
+}
+
+/* ---- registration -------------------------------------------------------------------- */
+
+static const bparam p_ist[] = {{"intervals", "int", "nil"}, {"crossings", "int|vec", "1"},
+                               {"iterations", "int", "2"},  {"cyclic", "bool", "false"},
+                               {"bounds", "vec", "nil"},    {"method", "str", "\"auto\""}};
+static const bparam p_ist_map[] = {{"ist", "ist", NULL}, {"u", "num|vec", NULL}};
+static const bparam p_ist_one[] = {{"ist", "ist", NULL}};
+static const bparam p_ist_samples[] = {{"ist", "ist", NULL}, {"levels", "int|vec", "nil"},
+                                       {"jitter", "bool", "false"}, {"seed", "num", "nil"}};
+static const bparam p_curve[] = {{"points", "list", NULL},      {"heights", "num|vec", "0"},
+                                 {"colours", "any", "nil"},     {"opacity", "num|vec", "1"},
+                                 {"crossings", "int", "1"},     {"closed", "bool", "false"},
+                                 {"ist", "bool", "true"},       {"shuffle", "str|list", "nil"},
+                                 {"tension", "num", "2/3"},     {"crack_band", "num", "0"},
+                                 {"jitter", "bool", "false"},   {"extra", "int", "0"},
+                                 {"seed", "num", "nil"}};
+static const bparam p_points[] = {{"curve", "wrinkly_curve", NULL}, {"iterations", "int", "nil"},
+                                  {"tolerance", "num", "nil"}, {"kmax", "int", "8"}};
+static const bparam p_draw[] = {{"curve", "wrinkly_curve", NULL}, {"size", "vec|num", "[256, 256]"},
+                                {"bounds", "list", "nil"},        {"width", "num", "1.5"},
+                                {"colour", "any", "nil"},         {"fill", "any", "nil"},
+                                {"background", "any", "0"},       {"onto", "image", "nil"},
+                                {"pixel", "num", "1"},            {"iterations", "int", "nil"},
+                                {"kmax", "int", "8"}};
+static const bparam p_surface[] = {{"control", "list", NULL},     {"heights", "num|list", "0"},
+                                   {"colours", "any", "nil"},     {"opacity", "num|list", "1"},
+                                   {"u", "rec", "nil"},           {"v", "rec", "nil"},
+                                   {"shuffle", "str|list", "nil"}, {"tension", "num", "2/3"},
+                                   {"crack_band", "num", "0"},    {"jitter", "bool", "false"},
+                                   {"extra", "int", "0"},         {"seed", "num", "nil"}};
+static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera", "rec", "nil"},
+                                {"size", "vec|num", "[256, 256]"},    {"pixel", "num", "1"},
+                                {"tolerance", "num", "nil"},          {"iterations", "int", "nil"},
+                                {"kmax", "int", "8"}};
+static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
+                                  {"camera", "rec", "nil"},
+                                  {"size", "vec|num", "[256, 256]"},
+                                  {"background", "any", "0"},
+                                  {"light", "vec", "nil"},
+                                  {"ambient", "num", "0.2"},
+                                  {"diffuse", "num", "0.8"},
+                                  {"flat", "bool", "false"},
+                                  {"unlit", "bool", "false"},
+                                  {"colour", "any", "1"},
+                                  {"pixel", "num", "1"},
+                                  {"kmax", "int", "8"}};
+
+static const builtin wrinkly_builtins[] = {
+    BUILTIN("ist", b_ist, p_ist,
+            "An Iterated Shuffle Transformation (seed 002 §4.1): N base intervals (default 5, or the N + 1 `bounds`), crossing count M (`crossings`, one number or one per interval), K = `iterations`, on a translation or `cyclic` axis. method: \"auto\", \"lists\" or \"closed\"."),
+    BUILTIN("ist_inv", b_ist_inv, p_ist_map,
+            "F^{-1}(u) of an ist: the source coordinate whose attributes appear at u (eq. 9); u a number or a list of numbers."),
+    BUILTIN("ist_fwd", b_ist_fwd, p_ist_map, "F(u) of an ist: where the source coordinate u is moved to (eq. 6)."),
+    BUILTIN("ist_lists", b_ist_lists, p_ist_one,
+            "The lists L_i^K of an ist in the notation of the paper's Fig. 2, one line per base interval (\"L5: 322 412 502 | …\"); K <= 9."),
+    BUILTIN("ist_samples", b_ist_samples, p_ist_samples,
+            "The adaptive sample positions of §5.2: in each base interval the (2M+1)^levels chosen sub-intervals' centres (or a seeded random point with jitter); levels one number or one per interval, default K."),
+    BUILTIN("wrinkly_curve", b_wrinkly_curve, p_curve,
+            "A wrinkly curve (eq. 10) through 2-D control points with heights, colours and opacity; crossings M, closed (cyclic), ist: false for the plain spline; shuffle names the attributes the IST moves; crack_band, jitter, extra, seed control the sampling."),
+    BUILTIN("wrinkly_points", b_wrinkly_points, p_points,
+            "Sample a wrinkly curve into a list of [x, y] points: fixed `iterations` (default 3) or adaptive to `tolerance` (world length of a sub-interval), K capped by kmax."),
+    BUILTIN("wrinkly_draw", b_wrinkly_draw, p_draw,
+            "Draw a wrinkly curve antialiased into an image (or over `onto`): sub-intervals adapt to `pixel` pixels unless `iterations` is given; colour nil uses the curve's own colours; fill a closed curve."),
+    BUILTIN("wrinkly_surface", b_wrinkly_surface, p_surface,
+            "A wrinkly surface (eq. 11) over a grid of control points [x, y, z] (a list of rows): heights, colours, opacity per point (or one value); u and v are records {cyclic, crossings, ist}."),
+    BUILTIN("tessellate", b_tessellate, p_tess,
+            "Sample a wrinkly surface into a coloured mesh (§5.2): with a camera, sub-intervals project to at most `pixel` pixels of an image of `size`; else `tolerance` (world length) or fixed `iterations` (default 3)."),
+    BUILTIN("rasterize", b_rasterize, p_raster,
+            "Render a mesh, a wrinkly surface or a list of them with a Z-buffer into an image: camera (default: framing the scene), lights, background; surfaces are tessellated for this camera."),
+};
+
+int bind_wrinkly_init(interp *I)
+{
+    return builtins_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
+}

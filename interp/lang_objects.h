@@ -27,6 +27,20 @@ mesh *lang_as_mesh(value v);
  * rows [t, r, g, b] / [t, r, g, b, a]; nil gives grey. */
 int lang_get_ramp(interp *I, value v, ramp *out, const char *what);
 
+/* Fields (bind_field.c). lang_field_value wraps a new node (consumes it);
+ * lang_to_field gives a new reference to the node of a field, number or
+ * volume value (NULL after an error); lang_field_fn compiles a value into
+ * a program usable as rt_field_fn (field_prog_fn, ctx = *prog), with
+ * lang_field_fn_done(tmp, own) to release what it made. */
+struct field;
+struct field_prog;
+extern const obj_class field_class;
+int lang_field_value(interp *I, struct field *f, value *out);
+struct field *lang_to_field(interp *I, value v, const char *what);
+int lang_field_fn(interp *I, value v, struct field **tmp, struct field_prog **own,
+                  const struct field_prog **prog, const char *what);
+void lang_field_fn_done(struct field *tmp, struct field_prog *own);
+
 /* Read an optional number/int/bool field of an options record: 1 found,
  * 0 absent, -1 error. */
 int opt_num(interp *I, value rec, const char *key, double *out);
