@@ -1,0 +1,25 @@
+/* lang_ifs.h — IFS values shared by the IFS bindings (bind_ifs.c and the
+ * function-set / fractal-top / super-IFS bindings). */
+#ifndef LANG_IFS_H
+#define LANG_IFS_H
+
+#include "affine.h"
+#include "chaos.h"
+#include "ifs.h"
+#include "state.h"
+
+typedef struct lang_ifs {
+    ifs f;
+} lang_ifs;
+
+extern const obj_class ifs_class, rifs_class, map_class;
+
+const lang_ifs *lang_as_ifs(value v);
+/* The system behind an ifs or rifs value. */
+int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what);
+/* Maps (and probabilities) from a table of rows, a list of maps or an ifs:
+ * malloc'd arrays; returns 1 if probabilities were given, 0 if not, -1 on
+ * error. */
+int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const char *what);
+
+#endif

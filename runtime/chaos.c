@@ -1,0 +1,902 @@
+/* chaos.c — the chaos game (random iteration algorithm) for IFS and RIFS
+ * (seed 003 §2; RIFS: seed 001 §2, measure μ(B) ≈ N(B,n)/(n+1): seed 001 §5).
+ *
+ * The hot loops are specialised by hand-written inline templates: the system
+ * kind (IFS / RIFS order 1 / order 2) and colour mode are compile-time
+ * constants in each instantiation, maps are plain arrays of 6 (2-D) or 12
+ * (3-D) doubles, and the map choice is an alias-table lookup (ifs.h). */
+#include "chaos.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "par.h"
+#include "rng.h"
+
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#define PREFETCHW(p) __builtin_prefetch((p), 1, 0)
+#else
+#define INLINE static inline
+#define PREFETCHW(p) ((void)(p))
+#endif
+
+enum { KIND_IFS, KIND_R1, KIND_R2 };
+
+/* Everything a chunk needs, flattened for the inner loop. */
+typedef struct sysdata {
+    int n, dim, kind;
+    uint32_t *thr; /* rows * n */
+    uint32_t *sel; /* rows * n * 2, map indices 0 .. n-1 */
+    double *m;     /* n * 6 (2-D: a b e c d f) or n * 12 (3-D: row-major M | t) */
+    uint32_t start_state, start_map;
+    double x0[3];
+    double *mc;                      /* n colour coordinates */
+    uint32_t pal[CHAOS_PALETTE][3];  /* ramp, 16-bit fixed point */
+    float palf[CHAOS_PALETTE][4];    /* ramp, float */
+} sysdata;
+
+static void sys_free(sysdata *d)
+{
+    free(d->thr);
+    free(d->sel);
+    free(d->m);
+    free(d->mc);
+    free(d);
+}
+
+static void fixed_point(const affine *a, double out[3])
+{
+    /* (I - A) x = t */
+    affine b = *a, inv;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            b.m[i][j] = (i == j ? 1.0 : 0.0) - a->m[i][j];
+    if (a->dim == 2) {
+        b.m[2][2] = 1;
+        b.m[0][2] = b.m[1][2] = b.m[2][0] = b.m[2][1] = 0;
+    }
+    for (int i = 0; i < 3; i++)
+        b.t[i] = 0;
+    out[0] = out[1] = out[2] = 0;
+    if (affine_invert(&b, &inv) == 0) {
+        double t[3] = {a->t[0], a->t[1], a->dim == 3 ? a->t[2] : 0};
+        affine_apply(&inv, t, out);
+        for (int i = 0; i < 3; i++)
+            if (!isfinite(out[i]))
+                out[i] = 0;
+    }
+}
+
+static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, rt_error *e)
+{
+    const affine *maps;
+    int n, dim, rows;
+    if ((s->ifs != NULL) == (s->rifs != NULL)) {
+        rt_fail(e, RT_EINVAL, "chaos game needs exactly one IFS or RIFS");
+        return NULL;
+    }
+    if (s->ifs) {
+        maps = s->ifs->maps, n = s->ifs->n, dim = s->ifs->dim, rows = 1;
+    } else {
+        maps = s->rifs->maps, n = s->rifs->n, dim = s->rifs->dim, rows = s->rifs->rows;
+    }
+    if (n < 1 || !maps) {
+        rt_fail(e, RT_EINVAL, "IFS has no maps");
+        return NULL;
+    }
+    if (want_dim && dim != want_dim) {
+        rt_fail(e, RT_EINVAL, "this needs %d-D maps, but the %s has %d-D maps", want_dim,
+                s->ifs ? "IFS" : "RIFS", dim);
+        return NULL;
+    }
+    if (o->map_c)
+        for (int k = 0; k < n; k++)
+            if (!(o->map_c[k] >= 0 && o->map_c[k] <= 1)) {
+                rt_fail(e, RT_EINVAL, "colour %d is %.6g (expected 0 .. 1)", k + 1, o->map_c[k]);
+                return NULL;
+            }
+    sysdata *d = calloc(1, sizeof *d);
+    if (!d) {
+        rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        return NULL;
+    }
+    d->n = n;
+    d->dim = dim;
+    size_t cols = (size_t)rows * (size_t)n;
+    d->thr = calloc(cols, sizeof *d->thr);
+    d->sel = calloc(cols * 2, sizeof *d->sel);
+    d->m = calloc((size_t)n * 12, sizeof *d->m);
+    d->mc = calloc((size_t)n, sizeof *d->mc);
+    if (!d->thr || !d->sel || !d->m || !d->mc) {
+        sys_free(d);
+        rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        return NULL;
+    }
+    for (int r = 0; r < rows; r++) {
+        const ifs_alias *a = s->ifs ? &s->ifs->alias : &s->rifs->row[r];
+        if (a->n != n) /* unused order-2 row: never visited */
+            continue;
+        memcpy(d->thr + (size_t)r * n, a->thresh, sizeof *d->thr * (size_t)n);
+        memcpy(d->sel + (size_t)r * n * 2, a->sel, sizeof *d->sel * 2 * (size_t)n);
+    }
+    for (int k = 0; k < n; k++) {
+        const affine *a = &maps[k];
+        double *m = d->m + (size_t)k * (dim == 2 ? 6 : 12);
+        if (dim == 2) {
+            m[0] = a->m[0][0], m[1] = a->m[0][1], m[2] = a->t[0];
+            m[3] = a->m[1][0], m[4] = a->m[1][1], m[5] = a->t[1];
+        } else {
+            for (int i = 0; i < 3; i++) {
+                m[4 * i] = a->m[i][0], m[4 * i + 1] = a->m[i][1], m[4 * i + 2] = a->m[i][2];
+                m[4 * i + 3] = a->t[i];
+            }
+        }
+        d->mc[k] = o->map_c ? o->map_c[k] : n > 1 ? (double)k / (n - 1) : 0;
+    }
+    if (s->ifs) {
+        d->kind = KIND_IFS;
+        d->start_state = 0;
+        d->start_map = 0;
+    } else if (s->rifs->order == 1) {
+        d->kind = KIND_R1;
+        d->start_state = d->start_map = (uint32_t)s->rifs->start;
+    } else {
+        d->kind = KIND_R2;
+        d->start_state = (uint32_t)s->rifs->start;
+        d->start_map = (uint32_t)(s->rifs->start % n);
+    }
+    fixed_point(&maps[d->start_map], d->x0);
+    ramp grey = ramp_grey();
+    const ramp *rp = o->ramp ? o->ramp : &grey;
+    for (int i = 0; i < CHAOS_PALETTE; i++) {
+        ramp_eval(rp, (double)i / (CHAOS_PALETTE - 1), d->palf[i]);
+        for (int ch = 0; ch < 3; ch++) {
+            double v = d->palf[i][ch];
+            v = v < 0 ? 0 : v > 1 ? 1 : v;
+            d->pal[i][ch] = (uint32_t)(v * 65535.0 + 0.5);
+        }
+    }
+    return d;
+}
+
+static uint32_t pal_index(double c)
+{
+    return (uint32_t)(c * (CHAOS_PALETTE - 1) + 0.5);
+}
+
+/* ---------- the orbit: state, choice, colour ---------- */
+
+typedef struct orbit {
+    rng r;
+    uint32_t s, cur;
+    double x, y, z, c;
+} orbit;
+
+static void orbit_start(orbit *ob, const sysdata *d, uint64_t seed, uint64_t chunk)
+{
+    rng_init(&ob->r, seed, chunk);
+    ob->s = d->start_state;
+    ob->cur = d->start_map;
+    ob->x = d->x0[0], ob->y = d->x0[1], ob->z = d->x0[2];
+    ob->c = d->mc[d->start_map];
+}
+
+/* Draw the next map (alias table of the current state's row). */
+INLINE uint32_t orbit_choose(orbit *ob, const sysdata *d, const int kind)
+{
+    uint64_t w = rng_next(&ob->r);
+    uint32_t n = (uint32_t)d->n;
+    uint32_t col = (uint32_t)(((w >> 32) * n) >> 32);
+    if (kind != KIND_IFS)
+        col += ob->s * n;
+    uint32_t k = d->sel[2 * col + ((uint32_t)w < d->thr[col])];
+    if (kind == KIND_R1)
+        ob->s = k;
+    else if (kind == KIND_R2)
+        ob->s = ob->cur * n + k;
+    ob->cur = k;
+    return k;
+}
+
+INLINE void orbit_step2(orbit *ob, const sysdata *d, const int kind)
+{
+    uint32_t k = orbit_choose(ob, d, kind);
+    const double *m = d->m + 6 * (size_t)k;
+    double nx = m[0] * ob->x + m[1] * ob->y + m[2];
+    double ny = m[3] * ob->x + m[4] * ob->y + m[5];
+    ob->x = nx, ob->y = ny;
+}
+
+INLINE void orbit_step3(orbit *ob, const sysdata *d, const int kind)
+{
+    uint32_t k = orbit_choose(ob, d, kind);
+    const double *m = d->m + 12 * (size_t)k;
+    double x = ob->x, y = ob->y, z = ob->z;
+    ob->x = m[0] * x + m[1] * y + m[2] * z + m[3];
+    ob->y = m[4] * x + m[5] * y + m[6] * z + m[7];
+    ob->z = m[8] * x + m[9] * y + m[10] * z + m[11];
+}
+
+/* Palette index of the current hit's colour. */
+INLINE uint32_t orbit_colour(orbit *ob, const sysdata *d, const int colour)
+{
+    if (colour == CHAOS_COLOUR_BLEND) {
+        ob->c = (ob->c + d->mc[ob->cur]) * 0.5; /* flam3's colour coordinate */
+        return pal_index(ob->c);
+    }
+    return pal_index(d->mc[ob->cur]);
+}
+
+/* ---------- common driver ---------- */
+
+typedef struct worker {
+    uint32_t *cnt;
+    uint64_t *carry; /* lazily allocated on the first 32-bit wrap */
+    double *zb;      /* projection: depth per pixel */
+    uint32_t *tag;   /* projection: palette index of the nearest point */
+    uint64_t inside, plotted;
+    int oom;
+} worker;
+
+typedef struct job {
+    const sysdata *d;
+    const chaos_opts *o;
+    uint64_t points, burn;
+    uint32_t chunk;
+    size_t nchunks;
+    worker *w;
+    size_t nbins; /* bins/voxels/pixels */
+    /* 2-D window */
+    int hw, hh;
+    double lox, hiy, sx, sy;
+    /* 3-D box */
+    int nx, ny, nz;
+    double lo3[3], s3[3];
+    /* point cloud */
+    float *pos, *col;
+    /* projection */
+    const camera *cam;
+    int iw, ih;
+} job;
+
+static void chunk_range(const job *j, size_t chunk, uint64_t *count)
+{
+    uint64_t first = (uint64_t)chunk * j->chunk;
+    uint64_t left = j->points - first;
+    *count = left < j->chunk ? left : j->chunk;
+}
+
+INLINE void bump(worker *w, uint32_t *cnt, size_t b, size_t nbins)
+{
+    if (!++cnt[b]) { /* exact carry on 32-bit wrap-around */
+        if (!w->carry)
+            w->carry = calloc(nbins + 1, sizeof *w->carry);
+        if (w->carry)
+            w->carry[b]++;
+        else
+            w->oom = 1;
+    }
+}
+
+/* ---------- 2-D histogram ---------- */
+
+#define RING 32 /* pending increments: prefetch this many points ahead */
+
+/* One coloured hit into cell b (b = nbins: the outside cell, ignored). */
+INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t b, uint32_t pc,
+                     size_t nbins)
+{
+    uint32_t *cell = cnt + 4 * b;
+    cell[1] += pal[pc][0];
+    cell[2] += pal[pc][1];
+    cell[3] += pal[pc][2];
+    if (!(++cell[0] & 0xffffu) && b < nbins) {
+        if (!w->carry)
+            w->carry = calloc(4 * nbins, sizeof *w->carry);
+        if (w->carry) {
+            for (int q = 0; q < 4; q++)
+                w->carry[4 * b + q] += cell[q];
+            cell[0] = cell[1] = cell[2] = cell[3] = 0;
+        } else {
+            w->oom = 1;
+        }
+    }
+}
+
+/* The 2-D loop keeps the orbit in locals and every pointer in a local: the
+ * build uses -fno-strict-aliasing, so a store into the counts would otherwise
+ * force the compiler to reload all of them after every hit. With colour a
+ * bin is 4 uint32 (count, r, g, b) in one 16-byte cell — one cache line per
+ * hit; after 65536 hits of a bin (at most 65535 per channel each, so no
+ * wrap) the cell is flushed into 64-bit side sums. */
+INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, const int colour)
+{
+    const sysdata *d = j->d;
+    worker *w = &j->w[wid];
+    uint64_t count;
+    chunk_range(j, chunk, &count);
+    orbit ob;
+    orbit_start(&ob, d, j->o->seed, chunk);
+    for (uint64_t i = 0; i < j->burn; i++) {
+        orbit_step2(&ob, d, kind);
+        if (colour == CHAOS_COLOUR_BLEND)
+            (void)orbit_colour(&ob, d, colour);
+    }
+    const double lox = j->lox, hiy = j->hiy, sx = j->sx, sy = j->sy;
+    const double fw = j->hw, fh = j->hh;
+    const size_t hw = (size_t)j->hw;
+    const uint32_t n = (uint32_t)d->n;
+    const uint32_t *const thr = d->thr, *const sel = d->sel;
+    const double *const M = d->m, *const mc = d->mc;
+    const uint32_t(*const pal)[3] = d->pal;
+    uint32_t *const cnt = w->cnt;
+    rng r = ob.r;
+    uint32_t st = ob.s, cur = ob.cur;
+    double x = ob.x, y = ob.y, c = ob.c;
+    uint64_t inside = 0;
+    size_t ring[RING];
+    uint32_t ringc[RING];
+    for (int q = 0; q < RING; q++)
+        ring[q] = j->nbins, ringc[q] = 0;
+    for (uint64_t i = 0; i < count; i++) {
+        uint64_t wd = rng_next(&r);
+        uint32_t col = (uint32_t)(((wd >> 32) * n) >> 32);
+        if (kind != KIND_IFS)
+            col += st * n;
+        uint32_t k = sel[2 * col + ((uint32_t)wd < thr[col])];
+        if (kind == KIND_R1)
+            st = k;
+        else if (kind == KIND_R2)
+            st = cur * n + k;
+        cur = k;
+        const double *m = M + 6 * (size_t)k;
+        double nx = m[0] * x + m[1] * y + m[2];
+        double ny = m[3] * x + m[4] * y + m[5];
+        x = nx, y = ny;
+        uint32_t pc = 0;
+        if (colour == CHAOS_COLOUR_BLEND) {
+            c = (c + mc[k]) * 0.5; /* flam3's colour coordinate */
+            pc = pal_index(c);
+        } else if (colour == CHAOS_COLOUR_LAST) {
+            pc = pal_index(mc[k]);
+        }
+        double fx = (x - lox) * sx, fy = (hiy - y) * sy;
+        if (colour == CHAOS_COLOUR_NONE) {
+            if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
+                bump(w, cnt, (size_t)(int)fy * hw + (size_t)(int)fx, j->nbins);
+                inside++;
+            }
+            continue;
+        }
+        /* colour: prefetch this hit's cell, add the hit RING points back
+         * (outside points go to the extra cell nbins) */
+        size_t b = j->nbins;
+        if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
+            b = (size_t)(int)fy * hw + (size_t)(int)fx;
+            inside++;
+        }
+        PREFETCHW(cnt + 4 * b);
+        size_t slot = (size_t)(i % RING);
+        add_cell(w, cnt, pal, ring[slot], ringc[slot], j->nbins);
+        ring[slot] = b;
+        ringc[slot] = pc;
+    }
+    if (colour != CHAOS_COLOUR_NONE)
+        for (int q = 0; q < RING; q++)
+            add_cell(w, cnt, pal, ring[q], ringc[q], j->nbins);
+    w->inside += inside;
+    w->plotted += count;
+}
+
+#define HIST_FN(name, kind, colour)                                                              \
+    static void name(void *ctx, size_t chunk, int wid)                                           \
+    {                                                                                            \
+        hist_chunk((const job *)ctx, chunk, wid, kind, colour);                                  \
+    }
+HIST_FN(hist_i0, KIND_IFS, CHAOS_COLOUR_NONE)
+HIST_FN(hist_i1, KIND_IFS, CHAOS_COLOUR_LAST)
+HIST_FN(hist_i2, KIND_IFS, CHAOS_COLOUR_BLEND)
+HIST_FN(hist_a0, KIND_R1, CHAOS_COLOUR_NONE)
+HIST_FN(hist_a1, KIND_R1, CHAOS_COLOUR_LAST)
+HIST_FN(hist_a2, KIND_R1, CHAOS_COLOUR_BLEND)
+HIST_FN(hist_b0, KIND_R2, CHAOS_COLOUR_NONE)
+HIST_FN(hist_b1, KIND_R2, CHAOS_COLOUR_LAST)
+HIST_FN(hist_b2, KIND_R2, CHAOS_COLOUR_BLEND)
+
+static const par_fn hist_fns[3][3] = {
+    {hist_i0, hist_i1, hist_i2}, {hist_a0, hist_a1, hist_a2}, {hist_b0, hist_b1, hist_b2}};
+
+/* ---------- 3-D volume ---------- */
+
+
+INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
+{
+    const sysdata *d = j->d;
+    worker *w = &j->w[wid];
+    uint64_t count;
+    chunk_range(j, chunk, &count);
+    orbit ob;
+    orbit_start(&ob, d, j->o->seed, chunk);
+    for (uint64_t i = 0; i < j->burn; i++)
+        orbit_step3(&ob, d, kind);
+    const double lx = j->lo3[0], ly = j->lo3[1], lz = j->lo3[2];
+    const double sx = j->s3[0], sy = j->s3[1], sz = j->s3[2];
+    const double fx_n = j->nx, fy_n = j->ny, fz_n = j->nz;
+    const size_t nx = (size_t)j->nx, nxy = (size_t)j->nx * (size_t)j->ny;
+    const size_t trash = j->nbins, nbins = j->nbins; /* outside points go to an extra slot */
+    const uint32_t n = (uint32_t)d->n;
+    const uint32_t *const thr = d->thr, *const sel = d->sel;
+    const double *const M = d->m;
+    uint32_t *const cnt = w->cnt;
+    rng r = ob.r;
+    uint32_t st = ob.s, cur = ob.cur;
+    double x = ob.x, y = ob.y, z = ob.z;
+    size_t ring[RING];
+    for (int i = 0; i < RING; i++)
+        ring[i] = trash;
+    uint64_t inside = 0;
+    for (uint64_t i = 0; i < count; i++) {
+        uint64_t wd = rng_next(&r);
+        uint32_t col = (uint32_t)(((wd >> 32) * n) >> 32);
+        if (kind != KIND_IFS)
+            col += st * n;
+        uint32_t k = sel[2 * col + ((uint32_t)wd < thr[col])];
+        if (kind == KIND_R1)
+            st = k;
+        else if (kind == KIND_R2)
+            st = cur * n + k;
+        cur = k;
+        const double *m = M + 12 * (size_t)k;
+        double nx_ = m[0] * x + m[1] * y + m[2] * z + m[3];
+        double ny_ = m[4] * x + m[5] * y + m[6] * z + m[7];
+        double nz_ = m[8] * x + m[9] * y + m[10] * z + m[11];
+        x = nx_, y = ny_, z = nz_;
+        double fx = (x - lx) * sx, fy = (y - ly) * sy, fz = (z - lz) * sz;
+        int in = fx >= 0 && fx < fx_n && fy >= 0 && fy < fy_n && fz >= 0 && fz < fz_n;
+        size_t b = trash;
+        if (in) {
+            b = (size_t)(int)fx + nx * (size_t)(int)fy + nxy * (size_t)(int)fz;
+            inside++;
+        }
+        /* prefetch this point's voxel, count the one RING points back */
+        PREFETCHW(&cnt[b]);
+        size_t slot = (size_t)(i % RING);
+        bump(w, cnt, ring[slot], nbins);
+        ring[slot] = b;
+    }
+    for (int i = 0; i < RING; i++)
+        bump(w, cnt, ring[i], nbins);
+    w->inside += inside;
+    w->plotted += count;
+}
+
+static void vol_i(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_IFS); }
+static void vol_a(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_R1); }
+static void vol_b(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_R2); }
+static const par_fn vol_fns[3] = {vol_i, vol_a, vol_b};
+
+/* ---------- points (point cloud, fit pre-pass, projection) ---------- */
+
+/* Generic 3-D/2-D orbit writing positions (and palette colours) of chunk
+ * points into j->pos / j->col at the chunk's offset. Not the hot path. */
+static void points_chunk(void *ctx, size_t chunk, int wid)
+{
+    const job *j = ctx;
+    const sysdata *d = j->d;
+    uint64_t count;
+    chunk_range(j, chunk, &count);
+    orbit ob;
+    orbit_start(&ob, d, j->o->seed, chunk);
+    int kind = d->kind, colour = j->o->colour;
+    for (uint64_t i = 0; i < j->burn + count; i++) {
+        if (d->dim == 2)
+            kind == KIND_IFS ? orbit_step2(&ob, d, KIND_IFS)
+            : kind == KIND_R1 ? orbit_step2(&ob, d, KIND_R1) : orbit_step2(&ob, d, KIND_R2);
+        else
+            kind == KIND_IFS ? orbit_step3(&ob, d, KIND_IFS)
+            : kind == KIND_R1 ? orbit_step3(&ob, d, KIND_R1) : orbit_step3(&ob, d, KIND_R2);
+        uint32_t pc = colour == CHAOS_COLOUR_BLEND ? orbit_colour(&ob, d, CHAOS_COLOUR_BLEND)
+                                                   : orbit_colour(&ob, d, CHAOS_COLOUR_LAST);
+        if (i < j->burn)
+            continue;
+        size_t at = (size_t)chunk * j->chunk + (size_t)(i - j->burn);
+        if (j->pos) {
+            j->pos[3 * at] = (float)ob.x;
+            j->pos[3 * at + 1] = (float)ob.y;
+            j->pos[3 * at + 2] = (float)ob.z;
+        }
+        if (j->col)
+            memcpy(j->col + 4 * at, d->palf[pc], 4 * sizeof(float));
+        if (j->cam) {
+            worker *w = &j->w[wid];
+            double p[3] = {ob.x, ob.y, ob.z}, sx, sy, z;
+            w->plotted++;
+            if (camera_project(j->cam, j->iw, j->ih, p, &sx, &sy, &z) != 0)
+                continue;
+            if (!(sx >= 0 && sx < j->iw && sy >= 0 && sy < j->ih))
+                continue;
+            w->inside++;
+            size_t b = (size_t)(int)sy * (size_t)j->iw + (size_t)(int)sx;
+            uint32_t tag = colour == CHAOS_COLOUR_NONE ? 0 : pc;
+            if (z < w->zb[b] || (z == w->zb[b] && tag < w->tag[b])) {
+                w->zb[b] = z;
+                w->tag[b] = tag;
+            }
+        }
+    }
+}
+
+static rt_code finish_par(rt_code rc, worker *w, int nw, rt_error *e)
+{
+    int oom = 0;
+    for (int i = 0; i < nw; i++)
+        oom |= w[i].oom;
+    if (rc == RT_ECANCEL)
+        return rt_fail(e, RT_ECANCEL, "interrupted");
+    if (oom)
+        return rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
+    return rc;
+}
+
+static void free_workers(worker *w, int nw)
+{
+    if (!w)
+        return;
+    for (int i = 0; i < nw; i++) {
+        free(w[i].cnt);
+        free(w[i].carry);
+        free(w[i].zb);
+        free(w[i].tag);
+    }
+    free(w);
+}
+
+static void job_init(job *j, const sysdata *d, const chaos_opts *o)
+{
+    memset(j, 0, sizeof *j);
+    j->d = d;
+    j->o = o;
+    j->points = o->points;
+    j->chunk = o->chunk ? o->chunk : CHAOS_CHUNK;
+    j->burn = o->burn == 0 ? CHAOS_BURN : o->burn < 0 ? 0 : (uint64_t)o->burn;
+    j->nchunks = (size_t)((o->points + j->chunk - 1) / j->chunk);
+}
+
+/* ---------- window fitting ---------- */
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
+                  rt_error *e)
+{
+    sysdata *d = sys_make(s, o, 0, e);
+    if (!d)
+        return e ? e->code : RT_EINVAL;
+    chaos_opts fo = *o;
+    fo.points = CHAOS_FIT_POINTS;
+    fo.colour = CHAOS_COLOUR_NONE;
+    fo.chunk = CHAOS_FIT_POINTS;
+    fo.seed = rng_hash3(o->seed, 1ull << 63, 0, 0); /* independent of the chunks' streams */
+    job j;
+    job_init(&j, d, &fo);
+    size_t np = CHAOS_FIT_POINTS;
+    j.pos = malloc(sizeof *j.pos * 3 * np);
+    double *ax = malloc(sizeof *ax * np);
+    if (!j.pos || !ax) {
+        free(j.pos);
+        free(ax);
+        sys_free(d);
+        return rt_fail(e, RT_ENOMEM, "out of memory fitting a window");
+    }
+    points_chunk(&j, 0, 0);
+    int dim = d->dim;
+    double ext[3];
+    for (int a = 0; a < dim; a++) {
+        for (size_t i = 0; i < np; i++)
+            ax[i] = j.pos[3 * i + a];
+        qsort(ax, np, sizeof *ax, cmp_double);
+        size_t cut = np / 1000; /* 0.1 % each side */
+        lo[a] = ax[cut];
+        hi[a] = ax[np - 1 - cut];
+        if (!isfinite(lo[a]) || !isfinite(hi[a]))
+            lo[a] = -1, hi[a] = 1;
+        ext[a] = hi[a] - lo[a];
+    }
+    double big = 0;
+    for (int a = 0; a < dim; a++)
+        if (ext[a] > big)
+            big = ext[a];
+    for (int a = 0; a < dim; a++) {
+        double c = 0.5 * (lo[a] + hi[a]);
+        double x = ext[a];
+        if (!(x > 1e-12 * (fabs(c) + 1)))
+            x = big > 0 ? 0.1 * big : 1;
+        x *= 1.1; /* 5 % margin each side */
+        lo[a] = c - 0.5 * x;
+        hi[a] = c + 0.5 * x;
+    }
+    if (dim == 2 && w > 0 && h > 0) {
+        double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
+        double want = (double)w / h;
+        if (ex / ey < want) {
+            double c = 0.5 * (lo[0] + hi[0]);
+            lo[0] = c - 0.5 * ey * want, hi[0] = c + 0.5 * ey * want;
+        } else {
+            double c = 0.5 * (lo[1] + hi[1]);
+            lo[1] = c - 0.5 * ex / want, hi[1] = c + 0.5 * ex / want;
+        }
+    }
+    free(j.pos);
+    free(ax);
+    sys_free(d);
+    return RT_OK;
+}
+
+/* ---------- public evaluations ---------- */
+
+static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int colour, int zbuf,
+                             rt_error *e)
+{
+    worker *w = calloc((size_t)nw, sizeof *w);
+    int bad = !w;
+    for (int i = 0; !bad && i < nw; i++) {
+        /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
+        if (counts && !(w[i].cnt = calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+            bad = 1;
+        if (zbuf) {
+            w[i].zb = malloc(sizeof *w[i].zb * nbins);
+            w[i].tag = malloc(sizeof *w[i].tag * nbins);
+            if (!w[i].zb || !w[i].tag)
+                bad = 1;
+            else
+                for (size_t b = 0; b < nbins; b++)
+                    w[i].zb[b] = INFINITY, w[i].tag[b] = 0;
+        }
+    }
+    if (bad) {
+        free_workers(w, nw);
+        return rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's accumulators");
+    }
+    *out = w;
+    return RT_OK;
+}
+
+static uint64_t total_count(const worker *w, int nw, size_t b)
+{
+    uint64_t t = 0;
+    for (int i = 0; i < nw; i++)
+        t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
+    return t;
+}
+
+static void fill_stats(chaos_stats *st, const worker *w, int nw)
+{
+    if (!st)
+        return;
+    st->plotted = st->inside = 0;
+    for (int i = 0; i < nw; i++) {
+        st->plotted += w[i].plotted;
+        st->inside += w[i].inside;
+    }
+}
+
+rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_stats *st,
+                    const rt_run *run, rt_error *e)
+{
+    if (st)
+        st->plotted = st->inside = 0;
+    if (o->colour != CHAOS_COLOUR_NONE && !hs->csum)
+        return rt_fail(e, RT_EINVAL, "colouring needs a histogram with colour sums");
+    if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
+        return rt_fail(e, RT_EINVAL, "histogram window [%g, %g] x [%g, %g] is empty", hs->lo[0],
+                       hs->hi[0], hs->lo[1], hs->hi[1]);
+    sysdata *d = sys_make(s, o, 2, e);
+    if (!d)
+        return e ? e->code : RT_EINVAL;
+    job j;
+    job_init(&j, d, o);
+    j.hw = hs->w, j.hh = hs->h;
+    j.nbins = (size_t)hs->w * (size_t)hs->h;
+    j.lox = hs->lo[0], j.hiy = hs->hi[1];
+    j.sx = hs->w / (hs->hi[0] - hs->lo[0]);
+    j.sy = hs->h / (hs->hi[1] - hs->lo[1]);
+    int nw = par_workers(run, j.nchunks);
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    if (rc) {
+        sys_free(d);
+        return rc;
+    }
+    rc = par_for(run, "chaos game", j.nchunks, hist_fns[d->kind][o->colour], &j);
+    rc = finish_par(rc, j.w, nw, e);
+    if (!rc) {
+        for (size_t b = 0; b < j.nbins; b++) {
+            if (o->colour == CHAOS_COLOUR_NONE) {
+                hs->count[b] += total_count(j.w, nw, b);
+                continue;
+            }
+            uint64_t t[4] = {0, 0, 0, 0};
+            for (int i = 0; i < nw; i++)
+                for (int q = 0; q < 4; q++)
+                    t[q] += j.w[i].cnt[4 * b + q] + (j.w[i].carry ? j.w[i].carry[4 * b + q] : 0);
+            hs->count[b] += t[0];
+            for (int ch = 0; ch < 3; ch++)
+                hs->csum[3 * b + ch] += (float)((double)t[ch + 1] / 65535.0);
+        }
+        fill_stats(st, j.w, nw);
+    }
+    free_workers(j.w, nw);
+    sys_free(d);
+    return rc;
+}
+
+rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, volume *vol,
+                     chaos_stats *st, const rt_run *run, rt_error *e)
+{
+    if (st)
+        st->plotted = st->inside = 0;
+    for (int a = 0; a < 3; a++)
+        if (!(vol->hi[a] > vol->lo[a]))
+            return rt_fail(e, RT_EINVAL, "volume box is empty on axis %c", "xyz"[a]);
+    sysdata *d = sys_make(s, o, 3, e);
+    if (!d)
+        return e ? e->code : RT_EINVAL;
+    job j;
+    job_init(&j, d, o);
+    j.nx = vol->nx, j.ny = vol->ny, j.nz = vol->nz;
+    int nn[3] = {vol->nx, vol->ny, vol->nz};
+    for (int a = 0; a < 3; a++) {
+        j.lo3[a] = vol->lo[a];
+        j.s3[a] = nn[a] / (vol->hi[a] - vol->lo[a]);
+    }
+    j.nbins = (size_t)vol->nx * (size_t)vol->ny * (size_t)vol->nz;
+    int nw = par_workers(run, j.nchunks);
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, 0, 0, e);
+    if (rc) {
+        sys_free(d);
+        return rc;
+    }
+    rc = par_for(run, "chaos game", j.nchunks, vol_fns[d->kind], &j);
+    rc = finish_par(rc, j.w, nw, e);
+    if (!rc) {
+        uint64_t mx = 0;
+        for (size_t b = 0; b < j.nbins; b++) {
+            uint64_t t = total_count(j.w, nw, b);
+            if (t > mx)
+                mx = t;
+        }
+        fill_stats(st, j.w, nw);
+        uint64_t plotted = 0;
+        for (int i = 0; i < nw; i++)
+            plotted += j.w[i].plotted;
+        double den = norm == CHAOS_NORM_TOTAL ? (double)plotted : norm == CHAOS_NORM_MAX ? (double)mx : 1;
+        if (!(den > 0))
+            den = 1;
+        for (size_t b = 0; b < j.nbins; b++)
+            vol->v[b] = (float)((double)total_count(j.w, nw, b) / den);
+    }
+    free_workers(j.w, nw);
+    sys_free(d);
+    return rc;
+}
+
+rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_run *run,
+                     rt_error *e)
+{
+    sysdata *d = sys_make(s, o, 0, e);
+    if (!d)
+        return e ? e->code : RT_EINVAL;
+    job j;
+    job_init(&j, d, o);
+    size_t np = (size_t)o->points;
+    j.pos = malloc(sizeof *j.pos * rt_mul_size(np ? np : 1, 3));
+    int want_col = m->col && o->colour != CHAOS_COLOUR_NONE;
+    if (want_col)
+        j.col = malloc(sizeof *j.col * rt_mul_size(np ? np : 1, 4));
+    if (!j.pos || (want_col && !j.col)) {
+        free(j.pos);
+        free(j.col);
+        sys_free(d);
+        return rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
+    }
+    rt_code rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    rc = finish_par(rc, NULL, 0, e);
+    for (size_t i = 0; !rc && i < np; i++)
+        if (mesh_add_vertex(m, j.pos + 3 * i, NULL, j.col ? j.col + 4 * i : NULL) == UINT32_MAX)
+            rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
+    free(j.pos);
+    free(j.col);
+    sys_free(d);
+    return rc;
+}
+
+rt_code chaos_project(const chaos_sys *s, const chaos_opts *o, const camera *cam, image *im,
+                      chaos_stats *st, const rt_run *run, rt_error *e)
+{
+    if (st)
+        st->plotted = st->inside = 0;
+    sysdata *d = sys_make(s, o, 3, e);
+    if (!d)
+        return e ? e->code : RT_EINVAL;
+    job j;
+    job_init(&j, d, o);
+    j.cam = cam;
+    j.iw = im->w, j.ih = im->h;
+    j.nbins = (size_t)im->w * (size_t)im->h;
+    int nw = par_workers(run, j.nchunks);
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 0, 0, 1, e);
+    if (rc) {
+        sys_free(d);
+        return rc;
+    }
+    rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    rc = finish_par(rc, j.w, nw, e);
+    if (!rc) {
+        /* merge: nearest depth, ties by smaller tag (order-free) */
+        double zmin = INFINITY, zmax = -INFINITY;
+        for (size_t b = 0; b < j.nbins; b++) {
+            for (int i = 1; i < nw; i++)
+                if (j.w[i].zb[b] < j.w[0].zb[b] ||
+                    (j.w[i].zb[b] == j.w[0].zb[b] && j.w[i].tag[b] < j.w[0].tag[b])) {
+                    j.w[0].zb[b] = j.w[i].zb[b];
+                    j.w[0].tag[b] = j.w[i].tag[b];
+                }
+            double z = j.w[0].zb[b];
+            if (z < INFINITY) {
+                if (z < zmin)
+                    zmin = z;
+                if (z > zmax)
+                    zmax = z;
+            }
+        }
+        double nb = o->near_b, fb = o->far_b;
+        if (nb == 0 && fb == 0)
+            nb = 1, fb = 0.25;
+        double span = zmax > zmin ? zmax - zmin : 1;
+        for (size_t b = 0; b < j.nbins; b++) {
+            float *px = im->px + 4 * b;
+            double z = j.w[0].zb[b];
+            if (!(z < INFINITY)) {
+                memcpy(px, o->bg, 4 * sizeof(float));
+                continue;
+            }
+            double br = nb + (fb - nb) * ((z - zmin) / span);
+            static const float white[4] = {1, 1, 1, 1};
+            const float *c = o->colour == CHAOS_COLOUR_NONE ? white : d->palf[j.w[0].tag[b]];
+            for (int ch = 0; ch < 3; ch++)
+                px[ch] = (float)(c[ch] * br);
+            px[3] = 1;
+        }
+        fill_stats(st, j.w, nw);
+    }
+    free_workers(j.w, nw);
+    sys_free(d);
+    return rc;
+}
+
+rt_code chaos_measure2(const hist2 *hs, chaos_norm norm, uint64_t total, image *im, rt_error *e)
+{
+    if (im->w != hs->w || im->h != hs->h)
+        return rt_fail(e, RT_EINVAL, "measure image is %d×%d but the histogram is %d×%d", im->w,
+                       im->h, hs->w, hs->h);
+    size_t nb = (size_t)hs->w * (size_t)hs->h;
+    uint64_t mx = 0;
+    for (size_t b = 0; b < nb; b++)
+        if (hs->count[b] > mx)
+            mx = hs->count[b];
+    double den = norm == CHAOS_NORM_TOTAL ? (double)total : norm == CHAOS_NORM_MAX ? (double)mx : 1;
+    if (!(den > 0))
+        den = 1;
+    for (size_t b = 0; b < nb; b++) {
+        float v = (float)((double)hs->count[b] / den);
+        float *px = im->px + 4 * b;
+        px[0] = px[1] = px[2] = v;
+        px[3] = 1;
+    }
+    return RT_OK;
+}

@@ -1,0 +1,469 @@
+/* test_chaos.c — the chaos game against independent facts: box-counting
+ * dimensions of known attractors, RIFS cell measures against a stationary
+ * distribution solved here, forbidden addresses, thread-count invariance,
+ * tone-mapping formulas by hand. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "chaos.h"
+#include "check.h"
+#include "tonemap.h"
+
+/* Number of occupied boxes of side `side` bins (boxes tile from the top-left;
+ * the last row/column may be partial). */
+static long box_count(const hist2 *hs, int side)
+{
+    long occ = 0;
+    for (int by = 0; by * side < hs->h; by++)
+        for (int bx = 0; bx * side < hs->w; bx++) {
+            uint64_t t = 0;
+            for (int y = by * side; y < (by + 1) * side && y < hs->h && !t; y++)
+                for (int x = bx * side; x < (bx + 1) * side && x < hs->w; x++)
+                    t += hs->count[(size_t)y * hs->w + x];
+            occ += t > 0;
+        }
+    return occ;
+}
+
+/* Least-squares slope of log N(side) against -log(side). */
+static double box_dimension(const hist2 *hs, const int *sides, int n)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int i = 0; i < n; i++) {
+        double X = -log((double)sides[i]), Y = log((double)box_count(hs, sides[i]));
+        sx += X, sy += Y, sxx += X * X, sxy += X * Y;
+    }
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+static void test_sierpinski(void)
+{
+    rt_error e;
+    ifs f;
+    /* right-angled Sierpinski triangle: level-k cells are dyadic squares, so
+     * exactly 3^k boxes of side 2^-k are occupied, dimension log 3 / log 2 */
+    affine m[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                   affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5)};
+    CHECK(ifs_build(&f, m, 3, NULL, 0, &e) == RT_OK, "build");
+    hist2 hs;
+    double lo[2] = {0, 0}, hi[2] = {1, 1};
+    CHECK(hist2_init(&hs, 512, 512, lo, hi, 0, &e) == RT_OK, "hist");
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.points = 2000000;
+    o.seed = 7;
+    chaos_stats st;
+    CHECK(chaos_hist2(&s, &o, &hs, &st, NULL, &e) == RT_OK, "chaos: %s", e.msg);
+    CHECK(st.plotted == 2000000 && st.inside == 2000000, "plotted %llu inside %llu",
+          (unsigned long long)st.plotted, (unsigned long long)st.inside);
+    /* Range k = 2..8: at k = 8 there are 6561 boxes and ~300 points per box
+     * (a box is missed with probability ~e^-300); k = 9 (~100 per box) is
+     * also safe, but beyond the box is a single bin. Below 2 the count is
+     * just the few quadrants. */
+    static const int dyadic[7] = {2, 4, 8, 16, 32, 64, 128}; /* k = 8 .. 2 */
+    double D = box_dimension(&hs, dyadic, 7);
+    CHECK_NEAR(D, log(3.0) / log(2.0), 0.05, "Sierpinski box dimension");
+    long p3 = 9;
+    for (int k = 2; k <= 8; k++, p3 *= 3) {
+        long c = box_count(&hs, 512 >> k);
+        CHECK(c == p3, "level %d: %ld boxes, expected 3^%d = %ld", k, c, k, p3);
+    }
+    /* fitted window: the triangle [0,1]² with a 5 % margin each side */
+    double flo[2], fhi[2];
+    CHECK(chaos_fit(&s, &o, 100, 100, flo, fhi, &e) == RT_OK, "fit");
+        /* (0.1 % quantiles trimmed: the interval is within [0, 1] and nearly all of it) */
+    CHECK(flo[0] > -0.06 && flo[0] < -0.03 && fhi[0] > 1.03 && fhi[0] < 1.06, "fit x [%g, %g]", flo[0], fhi[0]);
+    CHECK(flo[1] > -0.06 && fhi[1] < 1.06, "fit y [%g, %g]", flo[1], fhi[1]);
+    /* aspect 2:1 widens x about its centre */
+    CHECK(chaos_fit(&s, &o, 200, 100, flo, fhi, &e) == RT_OK, "fit 2:1");
+    CHECK_NEAR((fhi[0] - flo[0]) / (fhi[1] - flo[1]), 2.0, 1e-9, "fit aspect");
+    CHECK_NEAR(flo[0] + fhi[0], 1.0, 0.02, "fit centre");
+    hist2_free(&hs);
+    ifs_free(&f);
+}
+
+static void test_koch(void)
+{
+    rt_error e;
+    ifs f;
+    /* seed 003 Table 1: two similarities of ratio 1/√3 (the matrices are
+     * symmetric with eigenvalues ±1/√3), so D = log 2 / log √3 ≈ 1.2619 */
+    double r = sqrt(3.0) / 6;
+    affine m[2] = {affine_from_2d(0.5, r, r, -0.5, 0, 0), affine_from_2d(0.5, -r, -r, -0.5, 0.5, r)};
+    CHECK(ifs_build(&f, m, 2, NULL, 0, &e) == RT_OK, "build");
+    CHECK_NEAR(f.max_contraction, 1 / sqrt(3.0), 1e-12, "Koch map ratio");
+    hist2 hs;
+    double lo[2] = {0, -0.35}, hi[2] = {1, 0.65}; /* the curve spans [0,1] × [0, √3/6] */
+    CHECK(hist2_init(&hs, 1024, 1024, lo, hi, 0, &e) == RT_OK, "hist");
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.points = 3000000;
+    o.seed = 11;
+    chaos_stats st;
+    CHECK(chaos_hist2(&s, &o, &hs, &st, NULL, &e) == RT_OK, "chaos: %s", e.msg);
+    CHECK(st.inside == st.plotted, "Koch curve inside the window");
+    /* Box sides from one bin (1/1024 of the curve's length: ~400 points per
+     * occupied bin, so none is missed) to 64 bins (1/16: coarser, the curve
+     * covers < 50 boxes and its two ends dominate). Sides 2^k and 3·2^k are
+     * interleaved because the Koch count oscillates log-periodically with
+     * period log √3, which dyadic boxes alone would alias. */
+    static const int sides[12] = {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64};
+    double D = box_dimension(&hs, sides, 12);
+    CHECK_NEAR(D, log(2.0) / log(sqrt(3.0)), 0.05, "Koch box dimension");
+    hist2_free(&hs);
+    ifs_free(&f);
+}
+
+/* seed 001 Table 1 */
+static const double T1[64] = {
+    0.13, 0.14, 0.15, 0.09, 0.07, 0.15, 0.15, 0.07, 0.12, 0.07, 0.08, 0.15, 0.17, 0.08, 0.08, 0.21,
+    0.16, 0.14, 0.08, 0.07, 0.16, 0.14, 0.09, 0.11, 0.13, 0.12, 0.14, 0.15, 0.07, 0.17, 0.15, 0.02,
+    0.12, 0.08, 0.13, 0.16, 0.10, 0.10, 0.14, 0.13, 0.13, 0.15, 0.13, 0.11, 0.07, 0.08, 0.10, 0.18,
+    0.09, 0.13, 0.14, 0.16, 0.13, 0.09, 0.14, 0.07, 0.15, 0.15, 0.14, 0.17, 0.07, 0.16, 0.11, 0.01};
+static const double OCT[8][3] = {{0, 0, 0},   {128, 0, 0},   {128, 0, 128}, {0, 0, 128},
+                                 {0, 128, 0}, {128, 128, 0}, {0, 128, 128}, {128, 128, 128}};
+
+static void octant_maps(affine *m)
+{
+    double m9[9] = {0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5};
+    for (int i = 0; i < 8; i++)
+        m[i] = affine_from_3d(m9, OCT[i]);
+}
+
+/* π P = π, Σ π = 1 by Gaussian elimination with partial pivoting on the
+ * transposed system (P^T - I) π = 0 with the last equation replaced. */
+static void solve_stationary(const double *P, int n, double *pi)
+{
+    double A[8][9];
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < n; j++)
+            A[i][j] = P[j * n + i] - (i == j);
+        A[i][n] = 0;
+    }
+    for (int j = 0; j < n; j++)
+        A[n - 1][j] = 1;
+    A[n - 1][n] = 1;
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(A[r][c]) > fabs(A[p][c]))
+                p = r;
+        for (int k = 0; k <= n; k++) {
+            double t = A[c][k];
+            A[c][k] = A[p][k];
+            A[p][k] = t;
+        }
+        for (int r = 0; r < n; r++)
+            if (r != c) {
+                double f = A[r][c] / A[c][c];
+                for (int k = c; k <= n; k++)
+                    A[r][k] -= f * A[c][k];
+            }
+    }
+    for (int i = 0; i < n; i++)
+        pi[i] = A[i][n] / A[i][i];
+}
+
+static void test_rifs_measure(void)
+{
+    rt_error e;
+    rifs r;
+    affine m[8];
+    octant_maps(m);
+    /* Table 1 with some transitions forbidden, rows renormalised here */
+    double P[64];
+    memcpy(P, T1, sizeof P);
+    P[0 * 8 + 1] = 0;
+    P[3 * 8 + 7] = 0;
+    P[7 * 8 + 7] = 0;
+    P[5 * 8 + 2] = 0;
+    for (int i = 0; i < 8; i++) {
+        double s = 0;
+        for (int j = 0; j < 8; j++)
+            s += P[i * 8 + j];
+        for (int j = 0; j < 8; j++)
+            P[i * 8 + j] /= s;
+    }
+    CHECK(rifs_build(&r, m, 8, 1, P, 0, &e) == RT_OK, "build: %s", e.msg);
+    double pi[8];
+    solve_stationary(P, 8, pi);
+    /* Dobrushin coefficient δ = max_{i,i'} ½ Σ_j |p_ij − p_i'j|: the chain
+     * forgets its state at rate δ^t, so |Cov(1_A(X_0), 1_B(X_t))| ≤ π(A) δ^t. */
+    double delta = 0;
+    for (int i = 0; i < 8; i++)
+        for (int i2 = 0; i2 < 8; i2++) {
+            double d = 0;
+            for (int j = 0; j < 8; j++)
+                d += fabs(P[i * 8 + j] - P[i2 * 8 + j]);
+            if (d / 2 > delta)
+                delta = d / 2;
+        }
+    CHECK(delta < 0.5, "Dobrushin coefficient %g", delta);
+
+    volume vol;
+    double lo[3] = {0, 0, 0}, hi[3] = {256, 256, 256};
+    CHECK(volume_init(&vol, 4, 4, 4, lo, hi, &e) == RT_OK, "volume");
+    chaos_sys s = {NULL, &r};
+    chaos_opts o = {0};
+    o.points = 4000000;
+    o.seed = 3;
+    chaos_stats st;
+    CHECK(chaos_volume(&s, &o, CHAOS_NORM_TOTAL, &vol, &st, NULL, &e) == RT_OK, "chaos: %s", e.msg);
+    CHECK(st.inside == st.plotted, "all inside the cube");
+    double N = (double)st.plotted, total = 0;
+    /* Level-2 cell ω_j∘ω_i(cube) = t_j + t_i/2 + [0, 64)³ is voxel
+     * 2·b_j + b_i per axis; its measure is P(previous map i, current j) =
+     * π_i p_ij. Pair indicators: lag-1 covariance ≤ p, lag t ≥ 2 ≤ p δ^(t-1),
+     * so the variance factor τ ≤ 1 + 2/((1−δ)(1−p)); we allow 5 standard
+     * errors sqrt(τ p (1−p) / N) (plus 1e-6 for the burn-in and alias
+     * rounding). */
+    int worst_ok = 1;
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 8; j++) {
+            int v[3];
+            for (int a = 0; a < 3; a++)
+                v[a] = 2 * (OCT[j][a] > 0) + (OCT[i][a] > 0);
+            double mu = *volume_at(&vol, v[0], v[1], v[2]);
+            double p = pi[i] * P[i * 8 + j];
+            total += mu;
+            if (p == 0) {
+                CHECK(mu == 0, "forbidden address %d→%d has measure %g", i + 1, j + 1, mu);
+                continue;
+            }
+            double tau = 1 + 2 / ((1 - delta) * (1 - p));
+            double tol = 5 * sqrt(tau * p * (1 - p) / N) + 1e-6;
+            if (fabs(mu - p) > tol) {
+                worst_ok = 0;
+                CHECK(0, "cell %d→%d: measure %g vs π_i p_ij %g (tol %g)", i + 1, j + 1, mu, p, tol);
+            }
+        }
+    CHECK(worst_ok, "level-2 measures");
+    CHECK_NEAR(total, 1.0, 1e-5, "measure total");
+    /* level 1: octant j has measure π_j (state indicators: τ ≤ 1 + 2δ/((1−δ)(1−p))) */
+    for (int j = 0; j < 8; j++) {
+        double mu = 0;
+        for (int z = 0; z < 2; z++)
+            for (int y = 0; y < 2; y++)
+                for (int x = 0; x < 2; x++)
+                    mu += *volume_at(&vol, 2 * (OCT[j][0] > 0) + x, 2 * (OCT[j][1] > 0) + y,
+                                     2 * (OCT[j][2] > 0) + z);
+        double p = pi[j], tau = 1 + 2 * delta / ((1 - delta) * (1 - p));
+        CHECK_NEAR(mu, p, 5 * sqrt(tau * p * (1 - p) / N) + 1e-6, "octant measure = stationary π");
+    }
+    /* library's stationary distribution agrees with the one solved here */
+    double pi2[8];
+    CHECK(rifs_stationary(&r, pi2, &e) == RT_OK, "stationary");
+    for (int j = 0; j < 8; j++)
+        CHECK_NEAR(pi2[j], pi[j], 1e-9, "rifs_stationary");
+    /* normalise by max: the densest voxel is 1 */
+    CHECK(chaos_volume(&s, &o, CHAOS_NORM_MAX, &vol, &st, NULL, &e) == RT_OK, "max");
+    float mx = 0;
+    for (int i = 0; i < 64; i++)
+        mx = vol.v[i] > mx ? vol.v[i] : mx;
+    CHECK(mx == 1.0f, "max norm %g", mx);
+    volume_free(&vol);
+    rifs_free(&r);
+}
+
+static void test_order2(void)
+{
+    rt_error e;
+    rifs r;
+    /* binary digits: x/2 and x/2 + 1/2; an order-2 chain that forbids three
+     * equal maps in a row: after (1,1) always 2, after (2,2) always 1, else
+     * ½/½. Pair stationary law by hand: π(11) = π(22) = 1/6, π(12) = π(21)
+     * = 1/3, so each allowed triple has probability 1/6 and 111, 222 have 0.
+     * Bin floor(8x) = 4 k_n + 2 k_{n-1} + k_{n-2} (latest map most significant). */
+    affine m[2] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0)};
+    double P[8] = {0, 1, 0.5, 0.5, 0.5, 0.5, 1, 0};
+    CHECK(rifs_build(&r, m, 2, 2, P, 0, &e) == RT_OK, "build: %s", e.msg);
+    hist2 hs;
+    double lo[2] = {0, -0.5}, hi[2] = {1, 0.5};
+    CHECK(hist2_init(&hs, 8, 1, lo, hi, 0, &e) == RT_OK, "hist");
+    chaos_sys s = {NULL, &r};
+    chaos_opts o = {0};
+    o.points = 1000000;
+    o.seed = 5;
+    CHECK(chaos_hist2(&s, &o, &hs, NULL, NULL, &e) == RT_OK, "chaos: %s", e.msg);
+    CHECK(hs.count[0] == 0 && hs.count[7] == 0, "forbidden triples: %llu %llu",
+          (unsigned long long)hs.count[0], (unsigned long long)hs.count[7]);
+    /* se of 1/6 over 1e6 points ≈ 3.7e-4 × sqrt(τ); 0.005 is > 10 se for τ ≤ 2 */
+    for (int b = 1; b < 7; b++)
+        CHECK_NEAR(hs.count[b] / 1e6, 1.0 / 6, 0.005, "allowed triple");
+    double pi[2];
+    CHECK(rifs_stationary(&r, pi, &e) == RT_OK, "stationary");
+    CHECK_NEAR(pi[0], 0.5, 1e-9, "order-2 last-map law");
+    hist2_free(&hs);
+    rifs_free(&r);
+}
+
+static void test_threads(void)
+{
+    rt_error e;
+    ifs f;
+    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
+                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
+                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
+    double p[4] = {0.01, 0.85, 0.07, 0.07};
+    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    chaos_sys s = {&f, NULL};
+    ramp rp = ramp_grey();
+    rp.rgba[1][0] = 0.2f;
+    chaos_opts o = {0};
+    o.points = 300000;
+    o.seed = 99;
+    o.chunk = 1 << 14; /* 19 chunks */
+    o.colour = CHAOS_COLOUR_BLEND;
+    o.ramp = &rp;
+    double lo[2], hi[2];
+    CHECK(chaos_fit(&s, &o, 64, 64, lo, hi, &e) == RT_OK, "fit");
+    /* fern spans x ≈ [-2.2, 2.7], y ≈ [0, 10] */
+    CHECK(lo[1] < 0.1 && hi[1] > 9.5 && lo[0] < -2 && hi[0] > 2.5, "fern window");
+    hist2 h[3];
+    int th[3] = {1, 2, 4};
+    for (int t = 0; t < 3; t++) {
+        rt_run run = {th[t], NULL, 0};
+        CHECK(hist2_init(&h[t], 64, 64, lo, hi, 1, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s, &o, &h[t], NULL, &run, &e) == RT_OK, "chaos");
+    }
+    for (int t = 1; t < 3; t++) {
+        CHECK(memcmp(h[0].count, h[t].count, 64 * 64 * 8) == 0, "counts differ with %d threads", th[t]);
+        CHECK(memcmp(h[0].csum, h[t].csum, 64 * 64 * 12) == 0, "colours differ with %d threads", th[t]);
+    }
+    /* colour sums are in range: mean colour of a bin in [0, 1] */
+    int bad = 0;
+    for (int b = 0; b < 64 * 64; b++)
+        if (h[0].count[b] && (h[0].csum[3 * b + 1] < 0 || h[0].csum[3 * b + 1] > h[0].count[b] * 1.0001f))
+            bad++;
+    CHECK(bad == 0, "%d bins with colour out of range", bad);
+    for (int t = 0; t < 3; t++)
+        hist2_free(&h[t]);
+    ifs_free(&f);
+
+    /* 3-D: volume and projection */
+    rifs r;
+    affine m[8];
+    octant_maps(m);
+    CHECK(rifs_build(&r, m, 8, 1, T1, RIFS_NORMALISE, &e) == RT_OK, "rifs");
+    chaos_sys s3 = {NULL, &r};
+    volume v[3];
+    image im[3];
+    double vlo[3] = {0, 0, 0}, vhi[3] = {256, 256, 256};
+    camera cam;
+    double tgt[3] = {128, 128, 128};
+    camera_orbit(&cam, tgt, 600, 30, 20, 40);
+    CHECK(camera_setup(&cam) == 0, "camera");
+    for (int t = 0; t < 3; t++) {
+        rt_run run = {th[t], NULL, 0};
+        CHECK(volume_init(&v[t], 16, 16, 16, vlo, vhi, &e) == RT_OK, "vol");
+        CHECK(chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &v[t], NULL, &run, &e) == RT_OK, "vol chaos");
+        CHECK(image_init(&im[t], 48, 32, &e) == RT_OK, "image");
+        CHECK(chaos_project(&s3, &o, &cam, &im[t], NULL, &run, &e) == RT_OK, "project");
+    }
+    for (int t = 1; t < 3; t++) {
+        CHECK(memcmp(v[0].v, v[t].v, 16 * 16 * 16 * 4) == 0, "volume differs with %d threads", th[t]);
+        CHECK(memcmp(im[0].px, im[t].px, 48 * 32 * 16) == 0, "projection differs with %d threads", th[t]);
+    }
+    /* the projection of the cube-filling attractor covers the image centre */
+    CHECK(image_at(&im[0], 24, 16)[3] == 1, "centre pixel hit");
+    CHECK(image_at(&im[0], 0, 0)[3] == 0, "corner is background");
+    for (int t = 0; t < 3; t++) {
+        volume_free(&v[t]);
+        image_free(&im[t]);
+    }
+    /* point cloud: every point inside the cube [0, 256]³ */
+    mesh pc;
+    mesh_init(&pc, 0, 1);
+    o.points = 5000;
+    CHECK(chaos_points(&s3, &o, &pc, NULL, &e) == RT_OK, "points");
+    CHECK(pc.nv == 5000 && pc.nt == 0, "point cloud size %zu", pc.nv);
+    int out = 0;
+    for (size_t i = 0; i < 3 * pc.nv; i++)
+        out += pc.pos[i] < 0 || pc.pos[i] > 256;
+    CHECK(out == 0, "%d coordinates outside the cube", out);
+    mesh_free(&pc);
+    /* wrong dimension is an error */
+    hist2 hh;
+    CHECK(hist2_init(&hh, 4, 4, lo, hi, 0, &e) == RT_OK, "hist");
+    o.colour = CHAOS_COLOUR_NONE;
+    CHECK(chaos_hist2(&s3, &o, &hh, NULL, NULL, &e) == RT_EINVAL &&
+              strcmp(e.msg, "this needs 2-D maps, but the RIFS has 3-D maps") == 0,
+          "dimension message: %s", e.msg);
+    hist2_free(&hh);
+    rifs_free(&r);
+
+    /* one map x/2 + (0.25, 0.25): every point near the fixed point (0.5, 0.5),
+     * so one bin gets all 300000 hits — beyond the 65536-hit flush of the
+     * colour cells; map colour 1 = white: colour sum = count exactly */
+    affine one[1] = {affine_from_2d(0.5, 0, 0, 0.5, 0.25, 0.25)};
+    ifs f1;
+    CHECK(ifs_build(&f1, one, 1, NULL, 0, &e) == RT_OK, "one map");
+    chaos_sys s1 = {&f1, NULL};
+    double c1[1] = {1}, lo1[2] = {0, 0}, hi1[2] = {1, 1};
+    chaos_opts o1 = {0};
+    o1.points = 300000;
+    o1.colour = CHAOS_COLOUR_LAST;
+    o1.map_c = c1;
+    CHECK(hist2_init(&hh, 3, 3, lo1, hi1, 1, &e) == RT_OK, "hist");
+    CHECK(chaos_hist2(&s1, &o1, &hh, NULL, NULL, &e) == RT_OK, "chaos");
+    CHECK(hh.count[4] == 300000 && hh.csum[12] == 300000.0f && hh.csum[14] == 300000.0f,
+          "centre bin %llu hits, colour %g", (unsigned long long)hh.count[4], hh.csum[12]);
+    hist2_free(&hh);
+    ifs_free(&f1);
+}
+
+static void test_tonemap(void)
+{
+    rt_error e;
+    hist2 hs;
+    double lo[2] = {0, 0}, hi[2] = {1, 1};
+    CHECK(hist2_init(&hs, 4, 2, lo, hi, 1, &e) == RT_OK, "hist");
+    /* 2× supersampled: pixel 0 = bins (0..1, 0..1), pixel 1 = bins (2..3, 0..1) */
+    hs.count[0] = 1;                 /* pixel 0: C = 1 */
+    hs.count[2] = 3, hs.count[7] = 4; /* pixel 1: C = 7 */
+    hs.csum[0] = 1;                  /* pixel 0 mean colour (1, 0, 0) */
+    hs.csum[3 * 2 + 1] = 3, hs.csum[3 * 7 + 1] = 2, hs.csum[3 * 7 + 2] = 4; /* (0, 5/7, 4/7) */
+    image im;
+    CHECK(image_init(&im, 2, 1, &e) == RT_OK, "image");
+    tonemap_opts o = {0};
+    o.curve = TONEMAP_LOG;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "log");
+    CHECK_NEAR(im.px[0], log(2.0) / log(8.0), 1e-6, "log density 1/3"); /* grey ramp */
+    CHECK_NEAR(im.px[4], 1.0, 1e-6, "log density max");
+    o.curve = TONEMAP_LINEAR;
+    o.gamma = 2;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "linear");
+    CHECK_NEAR(im.px[0], sqrt(1.0 / 7), 1e-6, "linear gamma 2");
+    o.gamma = 1;
+    o.brightness = 3.5;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "bright");
+    CHECK_NEAR(im.px[0], 0.5, 1e-6, "brightness 3.5 × 1/7");
+    o.brightness = 1;
+    o.colour = TONEMAP_MEAN;
+    o.bg[2] = 0.5f, o.bg[3] = 1;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "mean");
+    /* pixel 0: v = 1/7, bg (0, 0, .5), mean (1, 0, 0) */
+    CHECK_NEAR(im.px[0], 1.0 / 7, 1e-6, "mean r");
+    CHECK_NEAR(im.px[2], 0.5 - 0.5 / 7, 1e-6, "mean b toward bg");
+    CHECK_NEAR(im.px[5], 5.0 / 7, 1e-6, "mean g at max");
+    CHECK_NEAR(im.px[6], 4.0 / 7, 1e-6, "mean b at max");
+    image_free(&im);
+    CHECK(image_init(&im, 3, 1, &e) == RT_OK, "image");
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_EINVAL &&
+              strcmp(e.msg, "histogram 4×2 is not a whole multiple k×k of the image 3×1") == 0,
+          "size message: %s", e.msg);
+    image_free(&im);
+    hist2_free(&hs);
+}
+
+int main(void)
+{
+    test_sierpinski();
+    test_koch();
+    test_rifs_measure();
+    test_order2();
+    test_threads();
+    test_tonemap();
+    return check_done("test_chaos");
+}
