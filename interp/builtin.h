@@ -63,6 +63,7 @@ int bind_ifs_init(interp *I);
 int bind_solid_init(interp *I);
 int bind_wrinkly_init(interp *I);
 int bind_show_init(interp *I);
+int bind_fset_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
 int call_value(interp *I, value fn, const value *args, int nargs, value *out);
