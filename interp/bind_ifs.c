@@ -2,8 +2,8 @@
  * chaos-game evaluations (seed 001 §5 measures, seed 003/004 IFS).
  *
  * Maps are values of class "map" (an affine map of the plane or of space):
- * map(a, b, c, d, e, f) in Fractint order, or map(scale:, rotate:, shear:,
- * translate:) built from transforms; m1 * m2 is the composition m1 ∘ m2
+ * affine(a, b, c, d, e, f) in Fractint order, or affine(scale:, rotate:,
+ * shear:, translate:) built from transforms; m1 * m2 is the composition m1 ∘ m2
  * (m2 first) and m * [x, y] applies a map. An IFS is declared from a table
  * whose rows are maps in the literature's column orders (the row length
  * tells which), or from a list of maps.
@@ -392,10 +392,10 @@ static int b_map(interp *I, value *a, int n, value *out)
     for (int i = 0; i < 6; i++)
         coef += a[i].k == V_NUM;
     if (coef && coef != 6)
-        return err_at(I, NULL, ERR_VALUE, "map: give all six coefficients a b c d e f, or use scale/rotate/shear/translate");
+        return err_at(I, NULL, ERR_VALUE, "affine: give all six coefficients a b c d e f, or use scale/rotate/shear/translate");
     if (coef == 6) {
         if (a[6].k != V_NIL || a[7].k != V_NIL || a[8].k != V_NIL || a[9].k != V_NIL)
-            return err_at(I, NULL, ERR_VALUE, "map: coefficients and transforms cannot be mixed");
+            return err_at(I, NULL, ERR_VALUE, "affine: coefficients and transforms cannot be mixed");
         return map_value(I, affine_from_2d(a[0].u.n, a[1].u.n, a[2].u.n, a[3].u.n, a[4].u.n, a[5].u.n), out);
     }
     /* scale, then shear, then rotate, then translate */
@@ -404,7 +404,7 @@ static int b_map(interp *I, value *a, int n, value *out)
         sx = sy = a[6].u.n;
     } else if (a[6].k == V_LIST) {
         double s[2];
-        if (get_vec(I, a[6], s, 2, "map: scale"))
+        if (get_vec(I, a[6], s, 2, "affine: scale"))
             return -1;
         sx = s[0];
         sy = s[1];
@@ -421,7 +421,7 @@ static int b_map(interp *I, value *a, int n, value *out)
     }
     if (a[9].k != V_NIL) {
         double t[2];
-        if (get_vec(I, a[9], t, 2, "map: translate"))
+        if (get_vec(I, a[9], t, 2, "affine: translate"))
             return -1;
         m.t[0] += t[0];
         m.t[1] += t[1];
@@ -435,11 +435,11 @@ static int b_map3(interp *I, value *a, int n, value *out)
     double m9[9], t[3] = {0, 0, 0};
     value rows = a[0];
     if (rows.k != V_LIST || AS_LIST(rows)->n != 3)
-        return err_at(I, NULL, ERR_VALUE, "map3: matrix must be 3 rows of 3 numbers");
+        return err_at(I, NULL, ERR_VALUE, "affine3: matrix must be 3 rows of 3 numbers");
     for (int i = 0; i < 3; i++)
-        if (get_vec(I, AS_LIST(rows)->items[i], m9 + 3 * i, 3, "map3: matrix row"))
+        if (get_vec(I, AS_LIST(rows)->items[i], m9 + 3 * i, 3, "affine3: matrix row"))
             return -1;
-    if (a[1].k != V_NIL && get_vec(I, a[1], t, 3, "map3: translate"))
+    if (a[1].k != V_NIL && get_vec(I, a[1], t, 3, "affine3: translate"))
         return -1;
     return map_value(I, affine_from_3d(m9, t), out);
 }
@@ -1025,9 +1025,9 @@ static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", "rec", 
 static const bparam p_load_ifs[] = {{"path", "str", NULL}};
 
 static const builtin ifs_builtins[] = {
-    BUILTIN("map", b_map, p_map,
-            "A 2-D affine map: map(a, b, c, d, e, f) with x' = a x + b y + e, y' = c x + d y + f (Fractint order), or map(scale:, shear:, rotate:, translate:) applied in that order. m1 * m2 composes (m2 first); m * [x, y] applies."),
-    BUILTIN("map3", b_map3, p_map3, "A 3-D affine map x' = M x + t from a 3×3 matrix (rows) and a translation."),
+    BUILTIN("affine", b_map, p_map,
+            "A 2-D affine map: affine(a, b, c, d, e, f) with x' = a x + b y + e, y' = c x + d y + f (Fractint order), or affine(scale:, shear:, rotate:, translate:) applied in that order. m1 * m2 composes (m2 first); m * [x, y] applies."),
+    BUILTIN("affine3", b_map3, p_map3, "A 3-D affine map x' = M x + t from a 3×3 matrix (rows) and a translation."),
     BUILTIN("ifs", b_ifs, p_ifs,
             "An IFS from a table of map rows (2-D: a b c d e f [p]; 3-D: a b c d e f g h i j k l [p], i.e. the 3×3 matrix by rows then the translation), a list of maps, or an ifs. Probabilities default to |det| weights; they must be ≥ 0 and sum to 1 unless normalize: true. Maps must contract unless allow_expanding: true."),
     BUILTIN("rifs", b_rifs, p_rifs,

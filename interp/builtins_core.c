@@ -18,6 +18,9 @@ int builtins_register(interp *I, const builtin *b, int n)
     while (root->parent)
         root = root->parent;
     for (int i = 0; i < n; i++) {
+        /* two builtins with one name would silently hide each other */
+        if (builtin_find(I, b[i].name))
+            return err_at(I, NULL, ERR_RUNTIME, "internal error: builtin '%s' is defined twice", b[i].name);
         if (I->nbuiltins == I->cap_builtins) {
             int nc = I->cap_builtins ? I->cap_builtins * 2 : 256;
             const builtin **nb = mem_realloc(I, I->builtins, (size_t)nc * sizeof *nb);
