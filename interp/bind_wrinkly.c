@@ -218,7 +218,7 @@ static int b_ist(interp *I, value *a, int n, value *out)
         if (nb < 2 || nb > MAX_CONTROL + 1)
             return err_at(I, NULL, ERR_VALUE, "ist: bounds must be a list of 2 to %d numbers (N + 1 for N intervals), got %zu",
                           MAX_CONTROL + 1, nb);
-        if (a[0].k != V_NIL && (size_t)a[0].u.n + 1 != nb)
+        if (a[0].k != V_NIL && a[0].u.n + 1 != (double)nb)
             return err_at(I, NULL, ERR_VALUE, "ist: intervals is %g but bounds gives %zu intervals (N + 1 bounds for N intervals)",
                           a[0].u.n, nb - 1);
         nint = (long)nb - 1;
@@ -900,6 +900,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
         return -1;
     }
     detiter_shape s;
+    memset(&s, 0, sizeof s);
     int rc = polyline_shape(I, &pl, pl.closed, &s);
     if (!rc && a[5].k != V_NIL) {
         draw_style st = {{fill[0], fill[1], fill[2], fill[3]}, 0, 0, 1};
@@ -915,7 +916,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
                 rc = lang_rt_error(I, e.code, &e, W);
         }
     }
-    if (!rc || s.v)
+    if (s.v)
         detiter_shape_free(&s);
     wrinkly_polyline_free(&pl);
     if (rc) {
