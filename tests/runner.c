@@ -378,6 +378,94 @@ static void run_lang_dir(const char *frac, const char *dir)
     free(names);
 }
 
+/* ---- command-line tests --------------------------------------------------------------
+ * tests/cli/NAME.cli: "# args: A B C" (the whole command line after frac;
+ * quoted 'single words' keep their spaces), "# stdin: TEXT" lines,
+ * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings). */
+static int split_args(char *s, char **argv, int max)
+{
+    int n = 0;
+    while (*s && n < max) {
+        while (*s == ' ')
+            s++;
+        if (!*s)
+            break;
+        if (*s == '\'') {
+            argv[n++] = ++s;
+            while (*s && *s != '\'')
+                s++;
+        } else {
+            argv[n++] = s;
+            while (*s && *s != ' ')
+                s++;
+        }
+        if (*s)
+            *s++ = 0;
+    }
+    return n;
+}
+
+static void run_cli_dir(const char *frac)
+{
+    int n;
+    char **names = list_dir("tests/cli", ".cli", &n);
+    for (int i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "tests/cli/%s", names[i]);
+        free(names[i]);
+        if (!matches_filter(path))
+            continue;
+        char *text = read_file(path, NULL);
+        buf in = {0}, why = {0};
+        char *outs[32], *errs[32], argline[4096] = "";
+        int nout = 0, nerr = 0, exit_code = 0;
+        for (char *p = text; p && *p;) {
+            char *e = strchr(p, '\n');
+            size_t l = e ? (size_t)(e - p) : strlen(p);
+            if (strncmp(p, "# args: ", 8) == 0)
+                snprintf(argline, sizeof argline, "%.*s", (int)(l - 8), p + 8);
+            else if (strncmp(p, "# stdin: ", 9) == 0) {
+                buf_add(&in, p + 9, l - 9);
+                buf_add(&in, "\n", 1);
+            } else if (strncmp(p, "# exit: ", 8) == 0)
+                exit_code = atoi(p + 8);
+            else if (strncmp(p, "# stdout: ", 10) == 0 && nout < 32)
+                outs[nout++] = strndup(p + 10, l - 10);
+            else if (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)
+                errs[nerr++] = strndup(p + 10, l - 10);
+            p = e ? e + 1 : p + l;
+        }
+        char *argv[64];
+        argv[0] = (char *)frac;
+        int k = 1 + split_args(argline, argv + 1, 60);
+        argv[k] = NULL;
+        buf out = {0}, err = {0};
+        int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
+        int ok = rc == exit_code;
+        if (!ok)
+            buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
+        for (int j = 0; j < nout; j++) {
+            if (!strstr(out.d, outs[j])) {
+                ok = 0;
+                buf_fmt(&why, "  stdout lacks: %s\n", outs[j]);
+            }
+            free(outs[j]);
+        }
+        for (int j = 0; j < nerr; j++) {
+            if (!strstr(err.d, errs[j])) {
+                ok = 0;
+                buf_fmt(&why, "  stderr lacks: %s\n", errs[j]);
+            }
+            free(errs[j]);
+        }
+        if (!ok)
+            buf_fmt(&why, "  stdout was:\n%.2000s\n  stderr was:\n%.2000s", out.d, err.d);
+        result(path, ok, &why);
+        free(text); free(in.d); free(out.d); free(err.d); free(why.d);
+    }
+    free(names);
+}
+
 /* ---- REPL sessions ------------------------------------------------------------------ */
 
 static void run_repl_dir(const char *frac, const char *dir)
@@ -696,6 +784,7 @@ int main(int argc, char **argv)
         run_unit(unit);
     run_lang_dir(fracabs, "tests/lang");
     run_lang_dir(fracabs, "tests/regression");
+    run_cli_dir(fracabs);
     run_repl_dir(fracabs, "tests/repl");
     if (ptyrun) {
         static char ptyabs[4096];
