@@ -30,7 +30,7 @@ RT_OBJ  := $(RT_SRC:%.c=$(BUILD)/%.o)
 IN_OBJ  := $(IN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/stdlib_gen.o
 UNIT_BIN:= $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
-.PHONY: all test asan golden gallery bench clean unit
+.PHONY: all test asan golden gallery bench clean unit fuzz
 all: $(BUILD)/frac
 
 $(BUILD)/%.o: %.c
@@ -93,7 +93,19 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/libfracrt.a
 bench: $(BUILD)/frac $(BENCH_BIN)
 	bash bench/run.sh $(BUILD)
 
+# Fuzz the whole interpreter with libFuzzer (needs clang; not part of test).
+FUZZ_SECONDS ?= 60
+fuzz:
+	@mkdir -p build-fuzz /tmp/frac-fuzz-out build-fuzz/corpus
+	$(MAKE) BUILD=build-fuzz build-fuzz/stdlib_gen.c
+	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
+	    -Iruntime -Iinterp -Ibuild-fuzz $(RT_SRC) $(filter-out interp/main.c,$(IN_SRC)) \
+	    build-fuzz/stdlib_gen.c tests/fuzz/fuzz_script.c -lm -lpthread -o build-fuzz/fuzz_script
+	for f in examples/*.frac tests/lang/*/*.frac; do cp "$$f" build-fuzz/corpus/$$(echo $$f | tr / _); done
+	build-fuzz/fuzz_script -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=30 \
+	    -rss_limit_mb=4096 build-fuzz/corpus
+
 clean:
-	rm -rf build build-asan gallery
+	rm -rf build build-asan build-fuzz gallery
 
 -include $(RT_OBJ:.o=.d) $(IN_OBJ:.o=.d)

@@ -1,8 +1,733 @@
-/* bind_solid.c — language binding (being written). */
+/* bind_solid.c — seed 000 in the language: the 3-D random fractal D(P)
+ * (midpoint displacement, Types I–IV) as a field, the marble and wood base
+ * functions, the perturbation P' = F(P, D(P)), objects cut out of a solid
+ * texture and planar slices. The reference for scripts is docs/solid.md;
+ * the engines are runtime/mpd.h, runtime/solid.h and runtime/texobj.h.
+ *
+ * Everything a script builds here is a *field* (runtime/field.h): the
+ * fractal and the base functions are external nodes, the perturbation is a
+ * warp node, so solid textures combine with every other field (arithmetic,
+ * noise, densities, sample, isosurface, raymarch, at) and user-defined base
+ * functions and perturbations are plain field expressions. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
 #include "builtin.h"
+#include "field.h"
+#include "lang_image.h"
+#include "lang_objects.h"
+#include "mpd.h"
+#include "solid.h"
+#include "texobj.h"
+
+#define AUTO_BUDGET ((size_t)64 << 20) /* automatic strategy: largest array it builds */
+
+/* ---- small helpers ------------------------------------------------------------------ */
+
+static int get_seed(interp *I, value v, uint64_t *seed, const char *what)
+{
+    if (v.k == V_NIL) {
+        *seed = I->seed;
+        return 0;
+    }
+    if (v.u.n < 0 || v.u.n > 9007199254740992.0 || v.u.n != floor(v.u.n))
+        return err_at(I, NULL, ERR_VALUE, "%s: seed must be a whole number >= 0, got %g", what, v.u.n);
+    *seed = (uint64_t)v.u.n;
+    return 0;
+}
+
+static int get_size2(interp *I, value v, int *w, int *h, const char *what)
+{
+    double s[2];
+    if (v.k == V_NUM)
+        s[0] = s[1] = v.u.n;
+    else if (get_vec(I, v, s, 2, what))
+        return -1;
+    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
+        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
+                      what, s[0], s[1]);
+    *w = (int)s[0];
+    *h = (int)s[1];
+    return 0;
+}
+
+static int get_vec3(interp *I, value v, double out[3], const char *what)
+{
+    if (get_vec(I, v, out, 3, what))
+        return -1;
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(out[i]))
+            return err_at(I, NULL, ERR_VALUE, "%s must be finite numbers, got [%g, %g, %g]", what, out[0], out[1],
+                          out[2]);
+    return 0;
+}
+
+/* An axis: "x", "y", "z" or a non-zero vector; normalised. */
+static int get_axis(interp *I, value v, double a[3], const char *what)
+{
+    if (v.k == V_STR) {
+        const char *s = AS_STR(v)->s;
+        if (AS_STR(v)->len != 1 || !strchr("xyz", s[0]))
+            return err_at(I, NULL, ERR_VALUE, "%s must be \"x\", \"y\", \"z\" or a vector [x, y, z], got \"%s\"",
+                          what, s);
+        a[0] = a[1] = a[2] = 0;
+        a[s[0] - 'x'] = 1;
+        return 0;
+    }
+    if (get_vec3(I, v, a, what))
+        return -1;
+    double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(l > 0))
+        return err_at(I, NULL, ERR_VALUE, "%s: the vector (0, 0, 0) has no direction", what);
+    for (int i = 0; i < 3; i++)
+        a[i] /= l;
+    return 0;
+}
+
+static int get_box(interp *I, value lo, value hi, double l[3], double h[3], const char *what)
+{
+    char w[96];
+    snprintf(w, sizeof w, "%s: lo", what);
+    if (get_vec3(I, lo, l, w))
+        return -1;
+    snprintf(w, sizeof w, "%s: hi", what);
+    if (get_vec3(I, hi, h, w))
+        return -1;
+    for (int i = 0; i < 3; i++)
+        if (!(h[i] > l[i]))
+            return err_at(I, NULL, ERR_VALUE, "%s: the box needs lo < hi on every axis (axis %d: %g, %g)", what, i,
+                          l[i], h[i]);
+    return 0;
+}
+
+/* Graph shorthands (constructors consume their arguments; NULL propagates). */
+static field *fadd(field *a, field *b) { return field_binary(FIELD_ADD, a, b); }
+static field *fsub(field *a, field *b) { return field_binary(FIELD_SUB, a, b); }
+static field *fmul(field *a, field *b) { return field_binary(FIELD_MUL, a, b); }
+static field *fref(field *f) { return f ? field_ref(f) : NULL; }
+
+/* s * f, without a multiplication when s is 1. */
+static field *fscaled(double s, field *f)
+{
+    if (s == 1)
+        return f;
+    return fmul(field_const(s), f);
+}
+
+/* The coordinate along a unit axis, dot(P - o, a); the bare coordinate
+ * node for a coordinate axis through the origin. */
+static field *axis_coord(const double a[3], const double o[3])
+{
+    field *s = NULL;
+    for (int i = 0; i < 3; i++) {
+        if (a[i] == 0)
+            continue;
+        field *c = field_coord(i);
+        if (o[i] != 0)
+            c = fsub(c, field_const(o[i]));
+        c = fscaled(a[i], c);
+        s = s ? fadd(s, c) : c;
+    }
+    return s;
+}
+
+/* warp(base, P + kD a): the linear perturbation along a unit axis (eq. (7)
+ * for a = +z). Consumes base and kd. */
+static field *warp_linear(field *base, field *kd, const double a[3])
+{
+    field *p[3];
+    for (int i = 0; i < 3; i++) {
+        p[i] = field_coord(i);
+        if (a[i] != 0)
+            p[i] = fadd(p[i], fscaled(a[i], fref(kd)));
+    }
+    field_unref(kd);
+    return field_warp(base, p[0], p[1], p[2]);
+}
+
+/* warp(base, P + kD u), u the unit vector from the line o + s a to P (0 on
+ * the line): the radial perturbation of wood. Consumes base and kd. */
+static field *warp_radial(field *base, field *kd, const double a[3], const double o[3])
+{
+    field *d[3], *q[3] = {NULL, NULL, NULL}, *p[3];
+    for (int i = 0; i < 3; i++) {
+        d[i] = field_coord(i);
+        if (o[i] != 0)
+            d[i] = fsub(d[i], field_const(o[i]));
+    }
+    /* q = (P - o) - ((P - o) . a) a, the part of P - o across the axis;
+     * along a coordinate axis it is just the other two components. */
+    int j = -1;
+    for (int i = 0; i < 3; i++)
+        if (fabs(a[i]) == 1)
+            j = i;
+    if (j >= 0) {
+        for (int i = 0; i < 3; i++)
+            q[i] = i == j ? NULL : d[i];
+        field_unref(d[j]);
+    } else {
+        field *t = NULL;
+        for (int i = 0; i < 3; i++)
+            if (a[i] != 0) {
+                field *c = fscaled(a[i], fref(d[i]));
+                t = t ? fadd(t, c) : c;
+            }
+        for (int i = 0; i < 3; i++)
+            q[i] = a[i] != 0 ? fsub(d[i], fscaled(a[i], fref(t))) : d[i];
+        field_unref(t);
+    }
+    field *r2 = NULL;
+    for (int i = 0; i < 3; i++)
+        if (i != j) {
+            field *sq = fmul(fref(q[i]), fref(q[i]));
+            r2 = r2 ? fadd(r2, sq) : sq;
+        }
+    field *r = field_unary(FIELD_SQRT, r2);
+    /* s = r > 0 ? kD / r : 0 */
+    field *s = field_select(field_binary(FIELD_GT, fref(r), field_const(0)), field_binary(FIELD_DIV, kd, r),
+                            field_const(0));
+    for (int i = 0; i < 3; i++)
+        p[i] = i == j ? field_coord(i) : fadd(field_coord(i), fmul(fref(s), q[i]));
+    field_unref(s);
+    return field_warp(base, p[0], p[1], p[2]);
+}
+
+/* k * D as a node (consumes nothing; NULL with an error on failure). */
+static field *kd_node(interp *I, value fluct, double k, const char *what)
+{
+    field *d = lang_to_field(I, fluct, what);
+    if (!d)
+        return NULL;
+    field *kd = fscaled(k, d);
+    if (!kd)
+        err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
+    return kd;
+}
+
+static int check_k(interp *I, double k, const char *what)
+{
+    if (!isfinite(k))
+        return err_at(I, NULL, ERR_VALUE, "%s: k must be a finite number, got %g", what, k);
+    return 0;
+}
+
+/* A compiled texture program for (texture - lo) / (hi - lo). */
+static int texture_prog(interp *I, value v, double lo, double hi, field **tmp, field_prog **own,
+                        const field_prog **prog, const char *who, const char *what)
+{
+    if (!(hi > lo) || !isfinite(lo) || !isfinite(hi))
+        return err_at(I, NULL, ERR_VALUE, "%s: the palette range needs finite lo < hi, got %g and %g", who, lo, hi);
+    if (lo == 0 && hi == 1)
+        return lang_field_fn(I, v, tmp, own, prog, what);
+    *tmp = NULL;
+    *own = NULL;
+    field *f = lang_to_field(I, v, what);
+    if (!f)
+        return -1;
+    f = field_affine(f, 1.0 / (hi - lo), -lo / (hi - lo));
+    if (!f)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
+    rt_error e;
+    *own = field_compile(f, &e);
+    if (!*own) {
+        field_unref(f);
+        return lang_rt_error(I, e.code, &e, what);
+    }
+    *tmp = f;
+    *prog = *own;
+    return 0;
+}
+
+/* ---- fractal: D(P) as a field --------------------------------------------------------- */
+
+typedef struct frac_ctx {
+    mpd m;
+    double lo[3], ext[3]; /* world box: P -> (P - lo) / ext */
+    int unit;             /* the box is the unit cube: no mapping */
+    interp *I;
+    size_t reserved;      /* bytes reserved from the interpreter's budget */
+} frac_ctx;
+
+static void frac_fn(const void *ctx, size_t n, const double *x, const double *y, const double *z, double *out)
+{
+    const frac_ctx *c = ctx;
+    if (c->unit) {
+        mpd_eval(&c->m, n, x, y, z, out);
+        return;
+    }
+    double u[RT_BLOCK], v[RT_BLOCK], w[RT_BLOCK];
+    for (size_t s = 0; s < n; s += RT_BLOCK) {
+        size_t k = n - s < RT_BLOCK ? n - s : RT_BLOCK;
+        for (size_t i = 0; i < k; i++) {
+            u[i] = (x[s + i] - c->lo[0]) / c->ext[0];
+            v[i] = (y[s + i] - c->lo[1]) / c->ext[1];
+            w[i] = (z[s + i] - c->lo[2]) / c->ext[2];
+        }
+        mpd_eval(&c->m, k, u, v, w, out + s);
+    }
+}
+
+static void frac_release(void *ctx)
+{
+    frac_ctx *c = ctx;
+    mpd_free(&c->m);
+    mem_release(c->I, c->reserved);
+    free(c);
+}
+
+static const char *roman[5] = {"auto", "I", "II", "III", "IV"};
+
+/* Largest R2 <= R whose Type I array (4 (2^R2+1)^3 bytes) fits in limit; -1 if none. */
+static int largest_r2(int R, size_t limit)
+{
+    int best = -1;
+    for (int r2 = 0; r2 <= R; r2++)
+        if (mpd_type1_bytes(r2) && mpd_type1_bytes(r2) <= limit)
+            best = r2;
+    return best;
+}
+
+static int get_R(interp *I, value v, int *R, const char *what)
+{
+    if (v.k != V_NUM || v.u.n != floor(v.u.n) || v.u.n < 1 || v.u.n > MPD_MAX_R)
+        return err_at(I, NULL, ERR_VALUE, "%s: R = %g is out of range (expected a whole number 1 .. %d)", what,
+                      v.u.n, MPD_MAX_R);
+    *R = (int)v.u.n;
+    return 0;
+}
+
+static int b_fractal(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "fractal";
+    mpd_params p;
+    mpd_params_default(&p);
+    if (get_R(I, a[0], &p.R, W))
+        return -1;
+    p.beta = a[1].u.n;
+    if (!isfinite(p.beta))
+        return err_at(I, NULL, ERR_VALUE, "fractal: beta = %g is not a finite number", p.beta);
+    if (get_seed(I, a[2], &p.seed, W))
+        return -1;
+    if (a[3].k == V_NUM) {
+        for (int i = 0; i < 8; i++)
+            p.corner[i] = a[3].u.n;
+    } else if (a[3].k != V_NIL && get_vec(I, a[3], p.corner, 8, "fractal: corners")) {
+        return -1;
+    }
+    for (int i = 0; i < 8; i++)
+        if (!isfinite(p.corner[i]))
+            return err_at(I, NULL, ERR_VALUE, "fractal: corner %d = %g is not a finite number", i, p.corner[i]);
+    int type = -1;
+    if (a[4].k == V_STR && strcmp(AS_STR(a[4])->s, "auto") == 0)
+        type = MPD_AUTO;
+    else if (a[4].k == V_NUM && a[4].u.n == floor(a[4].u.n) && a[4].u.n >= 1 && a[4].u.n <= 4)
+        type = (int)a[4].u.n;
+    if (type < 0) {
+        if (a[4].k == V_STR)
+            return err_at(I, NULL, ERR_VALUE,
+                          "fractal: strategy must be \"auto\" or 1, 2, 3, 4 (Types I-IV), got \"%s\"", AS_STR(a[4])->s);
+        return err_at(I, NULL, ERR_VALUE, "fractal: strategy must be \"auto\" or 1, 2, 3, 4 (Types I-IV), got %g",
+                      a[4].u.n);
+    }
+    int R2 = -1;
+    if (a[5].k != V_NIL) {
+        if (type != MPD_AUTO && type != MPD_TYPE4)
+            return err_at(I, NULL, ERR_VALUE, "fractal: R2 is only used by Type IV (strategy: 4), not Type %s",
+                          roman[type]);
+        if (a[5].u.n != floor(a[5].u.n) || a[5].u.n < 0 || a[5].u.n > p.R)
+            return err_at(I, NULL, ERR_VALUE, "fractal: R2 = %g is out of range (expected a whole number 0 .. R = %d)",
+                          a[5].u.n, p.R);
+        R2 = (int)a[5].u.n;
+        type = MPD_TYPE4;
+    }
+    double lo[3], hi[3];
+    if (get_box(I, a[6], a[7], lo, hi, W))
+        return -1;
+
+    /* The automatic strategy: Type I when its array fits the budget, else
+     * Type IV with the largest array that does (Type III if none). */
+    size_t maxmem = I->lim.max_memory;
+    size_t budget = AUTO_BUDGET < maxmem ? AUTO_BUDGET : maxmem;
+    if (type == MPD_AUTO) {
+        if (mpd_type1_bytes(p.R) <= budget) {
+            type = MPD_TYPE1;
+        } else {
+            R2 = largest_r2(p.R, budget);
+            type = R2 >= 0 ? MPD_TYPE4 : MPD_TYPE3;
+        }
+    }
+    if (type == MPD_TYPE4 && R2 < 0)
+        R2 = largest_r2(p.R, budget) < 0 ? 0 : largest_r2(p.R, budget);
+    p.type = type;
+    p.R2 = R2;
+    p.mem_limit = maxmem;
+    p.budget = budget;
+    size_t bytes = type == MPD_TYPE1 ? mpd_type1_bytes(p.R) : type == MPD_TYPE4 ? mpd_type1_bytes(R2) : 0;
+    /* Arrays beyond --max-memory are refused by mpd_init with a message that
+     * names the strategy that fits; within it, reserve before allocating. */
+    size_t reserved = 0;
+    if (bytes && bytes <= maxmem) {
+        char what[64];
+        snprintf(what, sizeof what, "fractal: the Type %s array", roman[type]);
+        if (mem_reserve(I, (double)bytes, what))
+            return -1;
+        reserved = bytes;
+    }
+    frac_ctx *c = calloc(1, sizeof *c);
+    if (!c) {
+        mem_release(I, reserved);
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    }
+    rt_run run = lang_run(I);
+    rt_error e;
+    rt_code rc = mpd_init(&c->m, &p, &run, &e);
+    if (rc) {
+        free(c);
+        mem_release(I, reserved);
+        if (rc == RT_EINVAL && bytes > maxmem) /* the array is over --max-memory */
+            return err_at(I, NULL, ERR_LIMIT, "fractal: %s (the limit is --max-memory)", e.msg);
+        return lang_rt_error(I, rc, &e, W);
+    }
+    c->I = I;
+    c->reserved = reserved;
+    c->unit = 1;
+    for (int i = 0; i < 3; i++) {
+        c->lo[i] = lo[i];
+        c->ext[i] = hi[i] - lo[i];
+        if (lo[i] != 0 || hi[i] != 1)
+            c->unit = 0;
+    }
+    char name[32];
+    if (c->m.type == MPD_TYPE4)
+        snprintf(name, sizeof name, "fractal(R %d, IV, R2 %d)", c->m.R, c->m.R2);
+    else
+        snprintf(name, sizeof name, "fractal(R %d, %s)", c->m.R, roman[c->m.type]);
+    return lang_field_value(I, field_external(frac_fn, c, frac_release, name), out);
+}
+
+static int rec_num(interp *I, value r, const char *key, double v)
+{
+    return rec_set(I, AS_REC(r), intern(I, key, strlen(key)), val_num(v));
+}
+
+/* fractal_memory(R, R2): the bytes each strategy needs, as this
+ * implementation uses them. */
+static int b_fractal_memory(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    int R;
+    if (get_R(I, a[0], &R, "fractal_memory"))
+        return -1;
+    int R2;
+    if (a[1].k == V_NIL) {
+        R2 = largest_r2(R, AUTO_BUDGET < I->lim.max_memory ? AUTO_BUDGET : I->lim.max_memory);
+        if (R2 < 0)
+            R2 = 0;
+    } else {
+        if (a[1].u.n != floor(a[1].u.n) || a[1].u.n < 0 || a[1].u.n > R)
+            return err_at(I, NULL, ERR_VALUE,
+                          "fractal_memory: R2 = %g is out of range (expected a whole number 0 .. R = %d)", a[1].u.n, R);
+        R2 = (int)a[1].u.n;
+    }
+    value r = val_rec(I);
+    if (r.k == V_NIL)
+        return -1;
+    double n1 = ldexp(1.0, R) + 1;
+    if (rec_num(I, r, "type1", 4.0 * n1 * n1 * n1) || rec_num(I, r, "type3", (double)mpd_path_bytes(R)) ||
+        rec_num(I, r, "type4", (double)mpd_type4_bytes(R, R2)) || rec_num(I, r, "R2", R2) ||
+        rec_num(I, r, "nodes", n1 * n1 * n1)) {
+        val_unref(I, r);
+        return -1;
+    }
+    *out = r;
+    return 0;
+}
+
+/* ---- base functions and perturbation ------------------------------------------------- */
+
+static int b_marble(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    vlist *t = AS_LIST(a[0]);
+    if (t->n < 1 || t->n > SOLID_MAX_LAYERS)
+        return err_at(I, NULL, ERR_VALUE, "marble: layers must be a table of 1 to %d rows `c w alpha`, got %zu rows",
+                      SOLID_MAX_LAYERS, t->n);
+    solid_marble *m = calloc(1, sizeof *m);
+    if (!m)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    m->n = (int)t->n;
+    for (size_t i = 0; i < t->n; i++) {
+        value row = t->items[i];
+        double v[3];
+        if (row.k != V_LIST || AS_LIST(row)->n != 3) {
+            free(m);
+            return err_at(I, NULL, ERR_VALUE, "marble: layer %zu must be a row `c w alpha` of 3 numbers, got %s", i + 1,
+                          row.k == V_LIST ? "a row of another length" : val_type_name(row));
+        }
+        char w[48];
+        snprintf(w, sizeof w, "marble: layer %zu", i + 1);
+        if (get_vec(I, row, v, 3, w)) {
+            free(m);
+            return -1;
+        }
+        m->layer[i].c = v[0];
+        m->layer[i].w = v[1];
+        m->layer[i].alpha = v[2];
+    }
+    rt_error e;
+    double ax[3];
+    if (solid_marble_check(m, &e)) {
+        free(m);
+        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
+    }
+    if (check_k(I, a[2].u.n, "marble") || get_axis(I, a[3], ax, "marble: axis")) {
+        free(m);
+        return -1;
+    }
+    field *g = field_external(solid_marble_fn, m, free, "marble");
+    if (!g)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
+    /* G is a function of z; the layers lie across `axis`: evaluate it at
+     * z := P . a (+ k D(P): eq. (7) along the axis). */
+    static const double zero[3] = {0, 0, 0};
+    field *s = axis_coord(ax, zero);
+    if (a[1].k != V_NIL) {
+        field *kd = kd_node(I, a[1], a[2].u.n, "marble: fluct");
+        if (!kd) {
+            field_unref(g);
+            field_unref(s);
+            return -1;
+        }
+        s = fadd(s, kd);
+    } else if (ax[2] == 1) {
+        field_unref(s);
+        return lang_field_value(I, g, out);
+    }
+    return lang_field_value(I, field_warp(g, field_coord(0), field_coord(1), s), out);
+}
+
+static int b_wood(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    solid_wood *w = calloc(1, sizeof *w);
+    if (!w)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+    w->spacing = a[0].u.n;
+    w->sharpness = a[1].u.n;
+    rt_error e;
+    if (get_axis(I, a[2], w->axis, "wood: axis") || get_vec3(I, a[3], w->origin, "wood: origin") ||
+        check_k(I, a[5].u.n, "wood")) {
+        free(w);
+        return -1;
+    }
+    if (solid_wood_check(w, &e)) {
+        free(w);
+        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
+    }
+    double ax[3], o[3];
+    memcpy(ax, w->axis, sizeof ax);
+    memcpy(o, w->origin, sizeof o);
+    field *g = field_external(solid_wood_fn, w, free, "wood");
+    if (!g)
+        return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
+    if (a[4].k == V_NIL)
+        return lang_field_value(I, g, out);
+    field *kd = kd_node(I, a[4], a[5].u.n, "wood: fluct");
+    if (!kd) {
+        field_unref(g);
+        return -1;
+    }
+    return lang_field_value(I, warp_radial(g, kd, ax, o), out);
+}
+
+static int b_perturb(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double ax[3], o[3];
+    const char *mode = AS_STR(a[3])->s;
+    int radial = strcmp(mode, "radial") == 0;
+    if (!radial && strcmp(mode, "linear") != 0)
+        return err_at(I, NULL, ERR_VALUE, "perturb: mode must be \"linear\" or \"radial\", got \"%s\"", mode);
+    if (check_k(I, a[2].u.n, "perturb") || get_axis(I, a[4], ax, "perturb: axis") ||
+        get_vec3(I, a[5], o, "perturb: origin"))
+        return -1;
+    field *base = lang_to_field(I, a[0], "perturb: base");
+    if (!base)
+        return -1;
+    field *kd = kd_node(I, a[1], a[2].u.n, "perturb: fluct");
+    if (!kd) {
+        field_unref(base);
+        return -1;
+    }
+    return lang_field_value(I, radial ? warp_radial(base, kd, ax, o) : warp_linear(base, kd, ax), out);
+}
+
+/* ---- textured objects and slices ------------------------------------------------------ */
+
+static int b_textured(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "textured";
+    texobj_shape s;
+    memset(&s, 0, sizeof s);
+    const char *obj = AS_STR(a[1])->s;
+    static const char *kinds[4] = {"sphere", "cube", "cylinder", "plane"};
+    s.kind = -1;
+    for (int i = 0; i < 4; i++)
+        if (strcmp(obj, kinds[i]) == 0)
+            s.kind = i;
+    if (s.kind < 0)
+        return err_at(I, NULL, ERR_VALUE,
+                      "textured: object must be \"sphere\", \"cube\", \"cylinder\" or \"plane\", got \"%s\"", obj);
+    camera cam;
+    int w, h;
+    ramp r;
+    if (lang_get_camera(I, a[2], &cam, W) || get_size2(I, a[3], &w, &h, "textured: size") ||
+        lang_get_ramp(I, a[4], &r, "textured: palette") || get_vec3(I, a[7], s.center, "textured: center") ||
+        get_vec3(I, a[10], s.normal, "textured: normal"))
+        return -1;
+    s.radius = a[8].u.n;
+    s.height = a[9].u.n;
+    rt_error e;
+    if (texobj_shape_check(&s, &e))
+        return err_at(I, NULL, ERR_VALUE, "textured: %s", e.msg);
+    texobj_opts o;
+    texobj_opts_default(&o);
+    if (get_vec3(I, a[11], o.light, "textured: light"))
+        return -1;
+    if (o.light[0] == 0 && o.light[1] == 0 && o.light[2] == 0)
+        return err_at(I, NULL, ERR_VALUE, "textured: light (0, 0, 0) has no direction");
+    o.ambient = a[12].u.n;
+    o.diffuse = a[13].u.n;
+    if (!(o.ambient >= 0 && o.ambient <= 1) || !(o.diffuse >= 0 && o.diffuse <= 1))
+        return err_at(I, NULL, ERR_VALUE, "textured: ambient = %g and diffuse = %g must be between 0 and 1", o.ambient,
+                      o.diffuse);
+    if (lang_get_colour(I, a[14], o.background, "textured: background"))
+        return -1;
+    long ss;
+    if (get_int(I, a[15], 1, 8, &ss, "textured: supersample"))
+        return -1;
+    o.samples = (int)ss;
+    field *tmp;
+    field_prog *own;
+    const field_prog *prog;
+    if (texture_prog(I, a[0], a[5].u.n, a[6].u.n, &tmp, &own, &prog, W, "textured: texture"))
+        return -1;
+    image *im;
+    value res;
+    if (lang_image_new(I, w, h, &im) || lang_image_value(I, im, &res)) {
+        lang_field_fn_done(tmp, own);
+        return -1;
+    }
+    texobj_source src = {.field = field_prog_fn, .field_ctx = prog, .ramp = &r};
+    rt_run run = lang_run(I);
+    rt_code rc = texobj_render(&s, &cam, &src, &o, &run, im, NULL, &e);
+    lang_field_fn_done(tmp, own);
+    if (rc) {
+        val_unref(I, res);
+        return lang_rt_error(I, rc, &e, W);
+    }
+    *out = res;
+    return 0;
+}
+
+static int b_slice_plane(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double o[3], u[3], v[3];
+    int w, h;
+    ramp r;
+    if (get_vec3(I, a[1], o, "slice_plane: origin") || get_vec3(I, a[2], u, "slice_plane: u") ||
+        get_vec3(I, a[3], v, "slice_plane: v") || get_size2(I, a[4], &w, &h, "slice_plane: size") ||
+        lang_get_ramp(I, a[5], &r, "slice_plane: palette"))
+        return -1;
+    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    if (c[0] == 0 && c[1] == 0 && c[2] == 0)
+        return err_at(I, NULL, ERR_VALUE,
+                      "slice_plane: u and v must span a plane, got [%g, %g, %g] and [%g, %g, %g] (zero or parallel)",
+                      u[0], u[1], u[2], v[0], v[1], v[2]);
+    field *tmp;
+    field_prog *own;
+    const field_prog *prog;
+    if (texture_prog(I, a[0], a[6].u.n, a[7].u.n, &tmp, &own, &prog, "slice_plane", "slice_plane: field"))
+        return -1;
+    image *im;
+    value res;
+    if (lang_image_new(I, w, h, &im) || lang_image_value(I, im, &res)) {
+        lang_field_fn_done(tmp, own);
+        return -1;
+    }
+    rt_run run = lang_run(I);
+    rt_error e;
+    rt_code rc = texobj_slice(field_prog_fn, prog, &r, o, u, v, &run, im, &e);
+    lang_field_fn_done(tmp, own);
+    if (rc) {
+        val_unref(I, res);
+        return lang_rt_error(I, rc, &e, "slice_plane");
+    }
+    *out = res;
+    return 0;
+}
+
+/* ---- registration --------------------------------------------------------------------- */
+
+static const bparam p_fractal[] = {{"R", "num", "8"},          {"beta", "num", "0.5"},
+                                   {"seed", "num", "nil"},     {"corners", "vec|num", "nil"},
+                                   {"strategy", "str|num", "\"auto\""}, {"R2", "num", "nil"},
+                                   {"lo", "vec", "[-1, -1, -1]"}, {"hi", "vec", "[1, 1, 1]"}};
+static const bparam p_fmem[] = {{"R", "num", NULL}, {"R2", "num", "nil"}};
+static const bparam p_marble[] = {{"layers", "list", NULL},
+                                  {"fluct", "num|field|volume", "nil"},
+                                  {"k", "num", "0.1"},
+                                  {"axis", "str|vec", "\"z\""}};
+static const bparam p_wood[] = {{"spacing", "num", "0.1"},       {"sharpness", "num", "1"},
+                                {"axis", "str|vec", "\"z\""},    {"origin", "vec", "[0, 0, 0]"},
+                                {"fluct", "num|field|volume", "nil"}, {"k", "num", "0.02"}};
+static const bparam p_perturb[] = {{"base", "num|field|volume", NULL}, {"fluct", "num|field|volume", NULL},
+                                   {"k", "num", "0.1"},                {"mode", "str", "\"linear\""},
+                                   {"axis", "str|vec", "\"z\""},       {"origin", "vec", "[0, 0, 0]"}};
+static const bparam p_textured[] = {
+    {"texture", "num|field|volume", NULL}, {"object", "str", "\"sphere\""}, {"camera", "rec", "orbit()"},
+    {"size", "vec|num", "[256, 256]"},     {"palette", "list", "nil"},      {"lo", "num", "0"},
+    {"hi", "num", "1"},                    {"center", "vec", "[0, 0, 0]"},  {"radius", "num", "1"},
+    {"height", "num", "2"},                {"normal", "vec", "[0, 0, 1]"},  {"light", "vec", "[1, 1, 1]"},
+    {"ambient", "num", "0.2"},             {"diffuse", "num", "0.8"},       {"background", "any", "0"},
+    {"supersample", "num", "1"}};
+static const bparam p_slice_plane[] = {{"field", "num|field|volume", NULL}, {"origin", "vec", "[0, 0, 0]"},
+                                       {"u", "vec", "[1, 0, 0]"},           {"v", "vec", "[0, 1, 0]"},
+                                       {"size", "vec|num", "[256, 256]"},   {"palette", "list", "nil"},
+                                       {"lo", "num", "0"},                  {"hi", "num", "1"}};
+
+static const builtin solid_builtins[] = {
+    BUILTIN("fractal", b_fractal, p_fractal,
+            "The 3-D random fractal D(P) of seed 000 (midpoint displacement to level R, L(n) = exp(-(n-1) beta)) "
+            "as a field over the box lo..hi, trilinear between lattice nodes. strategy: \"auto\", 1 (Type I: whole "
+            "array), 2 (Type II: memoised parents), 3 (Type III: octree descent), 4 (Type IV: array to level R2, "
+            "descent below); all give identical values. corners: 8 numbers (index x + 2y + 4z) or one."),
+    BUILTIN("fractal_memory", b_fractal_memory, p_fmem,
+            "Bytes each strategy needs at level R: {type1, type3, type4, R2, nodes} (Type IV with array level R2; "
+            "default: the automatic choice)."),
+    BUILTIN("marble", b_marble, p_marble,
+            "Marble layers of seed 000 eq. (6): G = sum of exp(-alpha d) (1 inside a layer), d = |z - c| - w/2, "
+            "one table row `c w alpha` per layer, across `axis`; with fluct, evaluated at z + k D(P) (eq. (7))."),
+    BUILTIN("wood", b_wood, p_wood,
+            "Wood rings around the line through origin along axis: ((1 - cos(2 pi r / spacing)) / 2)^sharpness; "
+            "with fluct, the radius is displaced by k D(P)."),
+    BUILTIN("perturb", b_perturb, p_perturb,
+            "The perturbation P' = F(P, D(P)) of any base field: mode \"linear\" moves P by k D along axis "
+            "(eq. (7) for \"z\"), \"radial\" away from the line through origin along axis."),
+    BUILTIN("textured", b_textured, p_textured,
+            "An image of a sphere, cube, cylinder or plane cut out of a solid texture, seen by a camera: the "
+            "texture is evaluated only at the visible surface points, mapped from lo..hi through the palette, "
+            "and shaded by one directional light."),
+    BUILTIN("slice_plane", b_slice_plane, p_slice_plane,
+            "An image of the plane through origin spanned by u (right) and v (up), half sides; the field mapped "
+            "from lo..hi through the palette."),
+};
 
 int bind_solid_init(interp *I)
 {
-    (void)I;
-    return 0;
+    return builtins_register(I, solid_builtins, (int)(sizeof solid_builtins / sizeof solid_builtins[0]));
 }
