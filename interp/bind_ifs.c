@@ -134,7 +134,7 @@ static int map_arith(interp *I, int op, value a, value b, value *out)
 }
 
 /* A map from a table row in one of the literature's column orders. */
-static int row_to_map(interp *I, value row, affine *m, double *p, int *has_p, int index)
+static int row_to_map(interp *I, value row, affine *m, double *p, int *has_p, int index, const char *fn)
 {
     double r[13];
     size_t n = row.k == V_LIST ? AS_LIST(row)->n : 0;
@@ -142,9 +142,9 @@ static int row_to_map(interp *I, value row, affine *m, double *p, int *has_p, in
     snprintf(what, sizeof what, "row %d", index + 1);
     if (n != 6 && n != 7 && n != 12 && n != 13)
         return err_at(I, NULL, ERR_VALUE,
-                      "row %d has %zu numbers; a map row has 6 or 7 (2-D: a b c d e f [p]) or 12 or 13 (3-D: "
+                      "%s: row %d has %zu numbers; a map row has 6 or 7 (2-D: a b c d e f [p]) or 12 or 13 (3-D: "
                       "a b c d e f g h i j k l [p])",
-                      index + 1, n);
+                      fn, index + 1, n);
     if (get_vec(I, row, r, n, what))
         return -1;
     if (n <= 7) {
@@ -200,7 +200,7 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         if (m) {
             (*maps)[i] = *m;
             (*p)[i] = 0;
-        } else if (row_to_map(I, l->items[i], &(*maps)[i], &(*p)[i], &has, (int)i)) {
+        } else if (row_to_map(I, l->items[i], &(*maps)[i], &(*p)[i], &has, (int)i, what)) {
             free(*maps);
             free(*p);
             *maps = NULL;
@@ -210,12 +210,13 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         all_p &= has;
         any_p |= has;
         if ((*maps)[i].dim != (*maps)[0].dim) {
+            int di = (*maps)[i].dim, d0 = (*maps)[0].dim;
             free(*maps);
             free(*p);
             *maps = NULL;
             *p = NULL;
-            return err_at(I, NULL, ERR_VALUE, "%s: row %zu is a %d-D map but row 1 is %d-D", what, i + 1,
-                          (*maps)[i].dim, (*maps)[0].dim);
+            return err_at(I, NULL, ERR_VALUE, "%s: row %zu is a %d-D map but row 1 is %d-D", what, i + 1, di,
+                          d0);
         }
     }
     if (any_p && !all_p) {
@@ -803,11 +804,13 @@ static int b_points(interp *I, value *a, int n, value *out)
         mem_release(I, (size_t)(o.points * 28));
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
+    mesh_init(m, 0, o.colour != CHAOS_COLOUR_NONE);
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c = chaos_points(&s, &o, m, &run, &e);
     mem_release(I, (size_t)(o.points * 28));
     if (c) {
+        mesh_free(m);
         free(m);
         return lang_rt_error(I, c, &e, "points");
     }

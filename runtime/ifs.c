@@ -185,7 +185,7 @@ rt_code ifs_build(ifs *out, const affine *maps, int n, const double *p, int flag
         if (!(fabs(sum - 1) <= IFS_SUM_TOL) && !(flags & IFS_NORMALISE)) {
             free(q);
             return rt_fail(e, RT_EINVAL,
-                           "probabilities sum to %.10g, not 1 (use normalise to rescale them)", sum);
+                           "probabilities sum to %.10g, not 1 (use normalize: true to rescale them)", sum);
         }
         if (!(sum > 0)) {
             free(q);

@@ -32,7 +32,7 @@ static void test_ifs_validation(void)
 
     double p97[3] = {0.3, 0.3, 0.37};
     expect_msg(ifs_build(&f, m, 3, p97, 0, &e), &e,
-               "probabilities sum to 0.97, not 1 (use normalise to rescale them)", "sum");
+               "probabilities sum to 0.97, not 1 (use normalize: true to rescale them)", "sum");
     /* normalise: 0.3/0.97 etc. */
     CHECK(ifs_build(&f, m, 3, p97, IFS_NORMALISE, &e) == RT_OK, "normalise: %s", e.msg);
     CHECK_NEAR(f.p[2], 0.37 / 0.97, 1e-15, "normalised p3");
