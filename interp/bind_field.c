@@ -241,18 +241,6 @@ static int fv_arith(interp *I, int op, value a, value b, value *out)
 /* A DMF works on numbers (computed now) or fields (a node). */
 typedef double (*dmf_num)(double p, double t);
 
-static int seed_arg(interp *I, value v, uint64_t *seed)
-{
-    if (v.k == V_NIL) {
-        *seed = I->seed;
-        return 0;
-    }
-    if (v.k != V_NUM || v.u.n != floor(v.u.n) || v.u.n < 0)
-        return err_at(I, NULL, ERR_VALUE, "seed must be a whole number ≥ 0");
-    *seed = (uint64_t)v.u.n;
-    return 0;
-}
-
 static int get_bounds(interp *I, value lo, value hi, double l[3], double h[3], const char *what)
 {
     char w[128];
@@ -369,7 +357,7 @@ static int b_perlin(interp *I, value *a, int n, value *out)
 {
     (void)n;
     uint64_t seed;
-    if (seed_arg(I, a[1], &seed))
+    if (arg_seed(I, a[1], &seed, "perlin"))
         return -1;
     return noise_common(I, field_perlin(seed), a[0].u.n, out);
 }
@@ -388,7 +376,7 @@ static int b_fbm(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct, "fbm: octaves") || seed_arg(I, a[4], &seed))
+    if (octaves_arg(I, a[0], &oct, "fbm: octaves") || arg_seed(I, a[4], &seed, "fbm"))
         return -1;
     return noise_common(I, field_fbm(seed, oct, a[2].u.n, a[3].u.n), a[1].u.n, out);
 }
@@ -398,7 +386,7 @@ static int b_turbulence(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct, "turbulence: octaves") || seed_arg(I, a[2], &seed))
+    if (octaves_arg(I, a[0], &oct, "turbulence: octaves") || arg_seed(I, a[2], &seed, "turbulence"))
         return -1;
     return noise_common(I, field_turbulence(seed, oct), a[1].u.n, out);
 }

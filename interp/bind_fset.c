@@ -273,19 +273,6 @@ static const lang_order *as_order(value v)
     return v.k == V_OBJ && AS_OBJ(v)->cls == &order_class ? AS_OBJ(v)->payload : NULL;
 }
 
-static int seed_arg(interp *I, value v, uint64_t *seed, const char *what)
-{
-    if (v.k == V_NIL) {
-        *seed = I->seed;
-        return 0;
-    }
-    if (v.k != V_NUM || !(v.u.n >= 0) || v.u.n != floor(v.u.n) || v.u.n > 1.8e19)
-        return err_at(I, NULL, ERR_VALUE, "%s: seed must be a whole number >= 0, got %g", what,
-                      v.k == V_NUM ? v.u.n : NAN);
-    *seed = (uint64_t)v.u.n;
-    return 0;
-}
-
 /* order(sequence, repeat, probabilities, seed) */
 static int b_order(interp *I, value *a, int n, value *out)
 {
@@ -316,7 +303,7 @@ static int b_order(interp *I, value *a, int n, value *out)
             free(o);
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         }
-        if (get_vec(I, pr, o->p, np, "order: probabilities") || seed_arg(I, a[3], &o->o.seed, "order")) {
+        if (get_vec(I, pr, o->p, np, "order: probabilities") || arg_seed(I, a[3], &o->o.seed, "order")) {
             order_destroy(o);
             return -1;
         }
@@ -458,20 +445,6 @@ static void shape_summary(const void *pp, bytebuf *out)
                    s->npoly == 1 ? "" : "s", closed, s->dim, detiter_length(s));
 }
 
-static int num_list(interp *I, const double *x, int n, value *out)
-{
-    value l = val_list(I, (size_t)n);
-    if (l.k == V_NIL)
-        return -1;
-    for (int i = 0; i < n; i++)
-        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
-            val_unref(I, l);
-            return -1;
-        }
-    *out = l;
-    return 0;
-}
-
 static int shape_get(interp *I, const void *pp, const char *name, value *out)
 {
     const detiter_shape *s = pp;
@@ -490,7 +463,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
         b[1] = hi[0];
         b[2] = lo[1];
         b[3] = hi[1];
-        return num_list(I, b, 4, out);
+        return num_list_value(I, b, (size_t)(4), out);
     } else if (strcmp(name, "coords") == 0) {
         if ((double)s->nverts > I->lim.max_list)
             return err_at(I, NULL, ERR_LIMIT, "shape.coords: %zu vertices exceed the list limit of %.0f (raise it with --max-list)",
@@ -500,7 +473,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
             return -1;
         for (size_t i = 0; i < s->nverts; i++) {
             value p;
-            if (num_list(I, s->v + i * (size_t)s->dim, s->dim, &p) || list_push(I, AS_LIST(l), p)) {
+            if (num_list_value(I, s->v + i * (size_t)s->dim, (size_t)(s->dim), &p) || list_push(I, AS_LIST(l), p)) {
                 val_unref(I, l);
                 return -1;
             }
@@ -769,21 +742,6 @@ done:
 
 /* ---- drawing --------------------------------------------------------------------------- */
 
-static int size_arg(interp *I, value v, int *w, int *h, const char *what)
-{
-    double s[2];
-    if (v.k == V_NUM)
-        s[0] = s[1] = v.u.n;
-    else if (get_vec(I, v, s, 2, what))
-        return -1;
-    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels from 1 to 1000000, got %g×%g", what, s[0],
-                      s[1]);
-    *w = (int)s[0];
-    *h = (int)s[1];
-    return 0;
-}
-
 static int window_arg(interp *I, value v, double lo[2], double hi[2], const char *what)
 {
     double win[4];
@@ -873,7 +831,7 @@ static int b_draw(interp *I, value *a, int n, value *out)
     if (onto) {
         w = onto->w;
         h = onto->h;
-    } else if (size_arg(I, a[1], &w, &h, "draw: size"))
+    } else if (arg_size2(I, a[1], &w, &h, "draw: size"))
         return -1;
     if (lang_get_colour(I, a[3], col, "draw: colour") || fill_arg(I, a[6], &fill, fillc, col, "draw: fill") ||
         lang_get_colour(I, a[7], bg, "draw: background"))
@@ -1127,8 +1085,8 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     long depth, burn;
     if (order_arg(I, a[1], f->n, &o, &tmp, "chaos_fset"))
         goto done;
-    if (points_arg(I, a[2], &co.points, "chaos_fset") || size_arg(I, a[3], &w, &h, "chaos_fset: size") ||
-        tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || seed_arg(I, a[14], &co.seed, "chaos_fset") ||
+    if (points_arg(I, a[2], &co.points, "chaos_fset") || arg_size2(I, a[3], &w, &h, "chaos_fset: size") ||
+        tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || arg_seed(I, a[14], &co.seed, "chaos_fset") ||
         get_int(I, a[7], 0, 1000000, &burn, "chaos_fset: burn") || get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
         goto done;
     if (f->dim != 2) {
@@ -1248,10 +1206,10 @@ static int b_top(interp *I, value *a, int n, value *out)
     ramp r;
     float bg[4];
     long nsym;
-    if (size_arg(I, a[1], &w, &h, "top: size") || points_arg(I, a[2], &to.points, "top") ||
+    if (arg_size2(I, a[1], &w, &h, "top: size") || points_arg(I, a[2], &to.points, "top") ||
         lang_get_ramp(I, a[4], &r, "top: palette") || get_int(I, a[5], 1, 64, &nsym, "top: symbols") ||
         depth_arg(I, a[6], &to.depth, "top: depth") || lang_get_colour(I, a[7], bg, "top: background") ||
-        seed_arg(I, a[8], &to.seed, "top"))
+        arg_seed(I, a[8], &to.seed, "top"))
         return -1;
     if (li->f.dim != 2)
         return err_at(I, NULL, ERR_VALUE, "top: the IFS is 3-D; fractal tops need 2-D maps");
@@ -1310,13 +1268,13 @@ static int steal_args(interp *I, value *a, int k, steal_setup *s, int src_w, int
     memset(s, 0, sizeof *s);
     char wn[64];
     snprintf(wn, sizeof wn, "%s: size", what);
-    if (size_arg(I, a[k], &s->w, &s->h, wn) || points_arg(I, a[k + 1], &s->to.points, what))
+    if (arg_size2(I, a[k], &s->w, &s->h, wn) || points_arg(I, a[k + 1], &s->to.points, what))
         return -1;
     snprintf(wn, sizeof wn, "%s: background", what);
     if (lang_get_colour(I, a[k + 4], s->bg, wn))
         return -1;
     snprintf(wn, sizeof wn, "%s: depth", what);
-    if (depth_arg(I, a[k + 5], &s->to.depth, wn) || seed_arg(I, a[k + 6], &s->to.seed, what))
+    if (depth_arg(I, a[k + 5], &s->to.depth, wn) || arg_seed(I, a[k + 6], &s->to.seed, what))
         return -1;
     if (fi->f.n != gi->f.n)
         return err_at(I, NULL, ERR_VALUE,
@@ -1542,7 +1500,7 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     uint64_t pts;
     if (get_int(I, a[2], 1, 1024, &V, "superifs: V") || points_arg(I, a[3], &pts, "superifs") ||
         get_int(I, a[4], 0, 100000, &steps, "superifs: steps") || get_vec(I, a[5], so.start, 2, "superifs: start") ||
-        seed_arg(I, a[6], &so.seed, "superifs"))
+        arg_seed(I, a[6], &so.seed, "superifs"))
         goto done;
     if (f->dim != 2) {
         err_at(I, NULL, ERR_VALUE, "superifs: the IFSs are 3-D; a super IFS needs 2-D maps");
@@ -1620,7 +1578,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
     ramp r;
     tonemap_opts t;
     if (get_int(I, a[1], 1, s->st.V, &buf, "superifs_image: buffer") ||
-        size_arg(I, a[2], &w, &h, "superifs_image: size") ||
+        arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
         tone_args(I, a[4], a[5], a[6], a[7], a[8], &t, &r, "superifs_image"))
         return -1;
     double lo[2], hi[2];
@@ -1719,7 +1677,7 @@ static int b_tiling(interp *I, value *a, int n, value *out)
     (void)n;
     const image *t = lang_as_image(a[0]);
     int w, h;
-    if (size_arg(I, a[1], &w, &h, "tiling: size"))
+    if (arg_size2(I, a[1], &w, &h, "tiling: size"))
         return -1;
     if ((double)w * h > I->lim.max_pixels)
         return err_at(I, NULL, ERR_LIMIT,

@@ -42,25 +42,11 @@ static void map_summary(const void *p, bytebuf *out)
                        a->m[2][2], a->t[0], a->t[1], a->t[2], affine_contraction(a));
 }
 
-static int num_list(interp *I, const double *x, int n, value *out)
-{
-    value l = val_list(I, (size_t)n);
-    if (l.k == V_NIL)
-        return -1;
-    for (int i = 0; i < n; i++)
-        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
-            val_unref(I, l);
-            return -1;
-        }
-    *out = l;
-    return 0;
-}
-
 static int map_row(interp *I, const affine *a, value *out)
 {
     if (a->dim == 2) {
         double r[6] = {a->m[0][0], a->m[0][1], a->m[1][0], a->m[1][1], a->t[0], a->t[1]};
-        return num_list(I, r, 6, out);
+        return num_list_value(I, r, (size_t)(6), out);
     }
     double r[12];
     for (int i = 0; i < 3; i++)
@@ -68,7 +54,7 @@ static int map_row(interp *I, const affine *a, value *out)
             r[3 * i + j] = a->m[i][j];
     for (int i = 0; i < 3; i++)
         r[9 + i] = a->t[i];
-    return num_list(I, r, 12, out);
+    return num_list_value(I, r, (size_t)(12), out);
 }
 
 static int map_get(interp *I, const void *p, const char *name, value *out)
@@ -128,7 +114,7 @@ static int map_arith(interp *I, int op, value a, value b, value *out)
         if (get_vec(I, b, p, n, "point"))
             return -1;
         affine_apply(x, p, q);
-        return num_list(I, q, x->dim, out) ? -1 : 1;
+        return num_list_value(I, q, (size_t)(x->dim), out) ? -1 : 1;
     }
     return 0;
 }
@@ -267,7 +253,7 @@ static int ifs_get(interp *I, const void *p, const char *name, value *out)
         return 0;
     }
     if (strcmp(name, "probabilities") == 0)
-        return num_list(I, li->f.p, li->f.n, out);
+        return num_list_value(I, li->f.p, (size_t)(li->f.n), out);
     if (strcmp(name, "contraction") == 0)
         *out = val_num(li->f.max_contraction);
     else if (strcmp(name, "dim") == 0)
@@ -332,7 +318,7 @@ static int rifs_get(interp *I, const void *p, const char *name, value *out)
             free(pi);
             return lang_rt_error(I, e.code, &e, "stationary");
         }
-        int rc = num_list(I, pi, r->n, out);
+        int rc = num_list_value(I, pi, (size_t)(r->n), out);
         free(pi);
         return rc;
     }
@@ -569,32 +555,6 @@ static int points_arg(interp *I, value v, uint64_t *out, const char *what)
     return 0;
 }
 
-static int seed_of(interp *I, value v, uint64_t *seed)
-{
-    if (v.k == V_NIL) {
-        *seed = I->seed;
-        return 0;
-    }
-    if (v.k != V_NUM || v.u.n < 0 || v.u.n != floor(v.u.n))
-        return err_at(I, NULL, ERR_VALUE, "seed must be a whole number ≥ 0");
-    *seed = (uint64_t)v.u.n;
-    return 0;
-}
-
-static int size_arg(interp *I, value v, int *w, int *h, const char *what)
-{
-    double s[2];
-    if (v.k == V_NUM)
-        s[0] = s[1] = v.u.n;
-    else if (get_vec(I, v, s, 2, what))
-        return -1;
-    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels", what);
-    *w = (int)s[0];
-    *h = (int)s[1];
-    return 0;
-}
-
 static int colour_mode(interp *I, value v, chaos_colour *c, const char *what)
 {
     const char *s = v.k == V_STR ? AS_STR(v)->s : "";
@@ -622,9 +582,9 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     long ss;
     ramp r;
     if (lang_get_sys(I, a[0], &s, "chaos: system") || points_arg(I, a[1], &o.points, "chaos") ||
-        size_arg(I, a[2], &w, &h, "chaos: size") || colour_mode(I, a[4], &o.colour, "chaos") ||
+        arg_size2(I, a[2], &w, &h, "chaos: size") || colour_mode(I, a[4], &o.colour, "chaos") ||
         lang_get_ramp(I, a[5], &r, "chaos: palette") || get_int(I, a[10], 1, 8, &ss, "chaos: supersample") ||
-        seed_of(I, a[11], &o.seed))
+        arg_seed(I, a[11], &o.seed, NULL))
         return -1;
     if (sys_dim(&s) != 2)
         return err_at(I, NULL, ERR_VALUE,
@@ -718,7 +678,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
     memset(&o, 0, sizeof o);
     chaos_norm nm = CHAOS_NORM_TOTAL;
     if (lang_get_sys(I, a[0], &s, "measure: system") || points_arg(I, a[2], &o.points, "measure") ||
-        norm_arg(I, a[3], &nm, "measure") || seed_of(I, a[6], &o.seed))
+        norm_arg(I, a[3], &nm, "measure") || arg_seed(I, a[6], &o.seed, NULL))
         return -1;
     int dim = sys_dim(&s);
     double g[3];
@@ -794,7 +754,7 @@ static int b_points(interp *I, value *a, int n, value *out)
     ramp r;
     if (lang_get_sys(I, a[0], &s, "points: system") || points_arg(I, a[1], &o.points, "points") ||
         colour_mode(I, a[2], &o.colour, "points") || lang_get_ramp(I, a[3], &r, "points: palette") ||
-        seed_of(I, a[4], &o.seed))
+        arg_seed(I, a[4], &o.seed, NULL))
         return -1;
     o.ramp = &r;
     if (mem_reserve(I, (double)o.points * 28, "points: the point cloud"))
@@ -827,9 +787,9 @@ static int b_view(interp *I, value *a, int n, value *out)
     int w, h;
     ramp r;
     if (lang_get_sys(I, a[0], &s, "view: system") || lang_get_camera(I, a[1], &cam, "view") ||
-        size_arg(I, a[2], &w, &h, "view: size") || points_arg(I, a[3], &o.points, "view") ||
+        arg_size2(I, a[2], &w, &h, "view: size") || points_arg(I, a[3], &o.points, "view") ||
         colour_mode(I, a[4], &o.colour, "view") || lang_get_ramp(I, a[5], &r, "view: palette") ||
-        lang_get_colour(I, a[6], o.bg, "view: background") || seed_of(I, a[7], &o.seed))
+        lang_get_colour(I, a[6], o.bg, "view: background") || arg_seed(I, a[7], &o.seed, NULL))
         return -1;
     if (sys_dim(&s) != 3)
         return err_at(I, NULL, ERR_VALUE, "view: the system is 2-D; use chaos(…) to draw it");
@@ -955,12 +915,7 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    const char *p = AS_STR(a[0])->s;
-    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
-    if (p[0] == '/' || strcmp(dir, ".") == 0)
-        snprintf(path, sizeof path, "%s", p);
-    else
-        snprintf(path, sizeof path, "%s/%s", dir, p);
+    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
     fractint_list fl;
     rt_error e;
     rt_code c = fractint_load(path, &fl, &e);

@@ -25,33 +25,6 @@
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
-static int get_seed(interp *I, value v, uint64_t *seed, const char *what)
-{
-    if (v.k == V_NIL) {
-        *seed = I->seed;
-        return 0;
-    }
-    if (v.u.n < 0 || v.u.n > 9007199254740992.0 || v.u.n != floor(v.u.n))
-        return err_at(I, NULL, ERR_VALUE, "%s: seed must be a whole number >= 0, got %g", what, v.u.n);
-    *seed = (uint64_t)v.u.n;
-    return 0;
-}
-
-static int get_size2(interp *I, value v, int *w, int *h, const char *what)
-{
-    double s[2];
-    if (v.k == V_NUM)
-        s[0] = s[1] = v.u.n;
-    else if (get_vec(I, v, s, 2, what))
-        return -1;
-    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
-                      what, s[0], s[1]);
-    *w = (int)s[0];
-    *h = (int)s[1];
-    return 0;
-}
-
 static int get_vec3(interp *I, value v, double out[3], const char *what)
 {
     if (get_vec(I, v, out, 3, what))
@@ -308,7 +281,7 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     p.beta = a[1].u.n;
     if (!isfinite(p.beta))
         return err_at(I, NULL, ERR_VALUE, "fractal: beta = %g is not a finite number", p.beta);
-    if (get_seed(I, a[2], &p.seed, W))
+    if (arg_seed(I, a[2], &p.seed, W))
         return -1;
     if (a[3].k == V_NUM) {
         for (int i = 0; i < 8; i++)
@@ -584,7 +557,7 @@ static int b_textured(interp *I, value *a, int n, value *out)
     camera cam;
     int w, h;
     ramp r;
-    if (lang_get_camera(I, a[2], &cam, W) || get_size2(I, a[3], &w, &h, "textured: size") ||
+    if (lang_get_camera(I, a[2], &cam, W) || arg_size2(I, a[3], &w, &h, "textured: size") ||
         lang_get_ramp(I, a[4], &r, "textured: palette") || get_vec3(I, a[7], s.center, "textured: center") ||
         get_vec3(I, a[10], s.normal, "textured: normal"))
         return -1;
@@ -640,7 +613,7 @@ static int b_slice_plane(interp *I, value *a, int n, value *out)
     int w, h;
     ramp r;
     if (get_vec3(I, a[1], o, "slice_plane: origin") || get_vec3(I, a[2], u, "slice_plane: u") ||
-        get_vec3(I, a[3], v, "slice_plane: v") || get_size2(I, a[4], &w, &h, "slice_plane: size") ||
+        get_vec3(I, a[3], v, "slice_plane: v") || arg_size2(I, a[4], &w, &h, "slice_plane: size") ||
         lang_get_ramp(I, a[5], &r, "slice_plane: palette"))
         return -1;
     double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};

@@ -216,31 +216,17 @@ static void volume_summary(const void *p, bytebuf *out)
                    v->nz, v->lo[0], v->hi[0], v->lo[1], v->hi[1], v->lo[2], v->hi[2], mn, mx);
 }
 
-static int vec_value(interp *I, const double *x, int n, value *out)
-{
-    value l = val_list(I, (size_t)n);
-    if (l.k == V_NIL)
-        return -1;
-    for (int i = 0; i < n; i++)
-        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
-            val_unref(I, l);
-            return -1;
-        }
-    *out = l;
-    return 0;
-}
-
 static int volume_get(interp *I, const void *p, const char *name, value *out)
 {
     const volume *v = &((const vol_payload *)p)->v;
     if (strcmp(name, "size") == 0) {
         double s[3] = {v->nx, v->ny, v->nz};
-        return vec_value(I, s, 3, out);
+        return num_list_value(I, s, 3, out);
     }
     if (strcmp(name, "lo") == 0)
-        return vec_value(I, v->lo, 3, out);
+        return num_list_value(I, v->lo, 3, out);
     if (strcmp(name, "hi") == 0)
-        return vec_value(I, v->hi, 3, out);
+        return num_list_value(I, v->hi, 3, out);
     return 1;
 }
 
@@ -418,20 +404,11 @@ mesh *lang_as_mesh(value v)
 
 /* ---- builtins ----------------------------------------------------------------------------- */
 
-static void script_path(interp *I, const char *p, char *buf, size_t n)
-{
-    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
-    if (p[0] == '/' || strcmp(dir, ".") == 0)
-        snprintf(buf, n, "%s", p);
-    else
-        snprintf(buf, n, "%s/%s", dir, p);
-}
-
 static int b_load_volume(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096], ext[16];
-    script_path(I, AS_STR(a[0])->s, path, sizeof path);
+    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
     fileio_ext(path, ext, sizeof ext);
     volume tmp;
     rt_error e;
@@ -452,7 +429,7 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    script_path(I, AS_STR(a[0])->s, path, sizeof path);
+    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
     mesh *m = malloc(sizeof *m);
     if (!m)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");

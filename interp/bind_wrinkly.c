@@ -23,47 +23,6 @@
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
-static int list_of_nums(interp *I, const double *x, size_t n, value *out)
-{
-    value l = val_list(I, n);
-    if (l.k == V_NIL)
-        return -1;
-    for (size_t i = 0; i < n; i++)
-        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
-            val_unref(I, l);
-            return -1;
-        }
-    *out = l;
-    return 0;
-}
-
-static int get_seed(interp *I, value v, uint64_t *seed, const char *what)
-{
-    if (v.k == V_NIL) {
-        *seed = I->seed;
-        return 0;
-    }
-    if (v.u.n < 0 || v.u.n > 9007199254740992.0 || v.u.n != floor(v.u.n))
-        return err_at(I, NULL, ERR_VALUE, "%s: seed must be a whole number >= 0, got %g", what, v.u.n);
-    *seed = (uint64_t)v.u.n;
-    return 0;
-}
-
-static int get_size2(interp *I, value v, int *w, int *h, const char *what)
-{
-    double s[2];
-    if (v.k == V_NUM)
-        s[0] = s[1] = v.u.n;
-    else if (get_vec(I, v, s, 2, what))
-        return -1;
-    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
-                      what, s[0], s[1]);
-    *w = (int)s[0];
-    *h = (int)s[1];
-    return 0;
-}
-
 /* shuffle: nil (everything), "height", or a list of "height" / "colour" / "opacity". */
 static int get_shuffle(interp *I, value v, unsigned *bits, const char *what)
 {
@@ -112,7 +71,7 @@ static int get_style(interp *I, value tension, value shuffle, value crack, value
     if (get_int(I, extra, 0, 8, &ex, w))
         return -1;
     o->extra = (int)ex;
-    return get_seed(I, seed, &o->seed, what);
+    return arg_seed(I, seed, &o->seed, what);
 }
 
 static void style_summary(const wrinkly_opts *o, bytebuf *out)
@@ -171,14 +130,14 @@ static int ist_get(interp *I, const void *p, const char *name, value *out)
     else if (strcmp(name, "closed_form") == 0)
         *out = val_bool(t->closed);
     else if (strcmp(name, "bounds") == 0)
-        return list_of_nums(I, t->bounds, (size_t)t->n + 1, out);
+        return num_list_value(I, t->bounds, (size_t)t->n + 1, out);
     else if (strcmp(name, "crossings") == 0) {
         double *m = malloc(sizeof(double) * (size_t)t->n);
         if (!m)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         for (int i = 0; i < t->n; i++)
             m[i] = t->ms[i];
-        int r = list_of_nums(I, m, (size_t)t->n, out);
+        int r = num_list_value(I, m, (size_t)t->n, out);
         free(m);
         return r;
     } else
@@ -419,7 +378,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
         goto done;
     }
     uint64_t seed;
-    if (get_seed(I, a[3], &seed, "ist_samples"))
+    if (arg_seed(I, a[3], &seed, "ist_samples"))
         goto done;
     pos = malloc(sizeof(double) * ((size_t)count + 1));
     if (!pos) {
@@ -431,7 +390,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
         err_at(I, NULL, ERR_VALUE, "ist_samples: too many sub-intervals; lower the levels");
         goto done;
     }
-    rc = list_of_nums(I, pos, got, out);
+    rc = num_list_value(I, pos, got, out);
 done:
     free(ki);
     free(pos);
@@ -724,7 +683,7 @@ static int b_wrinkly_points(interp *I, value *a, int n, value *out)
         goto oom;
     for (size_t i = 0; i < pl.n; i++) {
         value pt;
-        if (list_of_nums(I, pl.xy + 2 * i, 2, &pt) || list_push(I, AS_LIST(r), pt)) {
+        if (num_list_value(I, pl.xy + 2 * i, 2, &pt) || list_push(I, AS_LIST(r), pt)) {
             val_unref(I, r);
             goto oom;
         }
@@ -863,7 +822,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     if (onto) {
         w = onto->w;
         h = onto->h;
-    } else if (get_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
+    } else if (arg_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
         return -1;
     }
     draw_view v;
@@ -1195,7 +1154,7 @@ static int b_tessellate(interp *I, value *a, int n, value *out)
     camera cam;
     int use_cam, w = 256, h = 256;
     lod l;
-    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || get_size2(I, a[2], &w, &h, "tessellate: size") ||
+    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || arg_size2(I, a[2], &w, &h, "tessellate: size") ||
         get_lod(I, a[5], a[4], a[6], &l, W))
         return -1;
     if (!(a[3].u.n > 0))
@@ -1264,7 +1223,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
                           i, val_type_name(it));
     }
     int w, h;
-    if (get_size2(I, a[2], &w, &h, "rasterize: size"))
+    if (arg_size2(I, a[2], &w, &h, "rasterize: size"))
         return -1;
     raster_opts ro;
     raster_opts_default(&ro);

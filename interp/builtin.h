@@ -74,6 +74,15 @@ int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, .
 /* Check that v is a list of n numbers (n = 0: any length); copy to out. */
 int get_vec(interp *I, value v, double *out, size_t n, const char *what);
 int get_int(interp *I, value v, long lo, long hi, long *out, const char *what);
+/* Shared argument readers (args.c): a seed (nil: the global --seed), an
+ * image size (n or [w, h] whole pixels), a list of numbers as a value, and a
+ * path relative to the folder of the script being run. `what` prefixes
+ * messages ("chaos: size"); arg_seed accepts NULL. */
+int arg_seed(interp *I, value v, uint64_t *seed, const char *what);
+int arg_size2(interp *I, value v, int *w, int *h, const char *what);
+int num_list_value(interp *I, const double *x, size_t n, value *out);
+void script_relative_path(interp *I, const char *p, char *buf, size_t n);
+
 /* Signature text "name(a, b: num = 2)" for help. */
 void builtin_signature(const builtin *b, struct bytebuf *out);
 const builtin *builtin_find(interp *I, const char *name);

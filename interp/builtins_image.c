@@ -169,29 +169,13 @@ static int image_arith(interp *I, int op, value a, value b, value *out)
 
 /* ---- builtins ---------------------------------------------------------------------- */
 
-static int get_size(interp *I, value v, int *w, int *h, const char *what)
-{
-    double s[2];
-    if (v.k == V_NUM) {
-        s[0] = s[1] = v.u.n;
-    } else if (get_vec(I, v, s, 2, what)) {
-        return -1;
-    }
-    if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
-                      what, s[0], s[1]);
-    *w = (int)s[0];
-    *h = (int)s[1];
-    return 0;
-}
-
 static int b_image(interp *I, value *a, int n, value *out)
 {
     (void)n;
     int w, h;
     float c[4];
     image *im;
-    if (get_size(I, a[0], &w, &h, "image: size") || lang_get_colour(I, a[1], c, "image: colour") ||
+    if (arg_size2(I, a[0], &w, &h, "image: size") || lang_get_colour(I, a[1], c, "image: colour") ||
         lang_image_new(I, w, h, &im))
         return -1;
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
@@ -207,7 +191,7 @@ static int b_gradient(interp *I, value *a, int n, value *out)
     int w, h;
     float c0[4], c1[4];
     image *im;
-    if (get_size(I, a[0], &w, &h, "gradient: size") || lang_get_colour(I, a[1], c0, "gradient: from") ||
+    if (arg_size2(I, a[0], &w, &h, "gradient: size") || lang_get_colour(I, a[1], c0, "gradient: from") ||
         lang_get_colour(I, a[2], c1, "gradient: to"))
         return -1;
     double ang = a[3].u.n * 3.14159265358979323846 / 180.0;
@@ -239,7 +223,7 @@ static int b_checker(interp *I, value *a, int n, value *out)
     long cell;
     float c0[4], c1[4];
     image *im;
-    if (get_size(I, a[0], &w, &h, "checker: size") || get_int(I, a[1], 1, 1000000, &cell, "checker: cell") ||
+    if (arg_size2(I, a[0], &w, &h, "checker: size") || get_int(I, a[1], 1, 1000000, &cell, "checker: cell") ||
         lang_get_colour(I, a[2], c0, "checker: a") || lang_get_colour(I, a[3], c1, "checker: b") ||
         lang_image_new(I, w, h, &im))
         return -1;
@@ -276,12 +260,7 @@ static int b_load(interp *I, value *a, int n, value *out)
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     char path[4096];
-    const char *p = AS_STR(a[0])->s;
-    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
-    if (p[0] == '/' || strcmp(dir, ".") == 0)
-        snprintf(path, sizeof path, "%s", p);
-    else
-        snprintf(path, sizeof path, "%s/%s", dir, p);
+    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
     rt_error e;
     if (image_load(im, path, &e)) {
         free(im);
