@@ -61,6 +61,9 @@ static uint64_t pow_small(int b, int k)
 
 static void ist_zero(ist *t) { memset(t, 0, sizeof *t); }
 
+static void fast_init(ist *t);
+
+
 void ist_free(ist *t)
 {
     free(t->bounds);
@@ -74,6 +77,7 @@ void ist_free(ist *t)
     free(t->slot);
     free(t->owner);
     free(t->by_x);
+    free(t->ftab);
     ist_zero(t);
 }
 
@@ -120,6 +124,7 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
         t->s = sk;
         t->a0 = a0;
         t->h = h;
+        fast_init(t);
         return RT_OK;
     }
     rc = ist_build_lists(t, e);
@@ -531,8 +536,224 @@ static double fwd_closed(const ist *t, int j, double r)
     return t->a0 + (double)i * t->h + t->h * (((double)dst + rem) / (double)t->s);
 }
 
+/* Digit-group tables of the fast path (ist.h). The per-digit loop of
+ * inv_closed takes the digits p of idx least significant first and
+ * accumulates src = src·B + (2M - p) and Σ p; over a group of g digits
+ * that is src = src·B^g + rc(group) with rc the digit-reversed complement,
+ * so the integers, and hence the doubles, are the same. Without memory the
+ * slow path stays in use. */
+static void fill_groups(uint32_t *tab, uint32_t b, int d)
+{
+    uint32_t nv = 1;
+    for (int q = 0; q < d; q++)
+        nv *= b;
+    for (uint32_t v = 0; v < nv; v++) {
+        uint32_t x = v, rc = 0, sum = 0;
+        for (int q = 0; q < d; q++) {
+            uint32_t p = x % b;
+            x /= b;
+            sum += p;
+            rc = rc * b + (b - 1 - p);
+        }
+        tab[v] = rc | sum << 16; /* rc < B^g <= 4096, sum < B^g */
+    }
+}
+
+/* For the ends of a translation axis: the partial sums of p - M over the
+ * digits of a group, most significant first, and their least and greatest
+ * value over the prefixes of length 0 .. d-1 (int8 each; |values| <= d·M
+ * <= 21 for B <= 15). */
+static void fill_prefix(uint32_t *tab, uint32_t b, int d)
+{
+    uint32_t nv = 1;
+    for (int q = 0; q < d; q++)
+        nv *= b;
+    int m = (int)(b - 1) / 2;
+    for (uint32_t v = 0; v < nv; v++) {
+        int dig[32], mn = 0, mx = 0, sum = 0;
+        uint32_t x = v;
+        for (int q = 0; q < d; q++) {
+            dig[q] = (int)(x % b);
+            x /= b;
+        }
+        for (int q = d - 1; q >= 0; q--) {
+            mn = sum < mn ? sum : mn;
+            mx = sum > mx ? sum : mx;
+            sum += dig[q] - m;
+        }
+        tab[v] = (uint32_t)(uint8_t)(int8_t)mn | (uint32_t)(uint8_t)(int8_t)mx << 8 |
+                 (uint32_t)(uint8_t)(int8_t)sum << 16;
+    }
+}
+
+static void fast_init(ist *t)
+{
+    if (t->b < 3 || t->k < 1 || t->s > UINT32_MAX)
+        return;
+    uint32_t b = (uint32_t)t->b, bg = b; /* b <= 2001 */
+    int g = 1;
+    while (g < t->k && bg <= 4096 / b) {
+        bg *= b;
+        g++;
+    }
+    int r = t->k % g, topd = r ? r : g;
+    uint32_t btop = 1;
+    for (int q = 0; q < topd; q++)
+        btop *= b;
+    int dig = t->axis == IST_TRANSLATION && b <= 15;
+    size_t ne = (size_t)bg + (r ? btop : 0) + (dig ? 2 * (size_t)bg + (r ? btop : 0) : 0);
+    uint32_t *tab = malloc(sizeof(uint32_t) * ne);
+    if (!tab)
+        return;
+    fill_groups(tab, b, g);
+    t->ftop = tab;
+    if (r) {
+        t->ftop = tab + bg;
+        fill_groups(t->ftop, b, r);
+    }
+    t->fdig = NULL;
+    if (dig) {
+        t->fdig = tab + bg + (r ? btop : 0);
+        for (uint32_t v = 0; v < bg; v++) {
+            uint32_t x = v, pk = 0;
+            for (int q = 0; q < g; q++) {
+                pk |= (x % b) << (4 * q);
+                x /= b;
+            }
+            t->fdig[v] = pk;
+        }
+        t->fpre = t->fdig + bg;
+        t->fpretop = t->fpre;
+        fill_prefix(t->fpre, b, g);
+        if (r) {
+            t->fpretop = t->fpre + bg;
+            fill_prefix(t->fpretop, b, r);
+        }
+    }
+    t->ftab = tab;
+    t->fg = g;
+    t->ftopd = topd;
+    t->fdiv = (t->k - topd) / g;
+    t->fbg = bg;
+    t->fmul = (uint32_t)((((uint64_t)1) << 32) / bg);
+    t->fbtop = btop;
+    /* x/h and x·(1/h) are the same correctly rounded number when 1/h is an
+     * exact power of two */
+    int ex;
+    double mant = frexp(t->h, &ex), ih = 1.0 / t->h;
+    t->fh2 = mant == 0.5 && isnormal(ih) && ih * t->h == 1.0;
+    t->fih = ih;
+}
+
+/* x = q·B^g + lo with the reciprocal of B^g: the estimate is q or q - 1
+ * (x·floor(2^32/B^g)/2^32 > x/B^g - 1), and one step corrects it. */
+static inline uint32_t split_group(const ist *t, uint32_t x, uint32_t *lo)
+{
+    uint32_t q = (uint32_t)(((uint64_t)x * t->fmul) >> 32);
+    uint32_t l = x - q * t->fbg;
+    if (l >= t->fbg) {
+        q++;
+        l -= t->fbg;
+    }
+    *lo = l;
+    return q;
+}
+
+/* ist_inv for a closed form with tables: the same floating-point operations
+ * as ist_inv/inv_closed in the same order, integer digit work grouped. */
+static inline double inv_fast(const ist *t, double u)
+{
+    double uw, shift;
+    if (locate(t, u, &uw, &shift))
+        return u;
+    int n = t->n;
+    double v = t->fh2 ? (uw - t->a0) * t->fih : (uw - t->a0) / t->h;
+    /* (int)floor(v) clamped to [0, n-1]; v >= 0 unless NaN */
+    int i = v >= 0 ? (v < (double)n ? (int)v : n - 1) : 0;
+    double a = t->a0 + (double)i * t->h;
+    double r = t->fh2 ? (uw - a) * t->fih : (uw - a) / t->h;
+    if (r < 0)
+        r = 0;
+    double y = r * (double)t->s;
+    uint32_t x = y < (double)t->s ? (uint32_t)y : (uint32_t)(t->s - 1);
+    double rem = y - (double)x;
+    long km = (long)t->k * t->m;
+    uint32_t src = 0;
+    int j;
+    if (t->axis == IST_CYCLIC || ((long)i >= km && (long)i + km <= (long)n - 1)) {
+        uint32_t sum = 0, lo, e;
+        for (int q = 0; q < t->fdiv; q++) {
+            x = split_group(t, x, &lo);
+            e = t->ftab[lo];
+            src = src * t->fbg + (e & 0xffff);
+            sum += e >> 16;
+        }
+        e = t->ftop[x];
+        src = src * t->fbtop + (e & 0xffff);
+        sum += e >> 16;
+        long jj = (long)i + (long)sum - km;
+        if (jj < 0 || jj >= n) /* only on a cyclic axis */
+            jj = imod(jj, n);
+        j = (int)jj;
+    } else if (t->fdig) {
+        /* near an end of a translation axis: the same group sums, plus the
+         * range of intervals the slot walk visits (prefix sums composed
+         * from the least significant group up); if it keeps M away from
+         * both ends every step is a cyclic one and j = i + Σ(p - M). */
+        uint32_t grp[IST_MAX_K], sum = 0, e, pe;
+        for (int q = 0; q < t->fdiv; q++) {
+            x = split_group(t, x, &grp[q]);
+            e = t->ftab[grp[q]];
+            src = src * t->fbg + (e & 0xffff);
+            sum += e >> 16;
+        }
+        e = t->ftop[x];
+        src = src * t->fbtop + (e & 0xffff);
+        sum += e >> 16;
+        int mn = 1 << 20, mx = -(1 << 20); /* no prefix yet: the final j is not constrained */
+        for (int q = 0; q <= t->fdiv; q++) {
+            pe = q < t->fdiv ? t->fpre[grp[q]] : t->fpretop[x];
+            int gmn = (int8_t)(uint8_t)pe, gmx = (int8_t)(uint8_t)(pe >> 8), gs = (int8_t)(uint8_t)(pe >> 16);
+            mn = gs + mn < gmn ? gs + mn : gmn;
+            mx = gs + mx > gmx ? gs + mx : gmx;
+        }
+        if (i + mn >= t->m && i + mx <= n - 1 - t->m) {
+            j = (int)((long)i + (long)sum - km);
+        } else { /* the slot walk of inv_closed, digits most significant first */
+            uint32_t pw = 1, b = (uint32_t)t->b;
+            src = 0;
+            j = i;
+            for (int q = t->fdiv; q >= 0; q--) {
+                uint32_t pk = t->fdig[q == t->fdiv ? x : grp[q]];
+                for (int d = (q == t->fdiv ? t->ftopd : t->fg) - 1; d >= 0; d--) {
+                    int pc;
+                    slot_translation(n, t->m, j, (int)(pk >> (4 * d) & 15), &j, &pc);
+                    src += (uint32_t)pc * pw;
+                    pw *= b;
+                }
+            }
+        }
+    } else {
+        return inv_closed(t, i, r) + shift;
+    }
+    return t->a0 + (double)j * t->h + t->h * (((double)src + rem) / (double)t->s) + shift;
+}
+
+void ist_inv_block(const ist *t, size_t n, const double *u, double *out)
+{
+    if (t->ftab) {
+        for (size_t q = 0; q < n; q++)
+            out[q] = inv_fast(t, u[q]);
+    } else {
+        for (size_t q = 0; q < n; q++)
+            out[q] = ist_inv(t, u[q]);
+    }
+}
+
 double ist_inv(const ist *t, double u)
 {
+    if (t->ftab)
+        return inv_fast(t, u);
     double uw, shift;
     if (locate(t, u, &uw, &shift))
         return u;

@@ -100,6 +100,22 @@ typedef struct ist {
     uint32_t *slot;    /* slot index of the last round (for the '|' separators of ist_print) */
     uint32_t *owner;   /* list each entry belongs to */
     size_t *by_x;      /* entries sorted by source start (for F) */
+    /* closed-form fast path of F^{-1} (ist.c) when 3 <= B and B^K < 2^32:
+     * the K base-B digits are taken g at a time with small tables (one
+     * multiply-by-reciprocal division per group instead of one division
+     * per digit); bit-identical to the per-digit evaluation. ftab is NULL
+     * when the fast path is not in use. */
+    uint32_t *ftab;   /* B^g entries: reversed complement | digit sum << 16 */
+    uint32_t *ftop;   /* the same for the r = K mod g top digits (or ftab) */
+    uint32_t *fdig;   /* B^g packed digits, 4 bits each (translation axis, B <= 15), or NULL */
+    uint32_t *fpre, *fpretop; /* with fdig: prefix-sum ranges of the groups (ist.c) */
+    int fg, fdiv;     /* g, and the number of group divisions */
+    int ftopd;        /* digits in the top group (r, or g when r = 0) */
+    uint32_t fbg;     /* B^g */
+    uint32_t fmul;    /* floor(2^32 / B^g) */
+    uint32_t fbtop;   /* B^ftopd */
+    int fh2;          /* h is a power of two: x/h computed exactly as x·fih */
+    double fih;
 } ist;
 
 /* Validate spec and prepare the evaluator (builds the lists when needed).
@@ -109,6 +125,9 @@ void ist_free(ist *t);
 
 /* F^{-1}(u): the source coordinate whose attributes appear at u (eq. 9). */
 double ist_inv(const ist *t, double u);
+/* F^{-1} of n coordinates: out[q] = ist_inv(t, u[q]) bit for bit (out may
+ * be u). A tight loop for tessellation and benchmarks. */
+void ist_inv_block(const ist *t, size_t n, const double *u, double *out);
 /* F(u): where the source coordinate u is moved to (eq. 6). */
 double ist_fwd(const ist *t, double u);
 

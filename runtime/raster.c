@@ -9,7 +9,9 @@
 
 #define SUB 256     /* sub-pixel steps: screen coordinates snapped to 1/256 px */
 #define GUARD 1048576.0 /* ±2^20 px guard band */
-#define TRI_CHUNK 4096
+#define TRI_CHUNK 4096  /* least triangles per set-up and binning chunk */
+#define MAX_CHUNKS 64   /* most chunks (bounds the per-chunk bin counts) */
+#define MAX_BINS ((size_t)1 << 22) /* most chunks × tiles counters */
 
 void raster_opts_default(raster_opts *o)
 {
@@ -40,6 +42,11 @@ typedef struct setup_job {
     int w, h;
     double light[3];
     rtri *t;
+    size_t csz;     /* triangles per chunk */
+    size_t *bins;   /* per chunk: triangles listed in each tile, then where they go */
+    uint32_t *list; /* the tile lists, filled by fill_chunk */
+    size_t ntiles;
+    int ts, tiles_x;
 } setup_job;
 
 static int64_t floordiv(int64_t a, int64_t b)
@@ -53,8 +60,8 @@ static void setup_chunk(void *ctx, size_t chunk, int worker)
     (void)worker;
     setup_job *J = ctx;
     const mesh *m = J->m;
-    size_t end = (chunk + 1) * TRI_CHUNK < m->nt ? (chunk + 1) * TRI_CHUNK : m->nt;
-    for (size_t ti = chunk * TRI_CHUNK; ti < end; ti++) {
+    size_t end = (chunk + 1) * J->csz < m->nt ? (chunk + 1) * J->csz : m->nt;
+    for (size_t ti = chunk * J->csz; ti < end; ti++) {
         rtri *t = &J->t[ti];
         t->x0 = 1, t->x1 = 0;
         const uint32_t *v = m->tri + 3 * ti;
@@ -135,6 +142,43 @@ static void setup_chunk(void *ctx, size_t chunk, int worker)
         if (x0 > x1 || y0 > y1)
             continue;
         t->x0 = (int)x0, t->x1 = (int)x1, t->y0 = (int)y0, t->y1 = (int)y1;
+    }
+    /* binning, part 1: how many of this chunk's triangles each tile lists */
+    size_t *cnt = J->bins + chunk * J->ntiles, tx = (size_t)J->tiles_x;
+    int ts = J->ts;
+    const rtri *tr = J->t;
+    for (size_t ti = chunk * J->csz; ti < end; ti++) {
+        const rtri *t = &tr[ti];
+        if (t->x0 > t->x1)
+            continue;
+        int bx0 = t->x0 / ts, bx1 = t->x1 / ts, by1 = t->y1 / ts;
+        for (int by = t->y0 / ts; by <= by1; by++)
+            for (int bx = bx0; bx <= bx1; bx++)
+                cnt[(size_t)by * tx + (size_t)bx]++;
+    }
+}
+
+/* Binning, part 2: the chunk's triangles, in mesh order, into the slots
+ * raster_render reserved for the chunk in each tile list (after those of
+ * the chunks before it), so every list is in mesh order whatever the
+ * thread count. */
+static void fill_chunk(void *ctx, size_t chunk, int worker)
+{
+    (void)worker;
+    setup_job *J = ctx;
+    size_t end = (chunk + 1) * J->csz < J->m->nt ? (chunk + 1) * J->csz : J->m->nt;
+    size_t *fill = J->bins + chunk * J->ntiles, tx = (size_t)J->tiles_x;
+    int ts = J->ts;
+    const rtri *tr = J->t;
+    uint32_t *list = J->list;
+    for (size_t i = chunk * J->csz; i < end; i++) {
+        const rtri *t = &tr[i];
+        if (t->x0 > t->x1)
+            continue;
+        int bx0 = t->x0 / ts, bx1 = t->x1 / ts, by1 = t->y1 / ts;
+        for (int by = t->y0 / ts; by <= by1; by++)
+            for (int bx = bx0; bx <= bx1; bx++)
+                list[fill[(size_t)by * tx + (size_t)bx]++] = (uint32_t)i;
     }
 }
 
@@ -275,12 +319,30 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
     rtri *t = malloc(sizeof *t * (m->nt ? m->nt : 1));
     size_t *start = calloc(ntiles + 1, sizeof(size_t));
     uint32_t *list = NULL;
+    size_t *bins = NULL;
     rt_code rc = RT_OK;
     if (!t || !start || m->nt >= UINT32_MAX) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory rasterising %zu triangles", m->nt);
         goto done;
     }
-    setup_job S = {m, cam, o, im->w, im->h, {0, 0, 0}, t};
+    /* chunks depend on the triangle and tile counts only, never on threads */
+    size_t nch = (m->nt + TRI_CHUNK - 1) / TRI_CHUNK, maxch = MAX_BINS / (ntiles ? ntiles : 1);
+    if (nch > MAX_CHUNKS)
+        nch = MAX_CHUNKS;
+    if (nch > maxch)
+        nch = maxch;
+    if (nch < 1)
+        nch = 1;
+    size_t csz = (m->nt + nch - 1) / nch;
+    if (csz < 1)
+        csz = 1;
+    nch = (m->nt + csz - 1) / csz;
+    setup_job S = {m, cam, o, im->w, im->h, {0, 0, 0}, t, csz, NULL, NULL, ntiles, ts, tiles_x};
+    bins = S.bins = calloc(nch * ntiles + 1, sizeof(size_t));
+    if (!bins) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory binning %zu triangles", m->nt);
+        goto done;
+    }
     double ll = sqrt(o->light[0] * o->light[0] + o->light[1] * o->light[1] + o->light[2] * o->light[2]);
     if (ll > 0) {
         for (int d = 0; d < 3; d++)
@@ -294,43 +356,41 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         for (int d = 0; d < 3; d++)
             S.light[d] = l[d] / sqrt(n2);
     }
-    rc = par_for(run, "raster setup", (m->nt + TRI_CHUNK - 1) / TRI_CHUNK, setup_chunk, &S);
+    rc = par_for(run, "raster setup", nch, setup_chunk, &S);
     if (rc) {
         rt_fail(e, rc, "rasterising interrupted");
         goto done;
     }
-    /* bin in mesh order */
-    for (size_t i = 0; i < m->nt; i++) {
-        if (t[i].x0 > t[i].x1)
-            continue;
-        for (int by = t[i].y0 / ts; by <= t[i].y1 / ts; by++)
-            for (int bx = t[i].x0 / ts; bx <= t[i].x1 / ts; bx++)
-                start[(size_t)by * (size_t)tiles_x + (size_t)bx + 1]++;
+    /* tile lists in tile order; inside a tile, the chunks in chunk order:
+     * each chunk's count becomes where its first entry goes */
+    size_t tot = 0;
+    for (size_t q = 0; q < ntiles; q++) {
+        start[q] = tot;
+        for (size_t c = 0; c < nch; c++) {
+            size_t k = S.bins[c * ntiles + q];
+            S.bins[c * ntiles + q] = tot;
+            tot += k;
+        }
     }
-    for (size_t q = 0; q < ntiles; q++)
-        start[q + 1] += start[q];
-    list = malloc(sizeof(uint32_t) * (start[ntiles] ? start[ntiles] : 1));
-    size_t *fill = malloc(sizeof(size_t) * (ntiles ? ntiles : 1));
-    if (!list || !fill) {
-        free(fill);
+    start[ntiles] = tot;
+    list = malloc(sizeof(uint32_t) * (tot ? tot : 1));
+    if (!list) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory binning %zu triangles", m->nt);
         goto done;
     }
-    memcpy(fill, start, sizeof(size_t) * ntiles);
-    for (size_t i = 0; i < m->nt; i++) {
-        if (t[i].x0 > t[i].x1)
-            continue;
-        for (int by = t[i].y0 / ts; by <= t[i].y1 / ts; by++)
-            for (int bx = t[i].x0 / ts; bx <= t[i].x1 / ts; bx++)
-                list[fill[(size_t)by * (size_t)tiles_x + (size_t)bx]++] = (uint32_t)i;
+    S.list = list;
+    rc = par_for(run, "raster binning", nch, fill_chunk, &S);
+    if (rc) {
+        rt_fail(e, rc, "rasterising interrupted");
+        goto done;
     }
-    free(fill);
     tile_job T = {t, list, start, im->w, tiles_x, ts, im, o};
     rc = par_for(run, "raster", ntiles, tile_fn, &T);
     if (rc)
         rt_fail(e, rc, "rasterising interrupted");
     (void)tiles_y;
 done:
+    free(bins);
     free(t);
     free(start);
     free(list);

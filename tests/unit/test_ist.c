@@ -1,4 +1,5 @@
 /* test_ist.c — Iterated Shuffle Transformation (seed 002 §4.1, §5.2). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -245,6 +246,201 @@ static void test_sampling(void)
     ist_free(&t);
 }
 
+
+/* ---- reference: the per-digit closed form as it was before the grouped
+ * fast path (copied from ist.c), to check the fast path bit for bit ------- */
+
+static int ref_imod(long a, int n)
+{
+    long r = a % n;
+    return (int)(r < 0 ? r + n : r);
+}
+
+static int ref_locate(const ist *t, double u, double *uw, double *shift)
+{
+    double a = t->bounds[0], b = t->bounds[t->n];
+    *shift = 0;
+    if (t->axis == IST_CYCLIC) {
+        double p = b - a;
+        if (u < a || u >= b) {
+            double q = floor((u - a) / p);
+            *shift = q * p;
+            u -= *shift;
+            if (u >= b)
+                u = a;
+            if (u < a)
+                u = a;
+        }
+    } else if (!(u >= a && u < b)) {
+        return -1;
+    }
+    *uw = u;
+    return 0;
+}
+
+static void ref_slot(int n, int m, int i, int p, int *j, int *piece)
+{
+    int l = i < m ? i : m, r = n - 1 - i < m ? n - 1 - i : m;
+    if (p < l) {
+        int d = p - l;
+        *j = i + d;
+        *piece = m - d;
+    } else if (p < m) {
+        *j = i;
+        *piece = p - l;
+    } else if (p == m) {
+        *j = i;
+        *piece = m;
+    } else {
+        int q = p - m - 1;
+        if (q < m - r) {
+            *j = i;
+            *piece = n - i + m + q;
+        } else {
+            int d = q - (m - r) + 1;
+            *j = i + d;
+            *piece = m - d;
+        }
+    }
+}
+
+static double ref_inv_closed(const ist *t, int i, double r)
+{
+    double y = r * (double)t->s;
+    uint64_t idx = y < (double)t->s ? (uint64_t)y : t->s; /* no UB for NaN (the result is NaN) */
+    if (idx >= t->s)
+        idx = t->s - 1;
+    double rem = y - (double)idx;
+    uint64_t b = (uint64_t)t->b, src = 0;
+    int j;
+    int interior = t->axis == IST_CYCLIC ||
+                   ((long)i >= (long)t->k * t->m && (long)i + (long)t->k * t->m <= (long)t->n - 1);
+    if (interior && t->s <= UINT32_MAX) {
+        uint32_t id32 = (uint32_t)idx, b32 = (uint32_t)t->b, s32 = 0, m2 = (uint32_t)(2 * t->m);
+        long sumd = 0;
+        for (int q = 0; q < t->k; q++) {
+            uint32_t p = id32 % b32;
+            id32 /= b32;
+            sumd += (long)p;
+            s32 = s32 * b32 + m2 - p;
+        }
+        sumd -= (long)t->k * t->m;
+        j = t->axis == IST_CYCLIC ? ref_imod((long)i + sumd, t->n) : (int)((long)i + sumd);
+        src = s32;
+    } else if (interior) {
+        long sumd = 0;
+        for (int q = 0; q < t->k; q++) {
+            uint64_t p = idx % b;
+            idx /= b;
+            sumd += (long)p - t->m;
+            src = src * b + (uint64_t)(2 * t->m) - p;
+        }
+        j = ref_imod((long)i + sumd, t->n);
+    } else {
+        int dig[IST_MAX_K];
+        for (int q = t->k - 1; q >= 0; q--) {
+            dig[q] = (int)(idx % b);
+            idx /= b;
+        }
+        int pc[IST_MAX_K];
+        j = i;
+        for (int q = 0; q < t->k; q++)
+            ref_slot(t->n, t->m, j, dig[q], &j, &pc[q]);
+        for (int q = t->k - 1; q >= 0; q--)
+            src = src * b + (uint64_t)pc[q];
+    }
+    return t->a0 + (double)j * t->h + t->h * (((double)src + rem) / (double)t->s);
+}
+
+static double ref_inv(const ist *t, double u)
+{
+    double uw, shift;
+    if (ref_locate(t, u, &uw, &shift))
+        return u;
+    double f = floor((uw - t->a0) / t->h);
+    int i = f < 0 || f != f ? 0 : f >= t->n ? t->n - 1 : (int)f; /* (int)floor clamped */
+    double r = (uw - (t->a0 + (double)i * t->h)) / t->h;
+    if (r < 0)
+        r = 0;
+    return ref_inv_closed(t, i, r) + shift;
+}
+
+static int same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0 || (a != a && b != b);
+}
+
+/* The grouped fast path (and ist_inv_block) equals the per-digit code bit
+ * for bit: M = 1..3, K = 0..8 and a few larger K, both axis types, unit and
+ * other interval lengths, many u including every sub-interval boundary of
+ * some intervals and its neighbouring doubles. */
+static void test_fast_bits(void)
+{
+    static const double a0s[5] = {0, -2.5, 0.1, 3, -1}, hs[5] = {1, 0.25, 0.37, 1.5, 2};
+    double *u = malloc(sizeof(double) * 40000), *got = malloc(sizeof(double) * 40000);
+    CHECK(u && got, "memory");
+    long tested = 0, fast = 0;
+    for (int axis = 0; axis < 2; axis++)
+        for (int m = 1; m <= 3; m++)
+            for (int k = 0; k <= 11; k++)
+                for (int g = 0; g < 5; g++) {
+                    if (k > 8 && (m > 1 || g > 0))
+                        continue;
+                    /* 64, 43, 22 intervals: ends and interior, K·M > N/2; M + 2 and 1:
+                     * pieces held back at both ends */
+                    int n = g < 3 ? 64 - 21 * g : g == 3 ? m + 2 : 1;
+                    double bounds[65];
+                    for (int i = 0; i <= n; i++)
+                        bounds[i] = a0s[g] + (double)i * hs[g];
+                    ist t;
+                    ist_spec s = {.n = n, .bounds = bounds, .m = m, .k = k, .axis = (ist_axis_type)axis};
+                    rt_error e;
+                    CHECK(ist_init(&t, &s, &e) == RT_OK, "init: %s", e.msg);
+                    CHECK(t.closed, "closed form");
+                    fast += t.ftab != NULL;
+                    rng r;
+                    rng_init(&r, 5, (uint64_t)(axis * 1000 + m * 100 + k * 5 + g));
+                    size_t nu = 0;
+                    double lo = bounds[0], len = bounds[n] - bounds[0];
+                    for (int q = 0; q < 20000; q++) /* mostly inside, some outside */
+                        u[nu++] = lo - 0.1 * len + 1.2 * len * rng_uniform(&r);
+                    /* sub-interval boundaries of intervals 0, 1, n/2, n-1 */
+                    int iv[4] = {0, 1, n / 2, n - 1};
+                    uint64_t S = ipow(2 * m + 1, k), step = S / 2000 + 1;
+                    for (int w = 0; w < 4; w++)
+                        for (uint64_t q = 0; q <= S && nu + 3 <= 40000; q += step) {
+                            double x = bounds[iv[w]] + hs[g] * ((double)q / (double)S);
+                            u[nu++] = x;
+                            u[nu++] = nextafter(x, -1e300);
+                            u[nu++] = nextafter(x, 1e300);
+                        }
+                    u[0] = bounds[n], u[1] = nextafter(bounds[n], -1e300), u[2] = bounds[0];
+                    u[3] = bounds[0] + 1e3 * len, u[4] = -0.0, u[5] = NAN, u[6] = INFINITY;
+                    ist_inv_block(&t, nu, u, got);
+                    int bad = 0;
+                    for (size_t q = 0; q < nu; q++) {
+                        double want = ref_inv(&t, u[q]), one = ist_inv(&t, u[q]);
+                        if (!same_bits(want, one) || !same_bits(want, got[q])) {
+                            if (bad++ < 3)
+                                CHECK(0, "axis %d M %d K %d set %d: u = %.17g: %.17g / block %.17g, per-digit %.17g",
+                                      axis, m, k, g, u[q], one, got[q], want);
+                        }
+                    }
+                    CHECK(bad == 0, "axis %d M %d K %d set %d: %d of %zu differ", axis, m, k, g, bad, nu);
+                    tested += (long)nu;
+                    /* in place */
+                    memcpy(got, u, sizeof(double) * 100);
+                    ist_inv_block(&t, 100, got, got);
+                    for (int q = 0; q < 100; q++)
+                        CHECK(same_bits(got[q], ref_inv(&t, u[q])), "in place");
+                    ist_free(&t);
+                }
+    CHECK(fast > 100, "the fast path is used (%ld configurations)", fast);
+    CHECK(tested > 1000000, "%ld evaluations compared", tested);
+    free(u);
+    free(got);
+}
+
 int main(void)
 {
     test_fig2();
@@ -253,5 +449,6 @@ int main(void)
     test_general();
     test_validation();
     test_sampling();
+    test_fast_bits();
     return check_done("test_ist");
 }
