@@ -330,6 +330,63 @@ static int image_save_hook(interp *I, const void *p, const char *path, value opt
     return 0;
 }
 
+/* hstack(a, b, …) / vstack(…): images side by side (top-aligned) or one
+ * above the other (left-aligned), with `gap` pixels of `background`. */
+static int stack(interp *I, value *a, int n, value *out, int horizontal)
+{
+    const char *name = horizontal ? "hstack" : "vstack";
+    value *items = a;
+    size_t count = (size_t)n;
+    if (n == 1 && a[0].k == V_LIST) {
+        items = AS_LIST(a[0])->items;
+        count = AS_LIST(a[0])->n;
+    }
+    value gapv = a[n], bgv = a[n + 1];
+    long gap;
+    float bg[4];
+    if (get_int(I, gapv, 0, 100000, &gap, horizontal ? "hstack: gap" : "vstack: gap") ||
+        lang_get_colour(I, bgv, bg, horizontal ? "hstack: background" : "vstack: background"))
+        return -1;
+    if (count == 0)
+        return err_at(I, NULL, ERR_VALUE, "%s: give at least one image", name);
+    double W = 0, H = 0;
+    for (size_t i = 0; i < count; i++) {
+        image *im = lang_as_image(items[i]);
+        if (!im)
+            return err_at(I, NULL, ERR_TYPE, "%s: item %zu is %s, not an image", name, i + 1,
+                          val_type_name(items[i]));
+        if (horizontal) {
+            W += im->w + (i ? gap : 0);
+            H = im->h > H ? im->h : H;
+        } else {
+            H += im->h + (i ? gap : 0);
+            W = im->w > W ? im->w : W;
+        }
+    }
+    if (W > 1e6 || H > 1e6)
+        return err_at(I, NULL, ERR_LIMIT, "%s: the result would be %.0f×%.0f pixels", name, W, H);
+    image *r;
+    if (lang_image_new(I, (int)W, (int)H, &r))
+        return -1;
+    for (size_t p = 0; p < (size_t)W * (size_t)H; p++)
+        memcpy(r->px + 4 * p, bg, sizeof bg);
+    int x0 = 0, y0 = 0;
+    for (size_t i = 0; i < count; i++) {
+        image *im = lang_as_image(items[i]);
+        for (int y = 0; y < im->h; y++)
+            memcpy(image_at(r, x0, y0 + y), image_at(im, 0, y), (size_t)im->w * 4 * sizeof(float));
+        if (horizontal)
+            x0 += im->w + (int)gap;
+        else
+            y0 += im->h + (int)gap;
+    }
+    return lang_image_value(I, r, out);
+}
+
+static int b_hstack(interp *I, value *a, int n, value *out) { return stack(I, a, n, out, 1); }
+static int b_vstack(interp *I, value *a, int n, value *out) { return stack(I, a, n, out, 0); }
+
+static const bparam p_stack[] = {{"gap", "int", "0"}, {"background", "any", "0"}};
 static const bparam p_image[] = {{"size", "vec|num", NULL}, {"colour", "any", "0"}};
 static const bparam p_gradient[] = {{"size", "vec|num", NULL}, {"from", "any", "0"}, {"to", "any", "1"},
                                     {"angle", "num", "0"}};
@@ -344,6 +401,9 @@ static const builtin image_builtins[] = {
     BUILTIN("gradient", b_gradient, p_gradient,
             "A linear colour gradient across an image; angle in degrees (0: left to right, 90: bottom to top)."),
     BUILTIN("checker", b_checker, p_checker, "A checkerboard of two colours with square cells of `cell` pixels."),
+    BUILTIN_VAR("hstack", b_hstack, p_stack,
+                "Images side by side, top-aligned (several images or one list), `gap` pixels of `background` between them."),
+    BUILTIN_VAR("vstack", b_vstack, p_stack, "Images one above the other, left-aligned, like hstack."),
     BUILTIN("pixel", b_pixel, p_pixel, "The [r, g, b, a] of pixel (x, y); (0, 0) is the top-left."),
     BUILTIN("load", b_load, p_load, "Load an image (PNG, PPM/PGM, PFM), relative to the script's folder."),
     BUILTIN("save", b_save, p_save,
