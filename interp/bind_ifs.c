@@ -919,6 +919,9 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
     fractint_list fl;
     rt_error e;
     rt_code c = fractint_load(path, &fl, &e);
+    if (c == RT_EFORMAT) /* name the file: "load_ifs: x.ifs:4: expected …" */
+        return err_at(I, NULL, ERR_VALUE, "load_ifs: %s:%s", path,
+                      strncmp(e.msg, "line ", 5) == 0 ? e.msg + 5 : e.msg);
     if (c)
         return lang_rt_error(I, c, &e, "load_ifs");
     value r = val_rec(I);
