@@ -10,10 +10,16 @@
  *     projected with camera_project; screen coordinates are snapped to 1/256
  *     pixel and held as 64-bit integers, so edge functions are exact and a
  *     shared edge gives exactly opposite values in its two triangles.
- *     Triangles with a vertex behind the near plane (view depth <= near) or
- *     beyond a ±2^20 pixel guard band are dropped (no clipping: documented
- *     limitation; keep the camera out of the mesh). Both windings are drawn
- *     (two-sided).
+ *     A triangle with a vertex at or behind the near plane (view depth <=
+ *     near, at least 1e-6) or beyond a ±2^20 pixel guard band is clipped in
+ *     view space (Sutherland–Hodgman) against the near plane and the planes
+ *     where the screen x or y is ±2^19, attributes interpolated linearly
+ *     along the cut edges, and the convex polygon left is drawn as a fan of
+ *     up to 6 triangles, listed right after their mesh triangle; the camera
+ *     may be close to or inside a surface. A shared edge is cut at the same
+ *     points in both its triangles, so the top-left rule below still holds.
+ *     Triangles that need no clipping are set up exactly as before. Both
+ *     windings are drawn (two-sided).
  *  2. Shading per vertex (Gouraud): colour = vertex colour (or o.colour when
  *     the mesh has none) × (ambient + diffuse·|n·l|), n the vertex normal, or
  *     the face normal when the mesh has no normals or o.flat is set; l points
@@ -26,7 +32,9 @@
  *     perspective-correct) and colour buffer. Opaque triangles (all three
  *     alphas >= 1) first, in mesh order, depth test "strictly nearer"
  *     (ties keep the earlier triangle). Then the transparent ones, sorted
- *     back to front by their mean view depth (ties by index), blended "over"
+ *     back to front by their mean view depth (at equal depth the later
+ *     triangle first, so the earlier one is in front as for the opaque
+ *     ones; a clipped piece has the mean of its own corners), blended "over"
  *     in premultiplied colour where they are in front of the opaque depth,
  *     without writing depth. The tile is composited over o.background and
  *     written out un-premultiplied.

@@ -169,6 +169,30 @@ static void test_threads(void)
         CHECK(!memcmp(im.px, ref.px, sizeof(float) * 4 * 97 * 71), "threads %d byte-identical", th);
         image_free(&im);
     }
+    /* the camera inside the closed tube, looking along it with a wide field
+     * of view, so triangles pass beside and behind it: every ray hits the
+     * surface, so no pixel is left background (dropping the triangles that
+     * cross the near plane left 810 holes); still byte-identical for any
+     * thread count and tile size */
+    memset(&cam, 0, sizeof cam);
+    cam.eye[0] = 1.6, cam.target[0] = 1.6, cam.target[2] = 1, cam.up[1] = 1, cam.fov = 100;
+    camera_setup(&cam);
+    o.background[3] = 0;
+    raster_render(&m, &cam, &o, NULL, &ref, &e);
+    size_t holes = 0;
+    for (int y = 0; y < ref.h; y++)
+        for (int x = 0; x < ref.w; x++)
+            holes += image_at(&ref, x, y)[3] == 0;
+    CHECK(holes == 0, "inside the tube: %zu holes", holes);
+    for (int th = 1; th <= 4; th += 3) {
+        rt_run run = {th, NULL, 0};
+        image im;
+        image_init(&im, 97, 71, &e);
+        o.tile = 8;
+        raster_render(&m, &cam, &o, &run, &im, &e);
+        CHECK(!memcmp(im.px, ref.px, sizeof(float) * 4 * 97 * 71), "inside, tile 8, threads %d byte-identical", th);
+        image_free(&im);
+    }
     image_free(&ref);
     mesh_free(&m);
     free(p);
@@ -236,8 +260,18 @@ static void test_binning(void)
             const float *c = image_at(&ref, x, y);
             green += c[1] > 0 && c[0] == 0 && c[2] == 0 && c[3] == 1;
         }
-    /* (a handful of pure-green pixels remain near the transparent patch) */
-    CHECK(green < 100, "the earlier triangle wins the ties: %zu green pixels", green);
+    /* none: the transparent patch too is drawn with the earlier copy in
+     * front (it once sorted the later copy in front, which replaced the
+     * original wherever the interpolated alpha rounded to 1: 6 pure-green
+     * and some 5,800 all but green pixels) */
+    CHECK(green == 0, "the earlier triangle wins the ties: %zu green pixels", green);
+    size_t greenish = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *c = image_at(&ref, x, y);
+            greenish += c[1] > 0 && c[0] < 0.02f && c[2] < 0.02f;
+        }
+    CHECK(greenish == 0, "transparent ties: %zu nearly green pixels", greenish);
     /* and with the copy first it is green: the test sees the list order */
     size_t half = 3 * (m.nt / 2);
     uint32_t *sw = malloc(sizeof(uint32_t) * 2 * half);
@@ -273,11 +307,105 @@ static void test_binning(void)
     free(p);
 }
 
+/* Near-plane clipping. Camera at (0, 1, 0) looking along -z, 90° on
+ * 100×100: a pixel centre (px + 1/2, py + 1/2) has the ray direction
+ * (nx, ny, -1) with nx = (px + 1/2)/50 - 1, ny = 1 - (py + 1/2)/50. The
+ * floor y = 0, a square |x|, |z| <= L = 1000 around the camera (two
+ * triangles, corners behind the camera), is hit by the rays with ny < 0 at
+ * view depth d = -1/ny, world x = nx·d, z = -d: inside the square when
+ * d <= L, i.e. ny <= -1/L, i.e. py + 1/2 >= 50.05, and |nx| < 1 always.
+ * So exactly rows 50..99: 5,000 pixels, each drawn once (half transparent,
+ * so a pixel drawn twice would show alpha 0.75). Every triangle crosses the
+ * near plane and the cut corners land far outside the ±2^20 guard band; the
+ * old set-up dropped both triangles and drew nothing. */
+static void floor_mesh(mesh *m, double L, float a)
+{
+    mesh_init(m, 0, 1);
+    const double cx[4] = {-1, 1, 1, -1}, cz[4] = {-1, -1, 1, 1};
+    for (int k = 0; k < 4; k++) {
+        float p[3] = {(float)(cx[k] * L), 0, (float)(cz[k] * L)};
+        /* colours linear on the plane: r along x, g along z */
+        float c[4] = {(float)(0.5 + 0.4 * cx[k]), (float)(0.5 + 0.4 * cz[k]), 0.25f, a};
+        mesh_add_vertex(m, p, NULL, c);
+    }
+    mesh_add_tri(m, 0, 1, 2);
+    mesh_add_tri(m, 0, 2, 3);
+}
+
+static void test_near_clip(void)
+{
+    camera cam;
+    memset(&cam, 0, sizeof cam);
+    cam.eye[1] = 1, cam.target[1] = 1, cam.target[2] = -1, cam.up[1] = 1, cam.fov = 90;
+    camera_setup(&cam);
+    raster_opts o;
+    raster_opts_default(&o);
+    o.unlit = 1;
+    o.background[3] = 0;
+    rt_error e;
+    image im;
+    image_init(&im, 100, 100, &e);
+    const double L = 1000;
+    mesh m;
+    floor_mesh(&m, L, 0.5f);
+    CHECK(raster_render(&m, &cam, &o, NULL, &im, &e) == RT_OK, "render: %s", e.msg);
+    size_t cover = count_alpha(&im, 0.5f), wrong = 0;
+    for (int y = 0; y < 100; y++)
+        for (int x = 0; x < 100; x++)
+            wrong += image_at(&im, x, y)[3] != (y >= 50 ? 0.5f : 0.0f);
+    CHECK(cover == 5000, "floor through the near plane covers %zu pixels, expected 5000", cover);
+    CHECK(wrong == 0, "%zu pixels off the rows below the horizon (or drawn twice)", wrong);
+    /* colours as on the unclipped plane: r = 0.5 + 0.4 x/L, g = 0.5 - 0.4 d/L
+     * (to the snapping of corners to 1/256 px: away from the horizon row,
+     * where d changes by 200 per pixel, that is well under 1e-4) */
+    const int probe[][2] = {{0, 52}, {99, 52}, {30, 51}, {71, 60}, {5, 99}, {50, 75}};
+    for (size_t i = 0; i < sizeof probe / sizeof probe[0]; i++) {
+        int px = probe[i][0], py = probe[i][1];
+        double nx = (px + 0.5) / 50 - 1, ny = 1 - (py + 0.5) / 50, d = -1 / ny;
+        const float *c = image_at(&im, px, py);
+        CHECK_NEAR(c[0], 0.5 + 0.4 * nx * d / L, 1e-4, "clipped floor red");
+        CHECK_NEAR(c[1], 0.5 - 0.4 * d / L, 1e-4, "clipped floor green");
+    }
+    /* opaque, the same coverage; small tiles and threads give the same bytes */
+    mesh_free(&m);
+    floor_mesh(&m, L, 1);
+    CHECK(raster_render(&m, &cam, &o, NULL, &im, &e) == RT_OK, "render opaque");
+    CHECK(count_alpha(&im, 1) == 5000, "opaque floor covers %zu pixels", count_alpha(&im, 1));
+    for (int th = 1; th <= 4; th += 3) {
+        rt_run run = {th, NULL, 0};
+        image im2;
+        image_init(&im2, 100, 100, &e);
+        o.tile = 8;
+        raster_render(&m, &cam, &o, &run, &im2, &e);
+        CHECK(!memcmp(im2.px, im.px, sizeof(float) * 4 * 100 * 100), "clipped, tile 8, threads %d: same bytes", th);
+        image_free(&im2);
+    }
+    o.tile = 32;
+    /* looking the other way along the floor from below it: still rows 50..99 mirrored */
+    cam.eye[1] = -1, cam.target[1] = -1;
+    camera_setup(&cam);
+    raster_render(&m, &cam, &o, NULL, &im, &e);
+    size_t up = 0;
+    for (int y = 0; y < 50; y++)
+        for (int x = 0; x < 100; x++)
+            up += image_at(&im, x, y)[3] == 1;
+    CHECK(up == 5000 && count_alpha(&im, 1) == 5000, "floor from below covers rows 0..49: %zu", up);
+    /* wholly behind the camera: nothing */
+    cam.target[2] = 1, cam.eye[1] = 1, cam.target[1] = 1;
+    cam.eye[2] = -1001, cam.target[2] = -1002;
+    camera_setup(&cam);
+    raster_render(&m, &cam, &o, NULL, &im, &e);
+    CHECK(count_alpha(&im, 0) == 10000, "behind the camera: nothing drawn");
+    mesh_free(&m);
+    image_free(&im);
+}
+
 int main(void)
 {
     test_coverage();
     test_depth();
     test_threads();
     test_binning();
+    test_near_clip();
     return check_done("test_raster");
 }
