@@ -151,8 +151,7 @@ static int fv_preview(interp *I, const void *p, image **out)
         return -1;
     double *v = malloc(sizeof(double) * N * N);
     if (!v) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     double xs[N], ys[N], zs[N];

@@ -852,12 +852,7 @@ static int b_draw(interp *I, value *a, int n, value *out)
         draw_clear(im, bg);
     rt_error e;
     rt_code c = paint(im, &view, s, col, a[4].u.n, a[5].u.n, fill, fillc, &e);
-    if (c) {
-        image_free(im);
-        free(im);
-        return lang_rt_error(I, c, &e, "draw");
-    }
-    return lang_image_value(I, im, out);
+    return lang_image_finish(I, im, c, &e, "draw", out);
 }
 
 static int opt_colour(interp *I, value opts, const char *key, float rgba[4], int *found)
@@ -937,8 +932,7 @@ static int shape_preview(interp *I, const void *p, image **out)
     rt_error e;
     rt_code c = paint(im, &view, s, col, 1, 1, 0, col, &e);
     if (c) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return lang_rt_error(I, c, &e, "show");
     }
     *out = im;
@@ -1146,10 +1140,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     }
     mem_release(I, (size_t)bytes);
     if (c || !im) {
-        if (im) {
-            image_free(im);
-            free(im);
-        }
+        lang_image_discard(im);
         if (!I->err.active)
             lang_rt_error(I, c, &e, "chaos_fset");
         goto done;
@@ -1243,12 +1234,7 @@ static int b_top(interp *I, value *a, int n, value *out)
     }
     c = tops_colour(&tb, (int)nsym, &r, bg, im, &e);
     tops_free(&tb);
-    if (c) {
-        image_free(im);
-        free(im);
-        return lang_rt_error(I, c, &e, "top");
-    }
-    return lang_image_value(I, im, out);
+    return lang_image_finish(I, im, c, &e, "top", out);
 }
 
 /* Shared set-up of steal / fractal_filter: a[0] screen, a[1] source, then
@@ -1326,12 +1312,7 @@ static int b_steal(interp *I, value *a, int n, value *out)
     }
     c = tops_steal_apply(&tb, pic, s.bg, im, &e);
     tops_free(&tb);
-    if (c) {
-        image_free(im);
-        free(im);
-        return lang_rt_error(I, c, &e, "steal");
-    }
-    return lang_image_value(I, im, out);
+    return lang_image_finish(I, im, c, &e, "steal", out);
 }
 
 /* fractal_filter(screen, source, frames, size, points, window, source_window, background, depth, seed) */
@@ -1617,10 +1598,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
         c = tonemap_apply(&hs, &t, im, &e);
     hist2_free(&hs);
     if (c || !im) {
-        if (im) {
-            image_free(im);
-            free(im);
-        }
+        lang_image_discard(im);
         return I->err.active ? -1 : lang_rt_error(I, c, &e, "superifs_image");
     }
     return lang_image_value(I, im, out);

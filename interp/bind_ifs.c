@@ -645,10 +645,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     hist2_free(&hs);
     mem_release(I, (size_t)bytes);
     if (c || !im) {
-        if (im) {
-            image_free(im);
-            free(im);
-        }
+        lang_image_discard(im);
         return I->err.active ? -1 : lang_rt_error(I, c, &e, "chaos");
     }
     return lang_image_value(I, im, out);
@@ -725,8 +722,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
     hist2 hs;
     double bytes = (double)w * h * 8 * (I->threads + 1);
     if (mem_reserve(I, bytes, "measure: the histograms")) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return -1;
     }
     c = hist2_init(&hs, w, h, lo, hi, 0, &e);
@@ -737,12 +733,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
         hist2_free(&hs);
     }
     mem_release(I, (size_t)bytes);
-    if (c) {
-        image_free(im);
-        free(im);
-        return lang_rt_error(I, c, &e, "measure");
-    }
-    return lang_image_value(I, im, out);
+    return lang_image_finish(I, im, c, &e, "measure", out);
 }
 
 static int b_points(interp *I, value *a, int n, value *out)
@@ -799,8 +790,7 @@ static int b_view(interp *I, value *a, int n, value *out)
         return -1;
     double bytes = (double)w * h * 16 * (I->threads + 1);
     if (mem_reserve(I, bytes, "view: the depth buffers")) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return -1;
     }
     rt_run run = lang_run(I);
@@ -808,12 +798,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code c = chaos_project(&s, &o, &cam, im, &st, &run, &e);
     mem_release(I, (size_t)bytes);
-    if (c) {
-        image_free(im);
-        free(im);
-        return lang_rt_error(I, c, &e, "view");
-    }
-    return lang_image_value(I, im, out);
+    return lang_image_finish(I, im, c, &e, "view", out);
 }
 
 /* save(ifs, "x.flame"): flam3 XML for Fractorium, JWildfire, Apophysis. */
@@ -893,8 +878,7 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
     *out = im;
     return 0;
 fail:
-    image_free(im);
-    free(im);
+    lang_image_discard(im);
     return lang_rt_error(I, c, &e, "show");
 }
 

@@ -854,8 +854,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     }
     wrinkly_polyline pl;
     if (curve_sample(I, c, &l, &pl, W)) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return -1;
     }
     detiter_shape s;
@@ -879,8 +878,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
         detiter_shape_free(&s);
     wrinkly_polyline_free(&pl);
     if (rc) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return -1;
     }
     return lang_image_value(I, im, out);
@@ -1334,10 +1332,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
     rc = lang_image_value(I, im, out);
     im = NULL;
 done:
-    if (im) {
-        image_free(im);
-        free(im);
-    }
+    lang_image_discard(im);
     if (merged) {
         mesh_free(merged);
         free(merged);

@@ -9,12 +9,12 @@
 #include "image.h"
 #include "lexer.h"
 #include "lang_image.h"
+#include "lang_objects.h"
 
 static void image_destroy(void *p)
 {
     image *im = p;
-    image_free(im);
-    free(im);
+    lang_image_discard(im);
 }
 
 static void image_summary(const void *p, bytebuf *out)
@@ -73,6 +73,23 @@ int lang_image_value(interp *I, image *im, value *out)
 {
     *out = val_obj(I, &image_class, im);
     return out->k == V_NIL ? -1 : 0;
+}
+
+void lang_image_discard(image *im)
+{
+    if (im) {
+        image_free(im);
+        free(im);
+    }
+}
+
+int lang_image_finish(interp *I, image *im, rt_code c, const rt_error *e, const char *what, value *out)
+{
+    if (c) {
+        lang_image_discard(im);
+        return lang_rt_error(I, c, e, what);
+    }
+    return lang_image_value(I, im, out);
 }
 
 image *lang_as_image(value v)

@@ -147,6 +147,28 @@ static node *mk(parser *p, node_kind k, const token *at)
     return n;
 }
 
+/* A node with one or two children. */
+static node *mk1(parser *p, node_kind k, const token *at, node *a)
+{
+    node *n = mk(p, k, at);
+    if (!n || !(n->kids = arena_alloc(p->I, sizeof(node *))))
+        return NULL;
+    n->nkids = 1;
+    n->kids[0] = a;
+    return n;
+}
+
+static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
+{
+    node *n = mk(p, k, at);
+    if (!n || !(n->kids = arena_alloc(p->I, 2 * sizeof(node *))))
+        return NULL;
+    n->nkids = 2;
+    n->kids[0] = a;
+    n->kids[1] = b;
+    return n;
+}
+
 typedef struct nodevec {
     node **v;
     const char **names;
@@ -342,16 +364,7 @@ static node *parse_postfix(parser *p, node *e)
             p->table_mode = save_tm;
             if (p->failed)
                 return NULL;
-            node *n = mk(p, N_INDEX, open);
-            if (!n)
-                return NULL;
-            n->nkids = 2;
-            n->kids = arena_alloc(p->I, 2 * sizeof(node *));
-            if (!n->kids)
-                return NULL;
-            n->kids[0] = e;
-            n->kids[1] = ix;
-            e = n;
+            e = mk2(p, N_INDEX, open, e, ix);
         } else if (t->type == T_DOT) {
             next(p);
             token *name = peek(p);
@@ -362,14 +375,9 @@ static node *parse_postfix(parser *p, node *e)
                 return NULL;
             }
             next(p);
-            node *n = mk(p, N_FIELD, t);
+            node *n = mk1(p, N_FIELD, t, e);
             if (!n)
                 return NULL;
-            n->nkids = 1;
-            n->kids = arena_alloc(p->I, sizeof(node *));
-            if (!n->kids)
-                return NULL;
-            n->kids[0] = e;
             n->str = tok_name(p, name);
             e = n;
         } else if (t->type == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)) {
@@ -805,15 +813,10 @@ static node *parse_binary(parser *p, int min_prec)
         node *a = parse_binary(p, PREC_NOT);
         if (!a)
             return NULL;
-        left = mk(p, N_UNARY, t);
+        left = mk1(p, N_UNARY, t, a);
         if (!left)
             return NULL;
         left->op = 'n';
-        left->nkids = 1;
-        left->kids = arena_alloc(p->I, sizeof(node *));
-        if (!left->kids)
-            return NULL;
-        left->kids[0] = a;
     } else {
         left = parse_unary(p);
     }
@@ -857,16 +860,10 @@ static node *parse_binary(parser *p, int min_prec)
         node *r = parse_binary(p, right ? prec : prec + 1);
         if (!r)
             return NULL;
-        node *b = mk(p, op->type == T_AND ? N_AND : op->type == T_OR ? N_OR : N_BINARY, op);
+        node *b = mk2(p, op->type == T_AND ? N_AND : op->type == T_OR ? N_OR : N_BINARY, op, left, r);
         if (!b)
             return NULL;
         b->op = op->type;
-        b->nkids = 2;
-        b->kids = arena_alloc(p->I, 2 * sizeof(node *));
-        if (!b->kids)
-            return NULL;
-        b->kids[0] = left;
-        b->kids[1] = r;
         if (prec == 5) {
             /* comparisons do not chain: a < b < c is an error */
             int r2;
@@ -890,15 +887,9 @@ static node *parse_unary(parser *p)
         node *a = parse_unary(p);
         if (!a)
             return NULL;
-        node *n = mk(p, N_UNARY, t);
-        if (!n)
-            return NULL;
-        n->op = t->type == T_MINUS ? '-' : '+';
-        n->nkids = 1;
-        n->kids = arena_alloc(p->I, sizeof(node *));
-        if (!n->kids)
-            return NULL;
-        n->kids[0] = a;
+        node *n = mk1(p, N_UNARY, t, a);
+        if (n)
+            n->op = t->type == T_MINUS ? '-' : '+';
         return n;
     }
     node *base = parse_primary(p);
@@ -913,16 +904,9 @@ static node *parse_unary(parser *p)
         node *e = parse_unary(p);
         if (!e)
             return NULL;
-        node *b = mk(p, N_BINARY, op);
-        if (!b)
-            return NULL;
-        b->op = T_CARET;
-        b->nkids = 2;
-        b->kids = arena_alloc(p->I, 2 * sizeof(node *));
-        if (!b->kids)
-            return NULL;
-        b->kids[0] = base;
-        b->kids[1] = e;
+        node *b = mk2(p, N_BINARY, op, base, e);
+        if (b)
+            b->op = T_CARET;
         return b;
     }
     return base;
@@ -934,15 +918,9 @@ static node *parse_expr(parser *p) { return parse_binary(p, 1); }
 
 static node *one_kid(parser *p, node_kind k, const token *at, node *kid, const char *str)
 {
-    node *n = mk(p, k, at);
-    if (!n)
-        return NULL;
-    n->nkids = 1;
-    n->kids = arena_alloc(p->I, sizeof(node *));
-    if (!n->kids)
-        return NULL;
-    n->kids[0] = kid;
-    n->str = str;
+    node *n = mk1(p, k, at, kid);
+    if (n)
+        n->str = str;
     return n;
 }
 
@@ -1056,16 +1034,9 @@ static node *parse_statement(parser *p)
         node *body = parse_block_until(p, d, 0);
         if (!body || expect_close(p, T_END, d))
             return NULL;
-        node *n = mk(p, N_FOR, t);
-        if (!n)
-            return NULL;
-        n->str = var;
-        n->nkids = 2;
-        n->kids = arena_alloc(p->I, 2 * sizeof(node *));
-        if (!n->kids)
-            return NULL;
-        n->kids[0] = it;
-        n->kids[1] = body;
+        node *n = mk2(p, N_FOR, t, it, body);
+        if (n)
+            n->str = var;
         return n;
     }
     case T_IDENT:

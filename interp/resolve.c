@@ -106,37 +106,37 @@ static int visible(resolver *r, scope *s, const char *name)
     return env_lookup(r->globals, name) != NULL;
 }
 
+/* Append a name to a growable array (freed on failure). */
+static int push_candidate(interp *I, const char ***c, size_t *n, size_t *cap, const char *name)
+{
+    if (*n == *cap) {
+        size_t nc = *cap ? *cap * 2 : 64;
+        const char **grown = mem_realloc(I, *c, nc * sizeof *grown);
+        if (!grown) {
+            mem_free(I, *c);
+            *c = NULL;
+            return -1;
+        }
+        *c = grown;
+        *cap = nc;
+    }
+    (*c)[(*n)++] = name;
+    return 0;
+}
+
 static int unknown(resolver *r, scope *s, const node *at, const char *name)
 {
     /* gather candidates from every scope and the globals */
     const char **c = NULL;
     size_t n = 0, cap = 0;
     for (scope *t = s; t; t = t->parent)
-        for (int i = 0; i < t->n; i++) {
-            if (n == cap) {
-                cap = cap ? cap * 2 : 64;
-                const char **nc = mem_realloc(r->I, c, cap * sizeof *nc);
-                if (!nc) {
-                    mem_free(r->I, c);
-                    return -1;
-                }
-                c = nc;
-            }
-            c[n++] = t->names[i];
-        }
+        for (int i = 0; i < t->n; i++)
+            if (push_candidate(r->I, &c, &n, &cap, t->names[i]))
+                return -1;
     for (env *e = r->globals; e; e = e->parent)
-        for (size_t i = 0; i < e->n; i++) {
-            if (n == cap) {
-                cap = cap ? cap * 2 : 64;
-                const char **nc = mem_realloc(r->I, c, cap * sizeof *nc);
-                if (!nc) {
-                    mem_free(r->I, c);
-                    return -1;
-                }
-                c = nc;
-            }
-            c[n++] = e->names[i];
-        }
+        for (size_t i = 0; i < e->n; i++)
+            if (push_candidate(r->I, &c, &n, &cap, e->names[i]))
+                return -1;
     const char *sug = suggest_name(name, c, n);
     err_at(r->I, at, ERR_NAME, "unknown name '%s'%s%s%s", name, sug ? " (did you mean '" : "",
            sug ? sug : "", sug ? "'?)" : "");

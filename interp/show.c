@@ -50,8 +50,7 @@ static int mesh_preview(interp *I, const mesh *m, image **out)
     rt_error e;
     rt_code rc = raster_render(m, &cam, &o, &run, im, &e);
     if (rc) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
         return lang_rt_error(I, rc, &e, "show");
     }
     *out = im;
@@ -120,8 +119,7 @@ static int b_show(interp *I, value *a, int n, value *out)
     long cols = width > 2 ? width - 1 : 1;
     if (a[1].k == V_NUM && get_int(I, a[1], 1, 10000, &cols, "show: width")) {
         if (owned) {
-            image_free(im);
-            free(im);
+            lang_image_discard(im);
         }
         return -1;
     }
@@ -132,8 +130,7 @@ static int b_show(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code rc = termview_write(1, im, &o, &e);
     if (owned) {
-        image_free(im);
-        free(im);
+        lang_image_discard(im);
     }
     if (rc)
         return lang_rt_error(I, rc, &e, "show");
