@@ -183,40 +183,53 @@ static void orbit_start(orbit *ob, const sysdata *d, uint64_t seed, uint64_t chu
     ob->c = d->mc[d->start_map];
 }
 
-/* Draw the next map (alias table of the current state's row). */
-INLINE uint32_t orbit_choose(orbit *ob, const sysdata *d, const int kind)
+/* The one orbit step every loop uses, written once: draw the next map from
+ * the alias table of the current state's row (the comparison result indexes
+ * the pair, no branch), advance the RIFS state, then apply the map. The hot
+ * loops call these on locals; always_inline keeps them in registers. */
+INLINE uint32_t step_choose(rng *r, uint32_t n, const uint32_t *thr, const uint32_t *sel,
+                            uint32_t *st, uint32_t *cur, const int kind)
 {
-    uint64_t w = rng_next(&ob->r);
-    uint32_t n = (uint32_t)d->n;
+    uint64_t w = rng_next(r);
     uint32_t col = (uint32_t)(((w >> 32) * n) >> 32);
     if (kind != KIND_IFS)
-        col += ob->s * n;
-    uint32_t k = d->sel[2 * col + ((uint32_t)w < d->thr[col])];
+        col += *st * n;
+    uint32_t k = sel[2 * col + ((uint32_t)w < thr[col])];
     if (kind == KIND_R1)
-        ob->s = k;
+        *st = k;
     else if (kind == KIND_R2)
-        ob->s = ob->cur * n + k;
-    ob->cur = k;
+        *st = *cur * n + k;
+    *cur = k;
     return k;
+}
+
+/* 2-D map k: m = a b e c d f (x' = a x + b y + e, y' = c x + d y + f). */
+INLINE void step_map2(const double *m, double *x, double *y)
+{
+    double nx = m[0] * *x + m[1] * *y + m[2];
+    double ny = m[3] * *x + m[4] * *y + m[5];
+    *x = nx, *y = ny;
+}
+
+/* 3-D map k: m = row-major [M | t], 3 rows of 4. */
+INLINE void step_map3(const double *m, double *x, double *y, double *z)
+{
+    double nx = m[0] * *x + m[1] * *y + m[2] * *z + m[3];
+    double ny = m[4] * *x + m[5] * *y + m[6] * *z + m[7];
+    double nz = m[8] * *x + m[9] * *y + m[10] * *z + m[11];
+    *x = nx, *y = ny, *z = nz;
 }
 
 INLINE void orbit_step2(orbit *ob, const sysdata *d, const int kind)
 {
-    uint32_t k = orbit_choose(ob, d, kind);
-    const double *m = d->m + 6 * (size_t)k;
-    double nx = m[0] * ob->x + m[1] * ob->y + m[2];
-    double ny = m[3] * ob->x + m[4] * ob->y + m[5];
-    ob->x = nx, ob->y = ny;
+    uint32_t k = step_choose(&ob->r, (uint32_t)d->n, d->thr, d->sel, &ob->s, &ob->cur, kind);
+    step_map2(d->m + 6 * (size_t)k, &ob->x, &ob->y);
 }
 
 INLINE void orbit_step3(orbit *ob, const sysdata *d, const int kind)
 {
-    uint32_t k = orbit_choose(ob, d, kind);
-    const double *m = d->m + 12 * (size_t)k;
-    double x = ob->x, y = ob->y, z = ob->z;
-    ob->x = m[0] * x + m[1] * y + m[2] * z + m[3];
-    ob->y = m[4] * x + m[5] * y + m[6] * z + m[7];
-    ob->z = m[8] * x + m[9] * y + m[10] * z + m[11];
+    uint32_t k = step_choose(&ob->r, (uint32_t)d->n, d->thr, d->sel, &ob->s, &ob->cur, kind);
+    step_map3(d->m + 12 * (size_t)k, &ob->x, &ob->y, &ob->z);
 }
 
 /* Palette index of the current hit's colour. */
@@ -341,20 +354,8 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     for (int q = 0; q < RING; q++)
         ring[q] = j->nbins, ringc[q] = 0;
     for (uint64_t i = 0; i < count; i++) {
-        uint64_t wd = rng_next(&r);
-        uint32_t col = (uint32_t)(((wd >> 32) * n) >> 32);
-        if (kind != KIND_IFS)
-            col += st * n;
-        uint32_t k = sel[2 * col + ((uint32_t)wd < thr[col])];
-        if (kind == KIND_R1)
-            st = k;
-        else if (kind == KIND_R2)
-            st = cur * n + k;
-        cur = k;
-        const double *m = M + 6 * (size_t)k;
-        double nx = m[0] * x + m[1] * y + m[2];
-        double ny = m[3] * x + m[4] * y + m[5];
-        x = nx, y = ny;
+        uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
+        step_map2(M + 6 * (size_t)k, &x, &y);
         uint32_t pc = 0;
         if (colour == CHAOS_COLOUR_BLEND) {
             c = (c + mc[k]) * 0.5; /* flam3's colour coordinate */
@@ -438,21 +439,8 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
         ring[i] = trash;
     uint64_t inside = 0;
     for (uint64_t i = 0; i < count; i++) {
-        uint64_t wd = rng_next(&r);
-        uint32_t col = (uint32_t)(((wd >> 32) * n) >> 32);
-        if (kind != KIND_IFS)
-            col += st * n;
-        uint32_t k = sel[2 * col + ((uint32_t)wd < thr[col])];
-        if (kind == KIND_R1)
-            st = k;
-        else if (kind == KIND_R2)
-            st = cur * n + k;
-        cur = k;
-        const double *m = M + 12 * (size_t)k;
-        double nx_ = m[0] * x + m[1] * y + m[2] * z + m[3];
-        double ny_ = m[4] * x + m[5] * y + m[6] * z + m[7];
-        double nz_ = m[8] * x + m[9] * y + m[10] * z + m[11];
-        x = nx_, y = ny_, z = nz_;
+        uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
+        step_map3(M + 12 * (size_t)k, &x, &y, &z);
         double fx = (x - lx) * sx, fy = (y - ly) * sy, fz = (z - lz) * sz;
         int in = fx >= 0 && fx < fx_n && fy >= 0 && fy < fy_n && fz >= 0 && fz < fz_n;
         size_t b = trash;

@@ -457,6 +457,92 @@ static void test_tonemap(void)
     hist2_free(&hs);
 }
 
+
+/* 3-D maps with every matrix entry distinct and non-zero: the centroid of
+ * the invariant measure solves c = sum_i p_i (M_i c + t_i), i.e.
+ * (I - sum p_i M_i) c = sum p_i t_i, solved here by Cramer's rule. Both 3-D
+ * paths (the voxel hot loop and the point cloud) must reproduce it, so a
+ * swapped or mis-signed matrix term in either loop is caught. */
+static double det3(const double a[3][3])
+{
+    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+           a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+           a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+}
+
+static void test_3d_nondiagonal(void)
+{
+    static const double M[2][9] = {{0.50, 0.20, -0.10, 0.10, 0.40, 0.15, -0.05, 0.12, 0.45},
+                                   {0.30, -0.15, 0.22, 0.25, 0.35, -0.11, 0.13, -0.20, 0.40}};
+    static const double T[2][3] = {{0.1, -0.2, 0.3}, {0.5, 0.4, -0.1}};
+    double p[2] = {0.4, 0.6};
+    double A[3][3], b[3], c[3];
+    for (int i = 0; i < 3; i++) {
+        b[i] = p[0] * T[0][i] + p[1] * T[1][i];
+        for (int j = 0; j < 3; j++)
+            A[i][j] = (i == j) - (p[0] * M[0][3 * i + j] + p[1] * M[1][3 * i + j]);
+    }
+    double D = det3(A);
+    for (int k = 0; k < 3; k++) {
+        double Ak[3][3];
+        memcpy(Ak, A, sizeof Ak);
+        for (int i = 0; i < 3; i++)
+            Ak[i][k] = b[i];
+        c[k] = det3(Ak) / D;
+    }
+    rt_error e;
+    affine maps[2] = {affine_from_3d(M[0], T[0]), affine_from_3d(M[1], T[1])};
+    ifs f;
+    CHECK(ifs_build(&f, maps, 2, p, 0, &e) == RT_OK, "3-D build: %s", e.msg);
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.points = 4000000;
+    o.seed = 7;
+    double lo[3], hi[3];
+    CHECK(chaos_fit(&s, &o, 0, 0, lo, hi, &e) == RT_OK, "3-D fit");
+    /* voxels: measure-weighted mean of voxel centres */
+    volume vol;
+    int nv = 96;
+    CHECK(volume_init(&vol, nv, nv, nv, lo, hi, &e) == RT_OK, "volume");
+    rt_run run = {2, NULL, 0};
+    CHECK(chaos_volume(&s, &o, CHAOS_NORM_TOTAL, &vol, NULL, &run, &e) == RT_OK, "chaos_volume");
+    double m[3] = {0, 0, 0}, tot = 0;
+    for (int z = 0; z < nv; z++)
+        for (int y = 0; y < nv; y++)
+            for (int x = 0; x < nv; x++) {
+                double w = *volume_at(&vol, x, y, z);
+                int q[3] = {x, y, z};
+                for (int a = 0; a < 3; a++)
+                    m[a] += w * (lo[a] + (q[a] + 0.5) * (hi[a] - lo[a]) / nv);
+                tot += w;
+            }
+    double worst = 0;
+    for (int a = 0; a < 3; a++) {
+        double err = fabs(m[a] / tot - c[a]) / (hi[a] - lo[a]);
+        worst = err > worst ? err : worst;
+    }
+    /* sampling error ~ extent / sqrt(points) ≈ 5e-4; a swapped term moves it by > 1e-2 */
+    CHECK(worst < 3e-3, "3-D voxel centroid off by %.2g of the box (c = %.4f %.4f %.4f)", worst, c[0],
+          c[1], c[2]);
+    volume_free(&vol);
+    /* point cloud: plain mean of the positions */
+    mesh pts = {0};
+    o.points = 1000000;
+    CHECK(chaos_points(&s, &o, &pts, &run, &e) == RT_OK, "chaos_points");
+    double pm[3] = {0, 0, 0};
+    for (size_t i = 0; i < pts.nv; i++)
+        for (int a = 0; a < 3; a++)
+            pm[a] += pts.pos[3 * i + a];
+    worst = 0;
+    for (int a = 0; a < 3; a++) {
+        double err = fabs(pm[a] / (double)pts.nv - c[a]) / (hi[a] - lo[a]);
+        worst = err > worst ? err : worst;
+    }
+    CHECK(pts.nv == 1000000 && worst < 3e-3, "3-D point centroid off by %.2g of the box", worst);
+    mesh_free(&pts);
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -464,6 +550,7 @@ int main(void)
     test_rifs_measure();
     test_order2();
     test_threads();
+    test_3d_nondiagonal();
     test_tonemap();
     return check_done("test_chaos");
 }
