@@ -112,7 +112,7 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
             equal = 0;
     uint64_t sk = pow_small(2 * t->ms[0] + 1, s->k);
     int can_close = one_m && equal && sk != 0;
-    if (s->method == IST_CLOSED && !can_close) {
+    if ((s->method == IST_CLOSED || s->method == IST_CLOSED_DIGITS) && !can_close) {
         ist_free(t);
         return rt_fail(e, RT_EINVAL,
                        "IST closed form needs equal base intervals, one crossing count and (2M+1)^K <= 2^52");
@@ -124,7 +124,8 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
         t->s = sk;
         t->a0 = a0;
         t->h = h;
-        fast_init(t);
+        if (s->method != IST_CLOSED_DIGITS)
+            fast_init(t);
         return RT_OK;
     }
     rc = ist_build_lists(t, e);

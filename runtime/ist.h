@@ -68,7 +68,10 @@
 #define IST_MAX_K 60
 
 typedef enum ist_axis_type { IST_TRANSLATION = 0, IST_CYCLIC = 1 } ist_axis_type;
-typedef enum ist_method { IST_AUTO = 0, IST_LISTS = 1, IST_CLOSED = 2 } ist_method;
+/* IST_CLOSED_DIGITS: the closed form evaluated one base-B digit at a time,
+ * never the grouped fast path: the reference the fast path is tested
+ * against (tests/unit/test_ist.c), also usable to measure the gain. */
+typedef enum ist_method { IST_AUTO = 0, IST_LISTS = 1, IST_CLOSED = 2, IST_CLOSED_DIGITS = 3 } ist_method;
 
 typedef struct ist_spec {
     int n;                /* number of base intervals N >= 1 */

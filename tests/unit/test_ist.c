@@ -99,6 +99,44 @@ static void test_bijective(void)
 }
 
 /* The general list construction and the closed form agree on unit intervals. */
+
+/* (2M+1)^K beyond 2^32 takes the 64-bit per-digit branches of the closed
+ * form: slot centres must map to sub-interval centres and F must send them
+ * back to the same slot (an independent check of inv and fwd, which are
+ * separate code). A wrong digit moves a point by whole sub-intervals. */
+static void test_large_k(void)
+{
+    /* S·n stays below 2^40, so a sub-interval is thousands of doubles wide;
+     * at S near 2^52 sub-intervals near u = n are narrower than one ulp of u,
+     * so no double-precision F^{-1} can be one-to-one there (open: issue 13) */
+    static const int mk[4][2] = {{1, 21}, {1, 24}, {2, 14}, {3, 12}};
+    for (int axis = 0; axis < 2; axis++)
+        for (int c = 0; c < 4; c++) {
+            int n = 7, m = mk[c][0], k = mk[c][1];
+            ist t;
+            ist_spec s = {.n = n, .m = m, .k = k, .axis = (ist_axis_type)axis};
+            rt_error e;
+            CHECK(ist_init(&t, &s, &e) == RT_OK, "init K %d: %s", k, e.msg);
+            double S = (double)ipow(2 * m + 1, k);
+            CHECK(t.closed && S > 4294967296.0, "closed form beyond 2^32 (M %d K %d)", m, k);
+            rng r;
+            rng_init(&r, 3, (uint64_t)(axis * 10 + c));
+            int bad = 0;
+            for (int q = 0; q < 4000; q++) {
+                int i = (int)(rng_uniform(&r) * n);
+                double slot = floor(rng_uniform(&r) * S);
+                double u = i + (slot + 0.5) / S;
+                double y = ist_inv(&t, u) * S;
+                double id = floor(y);
+                double back = ist_fwd(&t, (id + 0.5) / S) * S;
+                if (!(fabs(y - (id + 0.5)) < 0.05) || !(floor(back) == i * S + slot))
+                    bad++;
+            }
+            CHECK(bad == 0, "axis %d M %d K %d: %d of 4000 slot centres do not round-trip", axis, m, k, bad);
+            ist_free(&t);
+        }
+}
+
 static void test_lists_vs_closed(void)
 {
     for (int axis = 0; axis < 2; axis++)
@@ -111,9 +149,12 @@ static void test_lists_vs_closed(void)
                 ist_spec s = {.n = n, .m = m, .k = k, .axis = (ist_axis_type)axis, .method = IST_LISTS};
                 rt_error e;
                 CHECK(ist_init(&a, &s, &e) == RT_OK, "lists: %s", e.msg);
-                s.method = IST_CLOSED;
+                /* the per-digit closed form against the lists (an independent
+                 * construction); the grouped fast path is held to the per-digit
+                 * form bit for bit in test_fast_bits */
+                s.method = IST_CLOSED_DIGITS;
                 CHECK(ist_init(&b, &s, &e) == RT_OK, "closed: %s", e.msg);
-                CHECK(a.closed == 0 && b.closed == 1, "methods chosen");
+                CHECK(a.closed == 0 && b.closed == 1 && !b.ftab, "methods chosen");
                 rng r;
                 rng_init(&r, 11, (uint64_t)(axis * 100 + m * 10 + k));
                 double worst = 0, worstf = 0;
@@ -247,130 +288,12 @@ static void test_sampling(void)
 }
 
 
-/* ---- reference: the per-digit closed form as it was before the grouped
- * fast path (copied from ist.c), to check the fast path bit for bit ------- */
-
-static int ref_imod(long a, int n)
-{
-    long r = a % n;
-    return (int)(r < 0 ? r + n : r);
-}
-
-static int ref_locate(const ist *t, double u, double *uw, double *shift)
-{
-    double a = t->bounds[0], b = t->bounds[t->n];
-    *shift = 0;
-    if (t->axis == IST_CYCLIC) {
-        double p = b - a;
-        if (u < a || u >= b) {
-            double q = floor((u - a) / p);
-            *shift = q * p;
-            u -= *shift;
-            if (u >= b)
-                u = a;
-            if (u < a)
-                u = a;
-        }
-    } else if (!(u >= a && u < b)) {
-        return -1;
-    }
-    *uw = u;
-    return 0;
-}
-
-static void ref_slot(int n, int m, int i, int p, int *j, int *piece)
-{
-    int l = i < m ? i : m, r = n - 1 - i < m ? n - 1 - i : m;
-    if (p < l) {
-        int d = p - l;
-        *j = i + d;
-        *piece = m - d;
-    } else if (p < m) {
-        *j = i;
-        *piece = p - l;
-    } else if (p == m) {
-        *j = i;
-        *piece = m;
-    } else {
-        int q = p - m - 1;
-        if (q < m - r) {
-            *j = i;
-            *piece = n - i + m + q;
-        } else {
-            int d = q - (m - r) + 1;
-            *j = i + d;
-            *piece = m - d;
-        }
-    }
-}
-
-static double ref_inv_closed(const ist *t, int i, double r)
-{
-    double y = r * (double)t->s;
-    uint64_t idx = y < (double)t->s ? (uint64_t)y : t->s; /* no UB for NaN (the result is NaN) */
-    if (idx >= t->s)
-        idx = t->s - 1;
-    double rem = y - (double)idx;
-    uint64_t b = (uint64_t)t->b, src = 0;
-    int j;
-    int interior = t->axis == IST_CYCLIC ||
-                   ((long)i >= (long)t->k * t->m && (long)i + (long)t->k * t->m <= (long)t->n - 1);
-    if (interior && t->s <= UINT32_MAX) {
-        uint32_t id32 = (uint32_t)idx, b32 = (uint32_t)t->b, s32 = 0, m2 = (uint32_t)(2 * t->m);
-        long sumd = 0;
-        for (int q = 0; q < t->k; q++) {
-            uint32_t p = id32 % b32;
-            id32 /= b32;
-            sumd += (long)p;
-            s32 = s32 * b32 + m2 - p;
-        }
-        sumd -= (long)t->k * t->m;
-        j = t->axis == IST_CYCLIC ? ref_imod((long)i + sumd, t->n) : (int)((long)i + sumd);
-        src = s32;
-    } else if (interior) {
-        long sumd = 0;
-        for (int q = 0; q < t->k; q++) {
-            uint64_t p = idx % b;
-            idx /= b;
-            sumd += (long)p - t->m;
-            src = src * b + (uint64_t)(2 * t->m) - p;
-        }
-        j = ref_imod((long)i + sumd, t->n);
-    } else {
-        int dig[IST_MAX_K];
-        for (int q = t->k - 1; q >= 0; q--) {
-            dig[q] = (int)(idx % b);
-            idx /= b;
-        }
-        int pc[IST_MAX_K];
-        j = i;
-        for (int q = 0; q < t->k; q++)
-            ref_slot(t->n, t->m, j, dig[q], &j, &pc[q]);
-        for (int q = t->k - 1; q >= 0; q--)
-            src = src * b + (uint64_t)pc[q];
-    }
-    return t->a0 + (double)j * t->h + t->h * (((double)src + rem) / (double)t->s);
-}
-
-static double ref_inv(const ist *t, double u)
-{
-    double uw, shift;
-    if (ref_locate(t, u, &uw, &shift))
-        return u;
-    double f = floor((uw - t->a0) / t->h);
-    int i = f < 0 || f != f ? 0 : f >= t->n ? t->n - 1 : (int)f; /* (int)floor clamped */
-    double r = (uw - (t->a0 + (double)i * t->h)) / t->h;
-    if (r < 0)
-        r = 0;
-    return ref_inv_closed(t, i, r) + shift;
-}
-
 static int same_bits(double a, double b)
 {
     return memcmp(&a, &b, sizeof a) == 0 || (a != a && b != b);
 }
 
-/* The grouped fast path (and ist_inv_block) equals the per-digit code bit
+/* The grouped fast path (and ist_inv_block) equals the library's per-digit evaluation (IST_CLOSED_DIGITS) bit
  * for bit: M = 1..3, K = 0..8 and a few larger K, both axis types, unit and
  * other interval lengths, many u including every sub-interval boundary of
  * some intervals and its neighbouring doubles. */
@@ -392,11 +315,13 @@ static void test_fast_bits(void)
                     double bounds[65];
                     for (int i = 0; i <= n; i++)
                         bounds[i] = a0s[g] + (double)i * hs[g];
-                    ist t;
+                    ist t, ref;
                     ist_spec s = {.n = n, .bounds = bounds, .m = m, .k = k, .axis = (ist_axis_type)axis};
                     rt_error e;
                     CHECK(ist_init(&t, &s, &e) == RT_OK, "init: %s", e.msg);
-                    CHECK(t.closed, "closed form");
+                    s.method = IST_CLOSED_DIGITS;
+                    CHECK(ist_init(&ref, &s, &e) == RT_OK, "per-digit init: %s", e.msg);
+                    CHECK(t.closed && ref.closed && !ref.ftab, "closed form, reference per digit");
                     fast += t.ftab != NULL;
                     rng r;
                     rng_init(&r, 5, (uint64_t)(axis * 1000 + m * 100 + k * 5 + g));
@@ -419,7 +344,7 @@ static void test_fast_bits(void)
                     ist_inv_block(&t, nu, u, got);
                     int bad = 0;
                     for (size_t q = 0; q < nu; q++) {
-                        double want = ref_inv(&t, u[q]), one = ist_inv(&t, u[q]);
+                        double want = ist_inv(&ref, u[q]), one = ist_inv(&t, u[q]);
                         if (!same_bits(want, one) || !same_bits(want, got[q])) {
                             if (bad++ < 3)
                                 CHECK(0, "axis %d M %d K %d set %d: u = %.17g: %.17g / block %.17g, per-digit %.17g",
@@ -432,8 +357,9 @@ static void test_fast_bits(void)
                     memcpy(got, u, sizeof(double) * 100);
                     ist_inv_block(&t, 100, got, got);
                     for (int q = 0; q < 100; q++)
-                        CHECK(same_bits(got[q], ref_inv(&t, u[q])), "in place");
+                        CHECK(same_bits(got[q], ist_inv(&ref, u[q])), "in place");
                     ist_free(&t);
+                    ist_free(&ref);
                 }
     CHECK(fast > 100, "the fast path is used (%ld configurations)", fast);
     CHECK(tested > 1000000, "%ld evaluations compared", tested);
@@ -445,6 +371,7 @@ int main(void)
 {
     test_fig2();
     test_bijective();
+    test_large_k();
     test_lists_vs_closed();
     test_general();
     test_validation();
