@@ -505,6 +505,80 @@ static void test_handmade(void)
     image_free(&src);
 }
 
+
+/* Filtering by the rules of §9.2–9.4 and the §12.8 heuristic (minimum sum
+ * of |residual| read as signed bytes; the lowest filter type wins a tie),
+ * written out here from the spec, against the encoder's filtered bytes, on
+ * rows of few distinct values so Paeth's ties (prefer a, then b, then c)
+ * are frequent. The test insists that Paeth wins rows with b/c ties, so a
+ * tie broken the wrong way in the encoder cannot hide. (An a/b tie with
+ * a != b cannot happen: |b-c| = |a-c| and |a-c| <= |a+b-2c| force a = b = c.) */
+static int paeth_ref(int a, int b, int c)
+{
+    int p = a + b - c;
+    int pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+    return pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+}
+
+static void test_paeth_ties(void)
+{
+    enum { W = 40, H = 300 };
+    unsigned char *rows = malloc(W * H), *want = malloc((W + 1) * H);
+    CHECK(rows && want, "memory");
+    uint32_t x = 12345;
+    for (int i = 0; i < W * H; i++) {
+        x = x * 1103515245u + 12345u;
+        rows[i] = (unsigned char)(100 + ((x >> 16) % 4) * 3 + (i % W) / 8);
+    }
+    int paeth_rows_with_ties = 0;
+    for (int y = 0; y < H; y++) {
+        const unsigned char *cur = rows + y * W;
+        unsigned char res[5][W];
+        long cost[5] = {0};
+        int ties = 0;
+        for (int i = 0; i < W; i++) {
+            int a = i ? cur[i - 1] : 0, b = y ? cur[i - W] : 0, c = i && y ? cur[i - W - 1] : 0;
+            int p = a + b - c, pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+            ties += pb == pc && pb < pa && b != c;
+            int pred[5] = {0, a, b, (a + b) / 2, paeth_ref(a, b, c)};
+            for (int f = 0; f < 5; f++) {
+                res[f][i] = (unsigned char)(cur[i] - pred[f]);
+                cost[f] += res[f][i] < 128 ? res[f][i] : 256 - res[f][i];
+            }
+        }
+        int best = 0;
+        for (int f = 1; f < 5; f++)
+            if (cost[f] < cost[best])
+                best = f;
+        want[y * (W + 1)] = (unsigned char)best;
+        memcpy(want + y * (W + 1) + 1, res[best], W);
+        paeth_rows_with_ties += best == 4 && ties >= 2;
+    }
+    CHECK(paeth_rows_with_ties >= 20, "Paeth wins %d rows that have b/c ties", paeth_rows_with_ties);
+    bytebuf out, filt;
+    bytebuf_init(&out);
+    bytebuf_init(&filt);
+    rt_error e;
+    CHECK(png_encode_samples(rows, W, H, 1, 8, 6, &out, &filt, &e) == RT_OK, "encode: %s", e.msg);
+    int bad = -1;
+    if (filt.len == (size_t)(W + 1) * H)
+        for (bad = 0; bad < H && !memcmp(filt.data + bad * (W + 1), want + bad * (W + 1), W + 1); bad++)
+            ;
+    CHECK(bad == H, "filtered rows differ from the spec's rules first at row %d", bad);
+    image im;
+    png_info info;
+    CHECK(png_decode(out.data, out.len, &im, &info, &e) == RT_OK, "decode: %s", e.msg);
+    int diff = 0;
+    for (int i = 0; i < W * H; i++)
+        diff += png_sample(image_at(&im, i % W, i / W)[0], 255) != rows[i];
+    CHECK(diff == 0, "decoded image differs in %d pixels", diff);
+    image_free(&im);
+    bytebuf_free(&out);
+    bytebuf_free(&filt);
+    free(rows);
+    free(want);
+}
+
 int main(void)
 {
     test_encoder();
@@ -512,5 +586,6 @@ int main(void)
     test_16bit();
     test_corrupt_suite();
     test_handmade();
+    test_paeth_ties();
     return check_done("test_png");
 }
