@@ -333,6 +333,68 @@ static void cross_norm(const double a[3], const double b[3], double n[3])
         n[0] /= l, n[1] /= l, n[2] /= l;
 }
 
+static void cross3(const double a[3], const double b[3], double n[3])
+{
+    n[0] = a[1] * b[2] - a[2] * b[1];
+    n[1] = a[2] * b[0] - a[0] * b[2];
+    n[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+void wrinkly_surface_flux(const wrinkly_surface *s, double tension, double *flux, double *reach)
+{
+    enum { G = 5 };
+    double lam = lam_of(tension);
+    /* midpoint rule on G×G cells per patch: first the area centroid, then Φ */
+    double c[3] = {0, 0, 0}, area = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        double f = 0, af = 0;
+        for (int j = 0; j < s->nv; j++)
+            for (int i = 0; i < s->nu; i++)
+                for (int b = 0; b < G; b++)
+                    for (int a = 0; a < G; a++) {
+                        axw au, av;
+                        axis_weights(s->nu, s->au.cyclic, lam, 1, i + (a + 0.5) / G, &au);
+                        axis_weights(s->nv, s->av.cyclic, lam, 1, j + (b + 0.5) / G, &av);
+                        double p[3], pu[3], pv[3], n[3];
+                        surf_eval(s, &au, &av, p, pu, pv);
+                        cross3(pu, pv, n);
+                        double dA = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                        if (pass == 0) {
+                            for (int d = 0; d < 3; d++)
+                                c[d] += p[d] * dA;
+                            area += dA;
+                        } else {
+                            double r[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+                            f += r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
+                            af += sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) * dA;
+                        }
+                    }
+        if (pass == 0 && area > 0)
+            for (int d = 0; d < 3; d++)
+                c[d] /= area;
+        *flux = f / (G * G);
+        *reach = af / (G * G);
+    }
+}
+
+int wrinkly_surface_side(const wrinkly_surface *s, const wrinkly_opts *o, rt_error *e)
+{
+    if (o->normal == WRINKLY_NORMAL_UV)
+        return 1;
+    double f, af;
+    wrinkly_surface_flux(s, o->tension, &f, &af);
+    int body = af > 0 && fabs(f) >= 0.25 * af;
+    if (o->normal == WRINKLY_NORMAL_AUTO)
+        return body && f < 0 ? -1 : 1;
+    if (!(af > 0 && fabs(f) > 1e-6 * af)) {
+        rt_fail(e, RT_EINVAL, "the surface encloses no volume, so no side of it is %s (use normal \"uv\")",
+                o->normal == WRINKLY_NORMAL_OUTWARD ? "outward" : "inward");
+        return 0;
+    }
+    int out = f < 0 ? -1 : 1;
+    return o->normal == WRINKLY_NORMAL_OUTWARD ? out : -out;
+}
+
 void wrinkly_surface_base(const wrinkly_surface *s, double tension, double u, double v, double p[3],
                           double n[3])
 {
@@ -361,6 +423,7 @@ typedef struct surf_job {
     int cyc_u, cyc_v;
     double *r;   /* displaced positions, nu*nv*3 */
     mesh *m;
+    double side; /* +1 or -1 on P_u × P_v (wrinkly_surface_side) */
 } surf_job;
 
 static double attr2(const wrinkly_surface *s, const axw *a, const axw *b, int which)
@@ -383,6 +446,8 @@ static void surf_row(void *ctx, size_t j, int worker)
         double p[3], pu[3], pv[3], n[3];
         surf_eval(s, &su->pos, &sv->pos, p, pu, pv);
         cross_norm(pu, pv, n);
+        for (int d = 0; d < 3; d++)
+            n[d] *= J->side;
         double cw = su->crack * sv->crack;
         double av[5];
         for (int w = 0; w < 5; w++) {
@@ -421,7 +486,7 @@ static void surf_normals(void *ctx, size_t j, int worker)
         size_t id = j * nu + i;
         if (n[0] != 0 || n[1] != 0 || n[2] != 0)
             for (int q = 0; q < 3; q++)
-                J->m->nrm[3 * id + q] = (float)n[q];
+                J->m->nrm[3 * id + q] = (float)(n[q] * J->side);
     }
 }
 
@@ -529,6 +594,11 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         rc = rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly surface");
         goto done;
     }
+    int side = wrinkly_surface_side(s, o, e);
+    if (!side) {
+        rc = RT_EINVAL;
+        goto done;
+    }
     wrinkly_surface_levels(s, o, ku, kv);
     rc = make_axis(s->nu, &s->au, ku, o, lam, 1, &su, &nu, &k[0], e);
     if (!rc)
@@ -555,7 +625,7 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
     }
     out->nv = out->cap_v = nvert;
     out->nt = out->cap_t = ntri;
-    surf_job J = {s, o, su, sv, nu, nv, s->au.cyclic, s->av.cyclic, r, out};
+    surf_job J = {s, o, su, sv, nu, nv, s->au.cyclic, s->av.cyclic, r, out, side};
     rc = par_for(run, "wrinkly surface", nv, surf_row, &J);
     if (!rc)
         rc = par_for(run, "wrinkly normals", nv, surf_normals, &J);
@@ -569,11 +639,14 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
             uint32_t a = (uint32_t)(j * nu + i), b = (uint32_t)(j * nu + (i + 1) % nu);
             uint32_t c = (uint32_t)(((j + 1) % nv) * nu + (i + 1) % nu), d = (uint32_t)(((j + 1) % nv) * nu + i);
             uint32_t *tr = out->tri + 3 * t;
+            if (side < 0) /* counter-clockwise seen from the side N points to */
+                b ^= d, d ^= b, b ^= d;
             tr[0] = a, tr[1] = b, tr[2] = c;
             tr[3] = a, tr[4] = c, tr[5] = d;
             t += 2;
         }
     if (info) {
+        info->side = side;
         info->k[0] = k[0];
         info->k[1] = k[1];
         info->samples[0] = nu;

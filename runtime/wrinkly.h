@@ -96,7 +96,24 @@ typedef struct wrinkly_opts {
     int jitter;             /* 1: random point inside each sampled sub-interval */
     uint64_t seed;
     double crack_band;      /* 0: off; else half-width of the blend band at joints */
+    int normal;             /* surfaces: WRINKLY_NORMAL_* (which side N and the heights face) */
 } wrinkly_opts;
+
+/* Orientation of a surface's normal N (and so of its heights and winding).
+ * The flux of the base surface about its centroid c, Φ = ∫ (P - c)·(P_u × P_v)
+ * du dv, says which way P_u × P_v faces: Φ > 0 outward, Φ < 0 inward (for a
+ * closed surface Φ is 3× the enclosed volume). Against the reach
+ * ρ = ∫ |P - c| |P_u × P_v| du dv (Φ = ρ for a sphere about its centre, and
+ * |Φ| <= ρ always) a surface is body-like when |Φ| >= ρ/4: a sphere, a
+ * torus (≈ 0.7), a cap, a tube up to ~20 radii long; a flat sheet (Φ = 0) or
+ * a wavy terrain is not, and a sheet has no outward side (|Φ| <= 1e-6 ρ).
+ *  AUTO:    outward if body-like, else P_u × P_v (the default);
+ *  OUTWARD: N points away from the body (error if Φ = 0: no side is outward);
+ *  INWARD:  the opposite;
+ *  UV:      N = P_u × P_v as the paper writes it, whatever the grid order.
+ * Triangles wind counter-clockwise seen from the side N points to, so a
+ * closed outward mesh has positive signed volume. */
+enum { WRINKLY_NORMAL_AUTO = 0, WRINKLY_NORMAL_OUTWARD, WRINKLY_NORMAL_INWARD, WRINKLY_NORMAL_UV };
 
 void wrinkly_opts_default(wrinkly_opts *o);
 
@@ -141,8 +158,16 @@ typedef struct wrinkly_surface {
 void wrinkly_surface_base(const wrinkly_surface *s, double tension, double u, double v, double p[3],
                           double n[3]);
 
+/* Φ and ρ of the base surface (above), by the midpoint rule on 5×5 cells
+ * per patch. */
+void wrinkly_surface_flux(const wrinkly_surface *s, double tension, double *flux, double *reach);
+/* The sign (+1 or -1) that o->normal applies to P_u × P_v; 0 after an error
+ * (OUTWARD/INWARD on a surface with no outward side). */
+int wrinkly_surface_side(const wrinkly_surface *s, const wrinkly_opts *o, rt_error *e);
+
 typedef struct wrinkly_info {
     int k[2];          /* K on u and v */
+    int side;          /* +1: N = P_u × P_v, -1: N = P_v × P_u */
     size_t samples[2]; /* vertices along u and v */
     size_t vertices, triangles;
 } wrinkly_info;

@@ -135,6 +135,7 @@ static void test_surface(void)
         wrinkly_opts o;
         wrinkly_opts_default(&o);
         o.k = 2;
+        o.normal = WRINKLY_NORMAL_UV; /* the winding test below follows P_u × P_v */
         mesh m;
         wrinkly_info info;
         rt_error e;
@@ -226,9 +227,101 @@ static void test_surface(void)
     free(p);
 }
 
+
+/* Signed volume of a triangle mesh, Σ a·(b × c)/6 (positive: outward winding). */
+static double signed_volume(const mesh *m)
+{
+    double v = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const float *a = m->pos + 3 * m->tri[3 * t], *b = m->pos + 3 * m->tri[3 * t + 1],
+                    *c = m->pos + 3 * m->tri[3 * t + 2];
+        v += (a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) - a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
+              a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) / 6;
+    }
+    return v;
+}
+
+/* Orientation (wrinkly.h): the torus in both grid orders (u around the
+ * axis or around the tube) is outward by default and with "outward",
+ * inward with "inward", and follows P_u × P_v with "uv"; heights then push
+ * the surface out of the body; a flat sheet has no outward side. */
+static void test_orientation(void)
+{
+    int nu = 8, nv = 6;
+    wrinkly_point *p = torus(nu, nv, 5);
+    wrinkly_point *q = calloc((size_t)nu * nv, sizeof *q); /* transposed: u runs around the tube */
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++)
+            q[i * nv + j] = p[j * nu + i];
+    double vol_tube = 2 * 3.14159265358979 * 3 * 3.14159265358979; /* 2π R · π r², R = 3, r = 1 */
+    for (int order = 0; order < 2; order++) {
+        wrinkly_surface s = order ? (wrinkly_surface){q, nv, nu, {1, 1, 1}, {1, 1, 1}}
+                                  : (wrinkly_surface){p, nu, nv, {1, 1, 1}, {1, 1, 1}};
+        double sign_uv = 0;
+        int sides[4] = {0, 0, 0, 0};
+        for (int mode = 0; mode < 4; mode++) {
+            wrinkly_opts o;
+            wrinkly_opts_default(&o);
+            o.k = 1;
+            o.normal = mode;
+            mesh m;
+            rt_error e;
+            wrinkly_info info;
+            CHECK(wrinkly_surface_mesh(&s, &o, NULL, &m, &info, &e) == RT_OK, "mesh: %s", e.msg);
+            double v = signed_volume(&m);
+            /* heights 0..0.3 outward grow the tube; the spline base alone is a
+             * little inside the control torus */
+            if (mode == WRINKLY_NORMAL_AUTO || mode == WRINKLY_NORMAL_OUTWARD)
+                CHECK(v > 0.8 * vol_tube, "order %d mode %d: volume %.3f, expected > %.3f", order, mode, v,
+                      0.8 * vol_tube);
+            else if (mode == WRINKLY_NORMAL_INWARD)
+                CHECK(v < 0 && -v < 0.8 * vol_tube, "order %d inward: volume %.3f (heights push in)", order, v);
+            else
+                sign_uv = v > 0 ? 1 : -1;
+            /* every vertex normal agrees with the winding: dot with the face normal > 0 */
+            int agree = 0;
+            for (size_t t = 0; t < m.nt; t++) {
+                const uint32_t *tr = m.tri + 3 * t;
+                const float *a = m.pos + 3 * tr[0], *b = m.pos + 3 * tr[1], *c = m.pos + 3 * tr[2];
+                double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+                double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+                const float *vn = m.nrm + 3 * tr[0];
+                agree += fn[0] * vn[0] + fn[1] * vn[1] + fn[2] * vn[2] > 0;
+            }
+            CHECK(agree > 0.95 * (double)m.nt, "order %d mode %d: vertex normals follow the winding (%d of %zu)",
+                  order, mode, agree, m.nt);
+            sides[mode] = info.side;
+            mesh_free(&m);
+        }
+        CHECK(sides[WRINKLY_NORMAL_UV] == 1 && sides[WRINKLY_NORMAL_AUTO] == sides[WRINKLY_NORMAL_OUTWARD] &&
+                  sides[WRINKLY_NORMAL_INWARD] == -sides[WRINKLY_NORMAL_OUTWARD],
+              "order %d: sides reported %d %d %d %d", order, sides[0], sides[1], sides[2], sides[3]);
+        /* this torus: P_u × P_v points inward in one grid order and outward in the other */
+        CHECK(sign_uv == (order ? 1 : -1), "order %d: uv orientation %g", order, sign_uv);
+    }
+    /* a flat sheet: auto keeps P_u × P_v, outward is refused */
+    wrinkly_point flat[16];
+    memset(flat, 0, sizeof flat);
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++)
+            flat[j * 4 + i].pos[0] = i, flat[j * 4 + i].pos[2] = -j, flat[j * 4 + i].opacity = 1;
+    wrinkly_surface sh = {flat, 4, 4, {0, 1, 1}, {0, 1, 1}};
+    wrinkly_opts o;
+    wrinkly_opts_default(&o);
+    rt_error e;
+    CHECK(wrinkly_surface_side(&sh, &o, &e) == 1, "flat sheet: auto is uv");
+    o.normal = WRINKLY_NORMAL_OUTWARD;
+    CHECK(wrinkly_surface_side(&sh, &o, &e) == 0 &&
+              strcmp(e.msg, "the surface encloses no volume, so no side of it is outward (use normal \"uv\")") == 0,
+          "flat sheet: outward refused: %s", e.msg);
+    free(p);
+    free(q);
+}
+
 int main(void)
 {
     test_curve();
     test_surface();
+    test_orientation();
     return check_done("test_wrinkly");
 }
