@@ -1,4 +1,5 @@
 /* builtins_core.c — math, lists, strings, printing, randomness. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdarg.h>
@@ -644,11 +645,17 @@ static int b_print(interp *I, value *a, int n, value *out)
         val_print(I, a[i], &b, 0);
     }
     bytebuf_byte(&b, '\n');
-    if (b.data)
-        fwrite(b.data, 1, b.len, I->out);
-    fflush(I->out);
+    errno = 0;
+    int bad = b.data && fwrite(b.data, 1, b.len, I->out) != b.len;
+    bad |= fflush(I->out) != 0 || ferror(I->out);
+    int e = errno;
     bytebuf_free(&b);
     *out = val_nil();
+    if (bad) {
+        clearerr(I->out); /* each failed print reports itself */
+        return err_at(I, NULL, ERR_IO, "print: cannot write to standard output%s%s", e ? ": " : "",
+                      e ? strerror(e) : "");
+    }
     return 0;
 }
 

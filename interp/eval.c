@@ -785,6 +785,12 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
 
 /* ---- statements --------------------------------------------------------------- */
 
+/* -D NAME=VALUE for `param NAME = default` (main.c runs this before the script
+ * for literal defaults). A string param takes the text as it is, or a quoted
+ * "string"; anything else is an expression evaluated among the builtins only
+ * (so the result does not depend on where the script is), and must have the
+ * default's type (any type for a nil default), a number being finite, as are
+ * the numbers in a list. A wrong value is a usage error at the `param`. */
 static int apply_param_override(interp *I, const node *n, value def, value *out)
 {
     for (int i = 0; i < I->noverrides; i++) {
@@ -792,40 +798,66 @@ static int apply_param_override(interp *I, const node *n, value def, value *out)
         if (o->name != n->str)
             continue;
         o->used = 1;
-        char srcname[160];
-        snprintf(srcname, sizeof srcname, "-D %s", n->str);
+        const node *at = n;
+        const char *tn = val_type_name(def), *t = o->text;
+        const char *article = def.k == V_NIL ? "" : strchr("aeiou", tn[0]) ? "an " : "a ";
         value v;
-        int save_depth = I->depth;
-        if (eval_text(I, srcname, o->text, &v)) {
-            /* a bare word is a string */
-            if (I->err.kind != ERR_NAME || def.k != V_STR) {
-                if (def.k == V_NUM || def.k == V_BOOL || def.k == V_LIST) {
-                    err_clear(I);
-                    I->depth = save_depth;
-                    return err_at(I, n, ERR_USAGE, "-D %s=%s: the parameter is a %s, and '%s' is not one",
-                                  n->str, o->text, val_type_name(def), o->text);
-                }
-                return -1;
-            }
-            err_clear(I);
-            I->depth = save_depth;
-            v = val_cstr(I, o->text);
+        if (def.k == V_STR && t[0] != '"') {
+            v = val_cstr(I, t);
             if (v.k == V_NIL)
                 return -1;
+        } else {
+            char srcname[160];
+            snprintf(srcname, sizeof srcname, "-D %s", n->str);
+            int src = interp_add_source(I, srcname, t, strlen(t));
+            if (src < 0)
+                return -1;
+            env *root = I->globals;
+            while (root->parent)
+                root = root->parent;
+            int save_depth = I->depth;
+            node *prog;
+            int bad = parse_source(I, src, &prog) || prog->nkids != 1 || prog->kids[0]->kind != N_EXPR ||
+                      eval_expr(I, root, prog->kids[0]->kids[0], &v);
+            if (bad) {
+                err_kind k = I->err.active ? I->err.kind : ERR_SYNTAX;
+                if (k != ERR_SYNTAX && k != ERR_NAME && k != ERR_TYPE && k != ERR_VALUE)
+                    return -1; /* out of memory, interrupted…: not about the text */
+                err_clear(I);
+                I->depth = save_depth;
+                if (def.k == V_NIL)
+                    return err_at(I, at, ERR_USAGE,
+                                  "-D %s=%s: '%s' is not a value (the default is nil, so any value "
+                                  "goes; quote a string: -D '%s=\"%s\"')",
+                                  n->str, t, t, n->str, t);
+                return err_at(I, at, ERR_USAGE, "-D %s=%s: the parameter is %s%s%s, and '%s' is not one",
+                              n->str, t, article, tn, def.k == V_BOOL ? " (true or false)" : "", t);
+            }
         }
         if (def.k != V_NIL && v.k != def.k) {
-            err_at(I, n, ERR_TYPE, "-D %s=%s: the parameter is a %s (default ", n->str, o->text,
-                   val_type_name(def));
-            bytebuf b;
-            bytebuf_init(&b);
-            val_print(I, def, &b, 1);
-            bytebuf_byte(&b, 0);
-            size_t l = strlen(I->err.msg);
-            snprintf(I->err.msg + l, sizeof I->err.msg - l, "%s), but the value given is a %s",
-                     b.data ? (char *)b.data : "", val_type_name(v));
-            bytebuf_free(&b);
+            const char *vn = val_type_name(v);
+            err_at(I, at, ERR_USAGE, "-D %s=%s: the parameter is %s%s%s, and '%s' is %s%s", n->str, t,
+                   article, tn, def.k == V_BOOL ? " (true or false)" : "", t,
+                   strchr("aeiou", vn[0]) ? "an " : "a ", vn);
             val_unref(I, v);
             return -1;
+        }
+        const value *items = &v;
+        size_t nitems = 1;
+        if (v.k == V_LIST) {
+            items = AS_LIST(v)->items;
+            nitems = AS_LIST(v)->n;
+        }
+        for (size_t j = 0; j < nitems; j++) {
+            if (items[j].k == V_NUM && !isfinite(items[j].u.n)) {
+                char where[48] = "";
+                if (v.k == V_LIST)
+                    snprintf(where, sizeof where, "item %zu of ", j + 1);
+                err_at(I, at, ERR_USAGE, "-D %s=%s: %s'%s' is %s; the parameter takes finite numbers", n->str,
+                       t, where, t, isnan(items[j].u.n) ? "not a number (nan)" : "infinite");
+                val_unref(I, v);
+                return -1;
+            }
         }
         *out = v;
         return 1;

@@ -1,37 +1,71 @@
-/* main.c — the command line: run, check, repl, -e. The only place that exits. */
+/* main.c — the command line: run, check, repl, -e. The only place that exits.
+ *
+ *   frac [COMMAND] [OPTIONS] [SCRIPT] [OPTIONS | ARGS]… [-- ARGS…]
+ *
+ * Options are recognised anywhere before `--`. The first word that is not an
+ * option (nor, before it, a command word) is the script; every later word is
+ * one of the script's `args`. Nothing on the command line is ignored: an
+ * option that does not apply, a bad number or an unknown -D name is a usage
+ * error (64) before anything runs, and a failed write to standard output or
+ * standard error makes the exit code 74. */
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "builtin.h"
+#include "eval.h"
 #include "fileio.h"
 #include "par.h"
+#include "parser.h"
 #include "repl.h"
 #include "session.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
 
 static const char usage_text[] =
-    "usage: frac SCRIPT.frac [ARGS…]       run a script (same as `frac run`)\n"
-    "       frac run [OPTIONS] SCRIPT.frac  run; files named in the script are written\n"
-    "       frac check [--params] SCRIPT    parse and check names without rendering\n"
-    "       frac repl                       interactive session (also: `frac` alone)\n"
-    "       frac -e 'EXPR'                  evaluate one expression and print it\n"
+    "usage: frac [run] [OPTIONS] SCRIPT.frac [OPTIONS] [ARGS…] [-- ARGS…]\n"
+    "                                          run a script; files it names are written\n"
+    "       frac check [--params] [OPTIONS] SCRIPT.frac\n"
+    "                                          parse and check without running anything\n"
+    "       frac repl                          interactive session (also: `frac` alone)\n"
+    "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac --version | --help\n"
     "\n"
-    "SCRIPT may be - to read the script from standard input.\n"
+    "SCRIPT may be - to read the script from standard input. A script may start\n"
+    "with `#!/usr/bin/env frac` and then runs as `./SCRIPT.frac -D NAME=VALUE …`.\n"
+    "Options may come before or after SCRIPT, mixed with its arguments: each word\n"
+    "after SCRIPT that is not an option goes, in order, into the list of strings\n"
+    "`args` (`frac s.frac a -D x=1 b`: args is [\"a\", \"b\"] and x is 1). `--` ends\n"
+    "the options: every word after it is an argument, even one that starts with -.\n"
+    "Long options take their value as `--NAME VALUE` or `--NAME=VALUE`; giving an\n"
+    "option twice is an error.\n"
     "\n"
     "options:\n"
-    "  -o, --out-dir DIR     where relative output paths go (default: current directory)\n"
-    "  -D NAME=VALUE         override a top-level `param` of the script\n"
-    "  --seed N              global random seed (default 1)\n"
-    "  --threads N           worker threads (default: all cores)\n"
-    "  --quiet               no progress bars or `wrote FILE` lines\n"
+    "  -o, --out-dir DIR     where relative output paths go (default: current\n"
+    "                        directory); created, with its parents, before the\n"
+    "                        script runs\n"
+    "  -D NAME=VALUE         override the script's top-level `param NAME = …`; also\n"
+    "                        -DNAME=VALUE. VALUE must suit the param's default: a\n"
+    "                        number param takes a finite number (1e6, -2, pi/4), a\n"
+    "                        boolean param true or false, a list param a list\n"
+    "                        ([0, 2]), a string param the text as it is (or a\n"
+    "                        quoted \"string\"). VALUE may use builtins, not the\n"
+    "                        script's names. Checked before anything runs (for a\n"
+    "                        computed default, when the script reaches the param);\n"
+    "                        an unknown NAME is an error\n"
+    "  --seed N              global random seed, a whole number 0 ≤ N ≤ 2^53\n"
+    "                        (default 1)\n"
+    "  --threads N           worker threads, 1 to 256 (default: all cores)\n"
+    "  -q, --quiet           no progress bars or `wrote FILE` lines\n"
     "  --params              with check: list the script's params and defaults\n"
-    "limits (a script that exceeds one stops with an error naming it):\n"
+    "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
+    "naming it):\n"
     "  --max-memory MIB      memory for values, images, volumes (default 4096)\n"
     "  --max-depth N         function call depth (default 1000)\n"
     "  --max-pixels N        pixels per image (default 64000000)\n"
@@ -39,8 +73,9 @@ static const char usage_text[] =
     "  --max-voxels N        voxels per volume (default 134217728 = 512^3)\n"
     "  --max-list N          items per list (default 1e8)\n"
     "\n"
-    "exit codes: 0 ok, 64 usage, 65 script error, 70 runtime failure, 74 I/O error,\n"
-    "130 interrupted. Documentation: docs/language.md.\n";
+    "exit codes: 0 ok, 64 usage, 65 script error, 70 runtime failure, 74 I/O error\n"
+    "(also when standard output cannot be written), 130 interrupted.\n"
+    "Documentation: docs/language.md.\n";
 
 static volatile sig_atomic_t interrupted;
 
@@ -52,33 +87,243 @@ static void on_sigint(int sig)
     interrupted = 1;
 }
 
-static int usage_error(const char *fmt, const char *arg)
+__attribute__((format(printf, 1, 2))) static int usage_error(const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
     fprintf(stderr, "frac: ");
-    fprintf(stderr, fmt, arg);
+    vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n(run `frac --help` for usage)\n");
+    va_end(ap);
     return EX_USAGE;
 }
 
-static int parse_number(const char *s, double lo, double hi, double *out)
+/* ---- numeric options ---------------------------------------------------------- */
+
+enum { F_SEED, F_THREADS, F_MEMORY, F_DEPTH, F_PIXELS, F_POINTS, F_VOXELS, F_LIST, F_FAIL, NNUM };
+
+static const struct numflag {
+    const char *name;
+    double lo, hi;
+    const char *range; /* for messages */
+} numflags[NNUM] = {
+    [F_SEED] = {"--seed", 0, 9007199254740992.0, "a whole number from 0 to 2^53 = 9007199254740992"},
+    [F_THREADS] = {"--threads", 1, 256, "a whole number from 1 to 256"},
+    [F_MEMORY] = {"--max-memory", 1, 1073741824.0, "a whole number of MiB from 1 to 2^30"},
+    [F_DEPTH] = {"--max-depth", 1, 1e6, "a whole number from 1 to 1000000"},
+    [F_PIXELS] = {"--max-pixels", 1, 1e12, "a whole number from 1 to 1e12"},
+    [F_POINTS] = {"--max-points", 1, 1e15, "a whole number from 1 to 1e15"},
+    [F_VOXELS] = {"--max-voxels", 1, 1e12, "a whole number from 1 to 1e12"},
+    [F_LIST] = {"--max-list", 1, 1e12, "a whole number from 1 to 1e12"},
+    [F_FAIL] = {"--fail-alloc", 1, 1e12, "a whole number from 1 to 1e12"}, /* testing */
+};
+
+/* A whole number in [lo, hi], written in decimal (1e6 is fine; nan, inf,
+ * hex, spaces and fractions are not). */
+static int parse_whole(const char *s, double lo, double hi, double *out)
 {
+    if (!*s || strspn(s, "0123456789.eE+-") != strlen(s))
+        return -1;
     char *end;
     errno = 0;
     double v = strtod(s, &end);
-    if (errno || end == s || *end || v < lo || v > hi)
+    if (errno || end == s || *end || !isfinite(v) || v != floor(v) || v < lo || v > hi)
         return -1;
     *out = v;
     return 0;
 }
 
+static void set_numflag(interp *I, int f, double d)
+{
+    switch (f) {
+    case F_SEED: I->seed = (uint64_t)d; break;
+    case F_THREADS: I->threads = (int)d; break;
+    case F_MEMORY: I->lim.max_memory = (size_t)(d * 1048576.0); break;
+    case F_DEPTH: I->lim.max_depth = (int)d; break;
+    case F_PIXELS: I->lim.max_pixels = d; break;
+    case F_POINTS: I->lim.max_points = d; break;
+    case F_VOXELS: I->lim.max_voxels = d; break;
+    case F_LIST: I->lim.max_list = d; break;
+    case F_FAIL: I->fail_alloc_at = (long)d; break;
+    }
+}
+
+/* ---- the command line --------------------------------------------------------- */
+
 typedef struct opts {
-    const char *mode; /* "run", "check", "repl", "eval" */
+    const char *mode; /* "run", "check", "repl", "eval"; NULL until known */
     const char *script;
     const char *expr;
     int list_params;
     int nargs;
-    char **args;
+    const char **args;  /* the script's arguments (pointers into argv) */
+    param_override *ov; /* -D as typed: name is "NAME=VALUE", text the VALUE */
+    int nov;
 } opts;
+
+static int is_command(const char *w)
+{
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0;
+}
+
+/* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
+ * (0 after --help/--version, 64 on a usage error). */
+static int parse_command_line(interp *I, int argc, char **argv, opts *o)
+{
+    int seen[NNUM] = {0}, seen_o = 0, end_of_options = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (end_of_options || a[0] != '-' || a[1] == 0) {
+            if (!end_of_options && !o->mode && !o->script && is_command(a))
+                o->mode = a; /* the command word may follow options */
+            else if (!o->script)
+                o->script = a;
+            else
+                o->args[o->nargs++] = a;
+            continue;
+        }
+        if (strcmp(a, "--") == 0) {
+            end_of_options = 1;
+            continue;
+        }
+        /* --NAME=VALUE: split; short options take their value from the next word */
+        char name[32];
+        const char *inline_val = NULL, *eq = strchr(a, '=');
+        if (a[1] == '-' && eq && (size_t)(eq - a) < sizeof name) {
+            memcpy(name, a, (size_t)(eq - a));
+            name[eq - a] = 0;
+            inline_val = eq + 1;
+        } else {
+            snprintf(name, sizeof name, "%s", strlen(a) < sizeof name ? a : "-?");
+        }
+        const char *val = inline_val ? inline_val : i + 1 < argc ? argv[i + 1] : NULL;
+        int f = 0;
+        while (f < NNUM && strcmp(name, numflags[f].name) != 0)
+            f++;
+
+        if (!strcmp(name, "--help") || !strcmp(name, "-h") || !strcmp(name, "--version") ||
+            !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params")) {
+            if (inline_val)
+                return usage_error("%s takes no value (got '%s')", name, a);
+            if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
+                fputs(usage_text, stdout);
+                return EX_OK;
+            } else if (!strcmp(name, "--version")) {
+                printf("frac %s\n", FRAC_VERSION);
+                return EX_OK;
+            } else if (!strcmp(name, "--params")) {
+                o->list_params = 1;
+            } else {
+                I->quiet = 1;
+                I->progress = 0;
+            }
+            continue;
+        }
+        if (strncmp(a, "-D", 2) == 0) {
+            const char *def = a[2] ? a + 2 : val;
+            if (!a[2])
+                i++;
+            const char *deq = def ? strchr(def, '=') : NULL;
+            if (!deq || deq == def)
+                return usage_error("-D needs NAME=VALUE, got '%s'", def ? def : "");
+            for (int k = 0; k < o->nov; k++) {
+                const char *prev = o->ov[k].name;
+                size_t l = (size_t)(deq - def);
+                if (strncmp(prev, def, l) == 0 && prev[l] == '=')
+                    return usage_error("-D %.*s is given twice (%s and %s)", (int)l, def, prev, def);
+            }
+            o->ov[o->nov].name = def; /* interned once the interpreter is set up */
+            o->ov[o->nov].text = deq + 1;
+            o->nov++;
+            continue;
+        }
+        int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
+        if (is_e || is_o || f < NNUM) {
+            const char *what = is_e ? "an expression" : is_o ? "a folder" : numflags[f].range;
+            if (!val)
+                return usage_error("%s needs a value: %s", name, what);
+            if (!inline_val)
+                i++;
+            if ((is_e && o->expr) || (is_o && seen_o) || (f < NNUM && seen[f]))
+                return usage_error("%s is given twice", name);
+            if (is_e) {
+                o->expr = val;
+            } else if (is_o) {
+                if (!*val)
+                    return usage_error("%s needs a value: %s", name, what);
+                I->out_dir = val;
+                seen_o = 1;
+            } else {
+                double d;
+                if (parse_whole(val, numflags[f].lo, numflags[f].hi, &d))
+                    return usage_error("%s takes %s, got '%s'", name, what, val);
+                set_numflag(I, f, d);
+                seen[f] = 1;
+            }
+            continue;
+        }
+        if (o->script)
+            return usage_error("unknown option '%s' after the script (to give it to the script in `args`, "
+                               "put it after `--`: frac %s -- %s)",
+                               a, o->script, a);
+        return usage_error("unknown option '%s'", a);
+    }
+
+    if (o->expr) {
+        if (o->mode)
+            return usage_error("-e does not go with `%s`", o->mode);
+        if (o->script)
+            return usage_error("-e takes no script or arguments (got '%s')", o->script);
+        o->mode = "eval";
+    }
+    if (!o->mode)
+        o->mode = o->script ? "run" : "repl";
+    if (strcmp(o->mode, "repl") == 0 && o->script)
+        return usage_error("repl takes no script (got '%s'; run it with `frac %s`, or :load it in the REPL)",
+                           o->script, o->script);
+    if ((strcmp(o->mode, "run") == 0 || strcmp(o->mode, "check") == 0) && !o->script)
+        return usage_error("%s needs a script file (or - for standard input)", o->mode);
+    if (o->list_params && strcmp(o->mode, "check") != 0)
+        return usage_error("%s", "--params goes with `frac check`");
+    if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
+        return usage_error("-D sets a param of a script (frac SCRIPT -D NAME=VALUE); %s has none",
+                           strcmp(o->mode, "eval") == 0 ? "-e" : "the REPL");
+    return -1;
+}
+
+/* -o DIR: create the folder and its parents (mkdir -p) before anything runs,
+ * so a missing folder does not lose a finished render. */
+static int make_out_dir(const char *dir)
+{
+    char path[4096];
+    size_t n = strlen(dir);
+    if (n >= sizeof path) {
+        fprintf(stderr, "frac: error: the output folder name is too long (%zu bytes)\n", n);
+        return EX_IO;
+    }
+    memcpy(path, dir, n + 1);
+    for (char *p = path + 1;; p++) {
+        if (*p != '/' && *p != 0)
+            continue;
+        char c = *p;
+        *p = 0;
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "frac: error: cannot create the output folder '%s': %s\n", dir, strerror(errno));
+            return EX_IO;
+        }
+        *p = c;
+        if (!c)
+            break;
+    }
+    struct stat st;
+    int gone = stat(dir, &st) != 0;
+    if (gone || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "frac: error: cannot create the output folder '%s': %s\n", dir,
+                gone ? strerror(errno) : "a file of that name is in the way");
+        return EX_IO;
+    }
+    return 0;
+}
 
 static int read_script(const char *path, unsigned char **text, size_t *len)
 {
@@ -123,7 +368,7 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
     return 0;
 }
 
-static int set_script_args(interp *I, opts *o)
+static int set_script_args(interp *I, const opts *o)
 {
     value l = val_list(I, (size_t)o->nargs);
     if (l.k == V_NIL)
@@ -156,133 +401,119 @@ static void print_params(interp *I)
     }
 }
 
-int main(int argc, char **argv)
+/* A default whose type is known without running the script. */
+static int is_literal(const node *n)
 {
-    interp st, *I = &st;
-    interp_init(I);
-    I->threads = par_cores();
-    I->progress = 1;
-    opts o = {0};
-    int i = 1;
-    if (i < argc && (strcmp(argv[i], "run") == 0 || strcmp(argv[i], "check") == 0 || strcmp(argv[i], "repl") == 0)) {
-        o.mode = argv[i];
-        i++;
+    switch (n->kind) {
+    case N_NUM:
+    case N_STR:
+    case N_BOOL:
+    case N_NIL:
+        return 1;
+    case N_UNARY:
+        return n->op != 'n' && n->kids[0]->kind == N_NUM;
+    case N_LIST:
+    case N_RECORD:
+        for (int i = 0; i < n->nkids; i++)
+            if (!is_literal(n->kids[i]))
+                return 0;
+        return 1;
+    default:
+        return 0;
     }
-    param_override *ov = calloc((size_t)argc, sizeof *ov);
-    if (!ov)
-        return EX_SOFTWARE;
-    int nov = 0, rc;
-    for (; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        double d;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(usage_text, stdout);
-            free(ov);
-            return EX_OK;
-        } else if (strcmp(a, "--version") == 0) {
-            printf("frac %s\n", FRAC_VERSION);
-            free(ov);
-            return EX_OK;
-        } else if (strcmp(a, "-e") == 0) {
-            if (!val) {
-                free(ov);
-                return usage_error("%s needs an expression", a);
-            }
-            o.mode = "eval";
-            o.expr = val;
-            i++;
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--out-dir") == 0) {
-            if (!val) {
-                free(ov);
-                return usage_error("%s needs a directory", a);
-            }
-            I->out_dir = val;
-            i++;
-        } else if (strncmp(a, "-D", 2) == 0) {
-            const char *def = a[2] ? a + 2 : val;
-            if (!a[2])
-                i++;
-            const char *eq = def ? strchr(def, '=') : NULL;
-            if (!eq || eq == def) {
-                free(ov);
-                return usage_error("-D needs NAME=VALUE, got '%s'", def ? def : "");
-            }
-            ov[nov].name = (const char *)def; /* interned below */
-            ov[nov].text = eq + 1;
-            nov++;
-        } else if (strcmp(a, "--seed") == 0 && val && parse_number(val, 0, 9007199254740991.0, &d) == 0) {
-            I->seed = (uint64_t)d;
-            i++;
-        } else if (strcmp(a, "--threads") == 0 && val && parse_number(val, 1, 256, &d) == 0 && d == (int)d) {
-            I->threads = (int)d;
-            i++;
-        } else if (strcmp(a, "--max-memory") == 0 && val && parse_number(val, 1, 1 << 30, &d) == 0) {
-            I->lim.max_memory = (size_t)(d * 1048576.0);
-            i++;
-        } else if (strcmp(a, "--max-depth") == 0 && val && parse_number(val, 1, 1e6, &d) == 0) {
-            I->lim.max_depth = (int)d;
-            i++;
-        } else if (strcmp(a, "--max-pixels") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
-            I->lim.max_pixels = d;
-            i++;
-        } else if (strcmp(a, "--max-points") == 0 && val && parse_number(val, 1, 1e15, &d) == 0) {
-            I->lim.max_points = d;
-            i++;
-        } else if (strcmp(a, "--max-voxels") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
-            I->lim.max_voxels = d;
-            i++;
-        } else if (strcmp(a, "--max-list") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
-            I->lim.max_list = d;
-            i++;
-        } else if (strcmp(a, "--fail-alloc") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
-            I->fail_alloc_at = (long)d;
-            i++;
-        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-            I->quiet = 1;
-            I->progress = 0;
-        } else if (strcmp(a, "--params") == 0) {
-            o.list_params = 1;
-        } else if (a[0] == '-' && a[1] != 0) {
-            free(ov);
-            if (strncmp(a, "--", 2) == 0 && !val)
-                return usage_error("option %s is unknown or needs a value", a);
-            return usage_error("unknown option or bad value: %s (see --help)", a);
-        } else if (!o.mode && (strcmp(a, "run") == 0 || strcmp(a, "check") == 0 || strcmp(a, "repl") == 0)) {
-            o.mode = a; /* the command word may follow options */
-        } else {
-            o.script = a;
-            o.args = argv + i + 1;
-            o.nargs = argc - i - 1;
-            break;
-        }
-    }
-    if (!o.mode)
-        o.mode = o.expr ? "eval" : o.script ? "run" : "repl";
-    if ((strcmp(o.mode, "run") == 0 || strcmp(o.mode, "check") == 0) && !o.script) {
-        free(ov);
-        return usage_error("%s needs a script file (or - for standard input)", o.mode);
-    }
-    if (o.list_params && strcmp(o.mode, "check") != 0) {
-        free(ov);
-        return usage_error("%s", "--params goes with `frac check`");
-    }
+}
 
+/* -D before anything runs: each NAME must be a top-level param of the script,
+ * and where the param's default is a literal, its value is checked now, by
+ * evaluating that one `param` statement on its own — the same code, and so
+ * the same messages, as when the script reaches it (apply_param_override in
+ * eval.c). Params with computed defaults are checked there. */
+static int check_overrides(interp *I, const char *name, const char *text, size_t len)
+{
+    int src = interp_add_source(I, name, text, len);
+    node *prog;
+    if (src < 0 || parse_source(I, src, &prog))
+        return -1;
+    for (int k = 0; k < I->noverrides; k++) {
+        const node *decl = NULL;
+        const char *cands[256];
+        int nc = 0;
+        for (int i = 0; i < prog->nkids; i++) {
+            const node *s = prog->kids[i];
+            if (s->kind != N_PARAM)
+                continue;
+            if (s->str == I->overrides[k].name && !decl)
+                decl = s;
+            if (nc < 256)
+                cands[nc++] = s->str;
+        }
+        const char *ovname = I->overrides[k].name;
+        if (!decl) {
+            const char *s = suggest_name(ovname, cands, (size_t)nc);
+            return err_pos(I, -1, 0, 0, ERR_USAGE, "-D %s: the script has no param '%s'%s%s%s", ovname,
+                           ovname, s ? " (did you mean '" : nc ? "" : " (it declares none)",
+                           s ? s : "", s ? "'?)" : "");
+        }
+        if (!is_literal(decl->kids[0]))
+            continue;
+        node *blk = arena_alloc(I, sizeof *blk);
+        node **kids = arena_alloc(I, sizeof *kids);
+        if (!blk || !kids)
+            return -1;
+        memset(blk, 0, sizeof *blk);
+        blk->kind = N_BLOCK;
+        blk->src = decl->src;
+        blk->line = decl->line;
+        blk->col = decl->col;
+        kids[0] = (node *)decl;
+        blk->kids = kids;
+        blk->nkids = 1;
+        value v;
+        if (eval_expr(I, I->globals, blk, &v))
+            return -1;
+        val_unref(I, v);
+    }
+    return 0;
+}
+
+/* Standard output and standard error are checked once at the end (print
+ * checks its own writes): a full disk or a closed pipe is an I/O error, not
+ * a success. */
+static int finish_output(int rc)
+{
+    errno = 0;
+    int bad = fflush(stdout) != 0;
+    int e = errno;
+    bad |= ferror(stdout);
+    if (bad && rc == EX_OK) {
+        fprintf(stderr, "frac: error: cannot write to standard output%s%s\n", e ? ": " : "",
+                e ? strerror(e) : "");
+        rc = EX_IO;
+    }
+    if ((fflush(stderr) != 0 || ferror(stderr)) && rc == EX_OK)
+        rc = EX_IO; /* nowhere left to say so */
+    return rc;
+}
+
+static int run_frac(interp *I, opts *o)
+{
+    int rc;
     if (session_setup(I)) {
         rc = session_report(I);
-        interp_free(I);
-        free(ov);
         return rc ? rc : EX_SOFTWARE;
     }
-    I->noverrides = nov;
-    I->overrides = mem_alloc(I, (size_t)(nov ? nov : 1) * sizeof *I->overrides);
-    for (int k = 0; k < nov && I->overrides; k++) {
-        const char *eq = strchr(ov[k].name, '=');
-        I->overrides[k].name = intern(I, ov[k].name, (size_t)(eq - ov[k].name));
-        I->overrides[k].text = ov[k].text;
+    I->noverrides = o->nov;
+    I->overrides = mem_alloc(I, (size_t)(o->nov ? o->nov : 1) * sizeof *I->overrides);
+    if (!I->overrides)
+        return session_report(I);
+    for (int k = 0; k < o->nov; k++) {
+        const char *eq = strchr(o->ov[k].name, '=');
+        I->overrides[k].name = intern(I, o->ov[k].name, (size_t)(eq - o->ov[k].name));
+        I->overrides[k].text = o->ov[k].text;
         I->overrides[k].used = 0;
+        if (!I->overrides[k].name)
+            return session_report(I);
     }
-    free(ov);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_sigint;
@@ -290,15 +521,18 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     I->interrupt = &interrupted;
 
-    if (strcmp(o.mode, "repl") == 0) {
-        rc = repl_main(I, &interrupted);
-        interp_free(I);
-        return rc;
+    int check = strcmp(o->mode, "check") == 0;
+    if (strcmp(o->mode, "repl") == 0) {
+        if (I->out_dir && (rc = make_out_dir(I->out_dir)))
+            return rc;
+        return repl_main(I, &interrupted);
     }
-    if (strcmp(o.mode, "eval") == 0) {
+    if (strcmp(o->mode, "eval") == 0) {
+        if (I->out_dir && (rc = make_out_dir(I->out_dir)))
+            return rc;
         value v = val_nil();
         rc = EX_OK;
-        if (session_run(I, "<-e>", o.expr, strlen(o.expr), 0, &v)) {
+        if (session_run(I, "<-e>", o->expr, strlen(o->expr), 0, &v)) {
             rc = session_report(I);
         } else {
             bytebuf b;
@@ -309,35 +543,50 @@ int main(int argc, char **argv)
             bytebuf_free(&b);
         }
         val_unref(I, v);
-        interp_free(I);
         return rc;
     }
     unsigned char *text;
     size_t len;
-    rc = read_script(o.script, &text, &len);
-    if (rc) {
-        interp_free(I);
+    rc = read_script(o->script, &text, &len);
+    if (rc)
         return rc;
-    }
-    if (set_script_args(I, &o)) {
+    const char *name = strcmp(o->script, "-") == 0 ? "<stdin>" : o->script;
+    if (set_script_args(I, o) || (o->nov && check_overrides(I, name, (const char *)text, len))) {
         free(text);
-        rc = session_report(I);
-        interp_free(I);
+        return session_report(I);
+    }
+    if (!check && I->out_dir && (rc = make_out_dir(I->out_dir))) {
+        free(text);
         return rc;
     }
-    const char *name = strcmp(o.script, "-") == 0 ? "<stdin>" : o.script;
-    int check = strcmp(o.mode, "check") == 0;
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
         rc = session_report(I);
     } else {
         rc = EX_OK;
-        if (check && o.list_params)
+        if (check && o->list_params)
             print_params(I);
     }
     free(text);
-    fflush(stdout);
-    if (ferror(stdout) && rc == EX_OK)
-        rc = EX_IO;
-    interp_free(I);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    interp st, *I = &st;
+    interp_init(I);
+    I->threads = par_cores();
+    I->progress = 1;
+    opts o = {0};
+    o.args = calloc((size_t)argc, sizeof *o.args);
+    o.ov = calloc((size_t)argc, sizeof *o.ov);
+    int rc = EX_SOFTWARE;
+    if (o.args && o.ov) {
+        rc = parse_command_line(I, argc, argv, &o);
+        if (rc < 0)
+            rc = run_frac(I, &o);
+    }
+    interp_free(I);
+    free(o.args);
+    free(o.ov);
+    return finish_output(rc);
 }

@@ -74,6 +74,9 @@ static void buf_fmt(buf *b, const char *fmt, ...)
 static int passed, failed;
 static const char *filter;
 static double timeout_s = 120;
+/* CLI tests: where the child's stdout goes instead of the pipe (e.g. /dev/full),
+ * and a folder to put first on its PATH (so `#!/usr/bin/env frac` finds frac). */
+static const char *child_stdout, *child_path_dir;
 
 /* Run argv with stdin text (may be NULL), capture stdout/stderr; returns the
  * exit code, 128+signal, or -1 on timeout. */
@@ -95,6 +98,16 @@ static int run(char *const argv[], const char *in, buf *out, buf *err, double ti
         dup2(pout[1], 1);
         dup2(perr[1], 2);
         close(pin[0]); close(pin[1]); close(pout[0]); close(pout[1]); close(perr[0]); close(perr[1]);
+        int fd = child_stdout ? open(child_stdout, O_WRONLY) : -1;
+        if (fd >= 0) {
+            dup2(fd, 1);
+            close(fd);
+        }
+        if (child_path_dir) {
+            char path[8192];
+            snprintf(path, sizeof path, "%s:%s", child_path_dir, getenv("PATH") ? getenv("PATH") : "/usr/bin:/bin");
+            setenv("PATH", path, 1);
+        }
         execv(argv[0], argv);
         fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
         _exit(127);
@@ -381,7 +394,11 @@ static void run_lang_dir(const char *frac, const char *dir)
 /* ---- command-line tests --------------------------------------------------------------
  * tests/cli/NAME.cli: "# args: A B C" (the whole command line after frac;
  * quoted 'single words' keep their spaces), "# stdin: TEXT" lines,
- * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings). */
+ * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings),
+ * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
+ * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
+ * folder first on PATH; the args follow it). @TMP@ in the args is a fresh
+ * empty folder, removed afterwards. */
 static int split_args(char *s, char **argv, int max)
 {
     int n = 0;
@@ -417,13 +434,17 @@ static void run_cli_dir(const char *frac)
             continue;
         char *text = read_file(path, NULL);
         buf in = {0}, why = {0};
-        char *outs[32], *errs[32], argline[4096] = "";
+        char *outs[32], *errs[32], argline[4096] = "", stdout_to[4096] = "", exec_path[4096] = "";
         int nout = 0, nerr = 0, exit_code = 0;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
             size_t l = e ? (size_t)(e - p) : strlen(p);
             if (strncmp(p, "# args: ", 8) == 0)
                 snprintf(argline, sizeof argline, "%.*s", (int)(l - 8), p + 8);
+            else if (strncmp(p, "# stdout-to: ", 13) == 0)
+                snprintf(stdout_to, sizeof stdout_to, "%.*s", (int)(l - 13), p + 13);
+            else if (strncmp(p, "# exec: ", 8) == 0)
+                snprintf(exec_path, sizeof exec_path, "%.*s", (int)(l - 8), p + 8);
             else if (strncmp(p, "# stdin: ", 9) == 0) {
                 buf_add(&in, p + 9, l - 9);
                 buf_add(&in, "\n", 1);
@@ -435,12 +456,40 @@ static void run_cli_dir(const char *frac)
                 errs[nerr++] = strndup(p + 10, l - 10);
             p = e ? e + 1 : p + l;
         }
+        char tmpdir[] = "/tmp/frac-cli-XXXXXX";
+        if (strstr(argline, "@TMP@") && mkdtemp(tmpdir)) {
+            char sub[4096], *o = sub, *q = argline, *at;
+            while ((at = strstr(q, "@TMP@")) && o - sub + (at - q) + sizeof tmpdir < sizeof sub) {
+                memcpy(o, q, (size_t)(at - q));
+                o += at - q;
+                memcpy(o, tmpdir, sizeof tmpdir - 1);
+                o += sizeof tmpdir - 1;
+                q = at + 5;
+            }
+            snprintf(o, sizeof sub - (size_t)(o - sub), "%s", q);
+            snprintf(argline, sizeof argline, "%s", sub);
+        } else {
+            tmpdir[0] = 0;
+        }
         char *argv[64];
-        argv[0] = (char *)frac;
+        argv[0] = exec_path[0] ? exec_path : (char *)frac;
         int k = 1 + split_args(argline, argv + 1, 60);
         argv[k] = NULL;
         buf out = {0}, err = {0};
+        char fracdir[4096];
+        snprintf(fracdir, sizeof fracdir, "%s", frac);
+        if (strrchr(fracdir, '/'))
+            *strrchr(fracdir, '/') = 0;
+        child_stdout = stdout_to[0] ? stdout_to : NULL;
+        child_path_dir = exec_path[0] ? fracdir : NULL;
         int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
+        child_stdout = child_path_dir = NULL;
+        if (tmpdir[0]) {
+            char rm[64];
+            snprintf(rm, sizeof rm, "rm -rf '%s'", tmpdir);
+            if (system(rm) != 0)
+                buf_fmt(&why, "  could not remove %s\n", tmpdir);
+        }
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
