@@ -36,6 +36,11 @@ typedef struct bparam {
     const char *def;
 } bparam;
 
+/* Type texts shared by several tables. */
+#define TY_COLOUR "num|vec|str"
+#define TY_CAMERA "rec{eye: vec3, target: vec3, up: vec3, fov: num(0,179)}"
+#define TY_SIZE "vec2[1,1000000]|int[1,1000000]"
+
 #define MAX_ARGS 32
 
 /* Operation codes passed to obj_class.arith beyond the operator tokens
