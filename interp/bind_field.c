@@ -674,6 +674,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
     }
     lang_field_fn_done(ctmp, cown);
     if (c) {
+        mesh_free(m); /* what the engine built before it failed */
         free(m);
         return lang_rt_error(I, c, &e, "isosurface");
     }
@@ -767,7 +768,7 @@ static const bparam p_torus[] = {{"center", "vec", "[0, 0, 0]"}, {"R", "num", "1
 static const bparam p_cylinder[] = {{"center", "vec", "[0, 0, 0]"}, {"r", "num", "1"}, {"half_height", "num", "1"},
                                     {"soft", "num", "0"}};
 static const bparam p_perlin[] = {{"frequency", "num", "1"}, {"seed", "int", "nil"}};
-static const bparam p_fbm[] = {{"octaves", "int", "6"}, {"frequency", "num", "1"}, {"lacunarity", "num", "2"},
+static const bparam p_fbm[] = {{"octaves", "int", "6"}, {"frequency", "num", "1"}, {"lacunarity", "num>0", "2"},
                                {"gain", "num", "0.5"}, {"seed", "int", "nil"}};
 static const bparam p_turb[] = {{"octaves", "int", "6"}, {"frequency", "num", "1"}, {"seed", "int", "nil"}};
 static const bparam p_bias[] = {{"t", "num|field|volume", NULL}, {"b", "num", NULL}};
@@ -787,12 +788,12 @@ static const bparam p_sample[] = {{"field", "num|field", NULL}, {"grid", "vec|nu
 static const bparam p_iso[] = {{"field", "num|field|volume", NULL}, {"level", "num", "0.5"}, {"grid", "vec|num", "64"},
                                {"lo", "vec", "[-1, -1, -1]"},        {"hi", "vec", "[1, 1, 1]"},
                                {"colour", "num|field|volume", "nil"}, {"palette", "list", "nil"}};
-static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", "rec", "orbit()"},
-                              {"size", "vec|num", "[256, 256]"},   {"lo", "vec", "[-1, -1, -1]"},
+static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", TY_CAMERA, "orbit()"},
+                              {"size", TY_SIZE, "[256, 256]"},   {"lo", "vec", "[-1, -1, -1]"},
                               {"hi", "vec", "[1, 1, 1]"},          {"mode", "str", "\"emission\""},
                               {"threshold", "num", "0.5"},         {"sigma", "num", "8"},
-                              {"step", "num", "nil"},              {"colour", "any", "1"},
-                              {"background", "any", "0"},          {"lighting", "bool", "true"},
+                              {"step", "num>0", "nil"},            {"colour", TY_COLOUR "|list", "1"},
+                              {"background", TY_COLOUR, "0"},          {"lighting", "bool", "true"},
                               {"light", "vec", "nil"}};
 
 static const builtin field_builtins[] = {

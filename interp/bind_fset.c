@@ -884,15 +884,13 @@ static int shape_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE, "save: a shape is saved as .svg (draw it with draw(…) for a picture), got '.%s'",
                       ext);
     double size = 512, width = 1, radius = 1, prec = 3;
-    if (opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
+    if (opts_check(I, opts,
+                   "rec{size: int[1,1000000], width: num[0,1000], radius: num[0,1000], precision: int[0,9], "
+                   "colour: nil|bool|" TY_COLOUR ", fill: nil|bool|" TY_COLOUR ", background: nil|bool|" TY_COLOUR "}",
+                   "save") ||
+        opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
         opt_num(I, opts, "radius", &radius) < 0 || opt_num(I, opts, "precision", &prec) < 0)
         return -1;
-    if (size != floor(size) || size < 1 || size > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "save: size must be a whole number of pixels from 1 to 1000000, got %g", size);
-    if (!(width >= 0 && width <= 1000) || !(radius >= 0 && radius <= 1000))
-        return err_at(I, NULL, ERR_VALUE, "save: width and radius must be between 0 and 1000 pixels");
-    if (prec != floor(prec) || prec < 0 || prec > 9)
-        return err_at(I, NULL, ERR_VALUE, "save: precision must be a whole number from 0 to 9, got %g", prec);
     draw_style st;
     memset(&st, 0, sizeof st);
     st.color[3] = 1;

@@ -120,14 +120,15 @@ static int map_arith(interp *I, int op, value a, value b, value *out)
 }
 
 /* A map from a table row in one of the literature's column orders. */
-static int row_to_map(interp *I, value row, affine *m, double *p, int *has_p, int index, const char *fn)
+static int row_to_map(interp *I, value table, value row, affine *m, double *p, int *has_p, int index,
+                      const char *fn)
 {
     double r[13];
     size_t n = row.k == V_LIST ? AS_LIST(row)->n : 0;
     char what[64];
     snprintf(what, sizeof what, "row %d", index + 1);
     if (n != 6 && n != 7 && n != 12 && n != 13)
-        return err_at(I, NULL, ERR_VALUE,
+        return err_item(I, table, (size_t)index, ERR_VALUE,
                       "%s: row %d has %zu numbers; a map row has 6 or 7 (2-D: a b c d e f [p]) or 12 or 13 (3-D: "
                       "a b c d e f g h i j k l [p])",
                       fn, index + 1, n);
@@ -179,38 +180,41 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         free(*p);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
-    int all_p = 1, any_p = 0;
+    int all_p = 1;
     for (size_t i = 0; i < l->n; i++) {
         const affine *m = as_map(l->items[i]);
         int has = 0;
         if (m) {
             (*maps)[i] = *m;
             (*p)[i] = 0;
-        } else if (row_to_map(I, l->items[i], &(*maps)[i], &(*p)[i], &has, (int)i, what)) {
+        } else if (row_to_map(I, v, l->items[i], &(*maps)[i], &(*p)[i], &has, (int)i, what)) {
             free(*maps);
             free(*p);
             *maps = NULL;
             *p = NULL;
             return -1;
         }
-        all_p &= has;
-        any_p |= has;
+        if (i == 0)
+            all_p = has;
+        if (has != all_p) {
+            /* the first row that differs from row 1 */
+            free(*maps);
+            free(*p);
+            *maps = NULL;
+            *p = NULL;
+            return err_item(I, v, i, ERR_VALUE,
+                            "%s: row %zu gives %s probability but row 1 %s (give one in every row or in none)",
+                            what, i + 1, has ? "a" : "no", has ? "does not" : "does");
+        }
         if ((*maps)[i].dim != (*maps)[0].dim) {
             int di = (*maps)[i].dim, d0 = (*maps)[0].dim;
             free(*maps);
             free(*p);
             *maps = NULL;
             *p = NULL;
-            return err_at(I, NULL, ERR_VALUE, "%s: row %zu is a %d-D map but row 1 is %d-D", what, i + 1, di,
-                          d0);
+            return err_item(I, v, i, ERR_VALUE, "%s: row %zu is a %d-D map but row 1 is %d-D", what, i + 1, di,
+                            d0);
         }
-    }
-    if (any_p && !all_p) {
-        free(*maps);
-        free(*p);
-        *maps = NULL;
-        *p = NULL;
-        return err_at(I, NULL, ERR_VALUE, "%s: some rows give a probability and some do not", what);
     }
     *n = (int)l->n;
     return all_p;
@@ -513,7 +517,7 @@ static int b_rifs(interp *I, value *a, int n, value *out)
         if (row.k != V_LIST || (int)AS_LIST(row)->n != count) {
             free(maps);
             free(P);
-            return err_at(I, NULL, ERR_VALUE, "%s must have %d numbers (one per map)", what, count);
+            return err_item(I, M, (size_t)i, ERR_VALUE, "%s must have %d numbers (one per map)", what, count);
         }
         if (get_vec(I, row, P + (size_t)i * count, (size_t)count, what)) {
             free(maps);
@@ -815,6 +819,8 @@ static int sys_save(interp *I, chaos_sys *s, const char *path, value opts)
     memset(&fo, 0, sizeof fo);
     fo.width = fo.height = 512;
     double v;
+    if (opts_check(I, opts, "rec{width: int[1,100000], height: int[1,100000]}", "save"))
+        return -1;
     if (opt_num(I, opts, "width", &v) == 1)
         fo.width = (int)v;
     if (opt_num(I, opts, "height", &v) == 1)
@@ -947,26 +953,26 @@ static const bparam p_map[] = {{"a", "num", "nil"},      {"b", "num", "nil"},   
                                {"scale", "num|vec", "nil"}, {"rotate", "num", "nil"}, {"shear", "num", "nil"},
                                {"translate", "vec", "nil"}};
 static const bparam p_map3[] = {{"matrix", "list", NULL}, {"translate", "vec", "nil"}};
-static const bparam p_ifs[] = {{"maps", "list|ifs", NULL}, {"probabilities", "vec", "nil"},
+static const bparam p_ifs[] = {{"maps", "list|ifs", NULL}, {"probabilities", "vec[0,1]", "nil"},
                                {"normalize", "bool", "false"}, {"allow_expanding", "bool", "false"}};
-static const bparam p_rifs[] = {{"maps", "list|ifs", NULL}, {"matrix", "list", NULL}, {"order", "int", "1"},
+static const bparam p_rifs[] = {{"maps", "list|ifs", NULL}, {"matrix", "list", NULL}, {"order", "int{1,2}", "1"},
                                 {"normalize", "bool", "false"}, {"allow_expanding", "bool", "false"}};
-static const bparam p_chaos[] = {{"system", "ifs|rifs", NULL},   {"points", "num", "1e6"},
-                                 {"size", "vec|num", "[512, 512]"}, {"window", "vec", "nil"},
+static const bparam p_chaos[] = {{"system", "ifs|rifs", NULL},   {"points", "int>=1", "1e6"},
+                                 {"size", TY_SIZE, "[512, 512]"}, {"window", "vec4", "nil"},
                                  {"colour", "str", "nil"},          {"palette", "list", "nil"},
-                                 {"curve", "str", "\"log\""},        {"gamma", "num", "2.2"},
-                                 {"brightness", "num", "1"},         {"background", "any", "[0, 0, 0, 1]"},
-                                 {"supersample", "int", "1"},        {"seed", "int", "nil"}};
+                                 {"curve", "str", "\"log\""},        {"gamma", "num>0", "2.2"},
+                                 {"brightness", "num>=0", "1"},      {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                                 {"supersample", "int[1,8]", "1"},   {"seed", "int>=0", "nil"}};
 static const bparam p_measure[] = {{"system", "ifs|rifs", NULL}, {"grid", "vec|num", "64"},
-                                   {"points", "num", "1e6"},     {"normalize", "str", "\"total\""},
+                                   {"points", "int>=1", "1e6"},  {"normalize", "str", "\"total\""},
                                    {"lo", "vec", "nil"},          {"hi", "vec", "nil"},
-                                   {"seed", "int", "nil"}};
-static const bparam p_points[] = {{"system", "ifs|rifs", NULL}, {"points", "num", "1e5"}, {"colour", "str", "nil"},
-                                  {"palette", "list", "nil"},    {"seed", "int", "nil"}};
-static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", "rec", "orbit()"},
-                                {"size", "vec|num", "[512, 512]"}, {"points", "num", "1e6"},
+                                   {"seed", "int>=0", "nil"}};
+static const bparam p_points[] = {{"system", "ifs|rifs", NULL}, {"points", "int>=1", "1e5"}, {"colour", "str", "nil"},
+                                  {"palette", "list", "nil"},    {"seed", "int>=0", "nil"}};
+static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", TY_CAMERA, "orbit()"},
+                                {"size", TY_SIZE, "[512, 512]"}, {"points", "int>=1", "1e6"},
                                 {"colour", "str", "nil"},          {"palette", "list", "nil"},
-                                {"background", "any", "[0, 0, 0, 1]"}, {"seed", "int", "nil"}};
+                                {"background", TY_COLOUR, "[0, 0, 0, 1]"}, {"seed", "int>=0", "nil"}};
 static const bparam p_load_ifs[] = {{"path", "str", NULL}};
 
 static const builtin ifs_builtins[] = {

@@ -278,9 +278,7 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     mpd_params_default(&p);
     if (get_R(I, a[0], &p.R, W))
         return -1;
-    p.beta = a[1].u.n;
-    if (!isfinite(p.beta))
-        return err_at(I, NULL, ERR_VALUE, "fractal: beta = %g is not a finite number", p.beta);
+    p.beta = a[1].u.n; /* declared: finite, >= 0 */
     if (arg_seed(I, a[2], &p.seed, W))
         return -1;
     if (a[3].k == V_NUM) {
@@ -646,7 +644,7 @@ static int b_slice_plane(interp *I, value *a, int n, value *out)
 
 /* ---- registration --------------------------------------------------------------------- */
 
-static const bparam p_fractal[] = {{"R", "num", "8"},          {"beta", "num", "0.5"},
+static const bparam p_fractal[] = {{"R", "num", "8"},          {"beta", "num>=0", "0.5"},
                                    {"seed", "num", "nil"},     {"corners", "vec|num", "nil"},
                                    {"strategy", "str|num", "\"auto\""}, {"R2", "num", "nil"},
                                    {"lo", "vec", "[-1, -1, -1]"}, {"hi", "vec", "[1, 1, 1]"}};
@@ -662,11 +660,11 @@ static const bparam p_perturb[] = {{"base", "num|field|volume", NULL}, {"fluct",
                                    {"k", "num", "0.1"},                {"mode", "str", "\"linear\""},
                                    {"axis", "str|vec", "\"z\""},       {"origin", "vec", "[0, 0, 0]"}};
 static const bparam p_textured[] = {
-    {"texture", "num|field|volume", NULL}, {"object", "str", "\"sphere\""}, {"camera", "rec", "orbit()"},
+    {"texture", "num|field|volume", NULL}, {"object", "str", "\"sphere\""}, {"camera", TY_CAMERA, "orbit()"},
     {"size", "vec|num", "[256, 256]"},     {"palette", "list", "nil"},      {"lo", "num", "0"},
     {"hi", "num", "1"},                    {"center", "vec", "[0, 0, 0]"},  {"radius", "num", "1"},
     {"height", "num", "2"},                {"normal", "vec", "[0, 0, 1]"},  {"light", "vec", "[1, 1, 1]"},
-    {"ambient", "num", "0.2"},             {"diffuse", "num", "0.8"},       {"background", "any", "0"},
+    {"ambient", "num", "0.2"},             {"diffuse", "num", "0.8"},       {"background", TY_COLOUR, "0"},
     {"supersample", "num", "1"}};
 static const bparam p_slice_plane[] = {{"field", "num|field|volume", NULL}, {"origin", "vec", "[0, 0, 0]"},
                                        {"u", "vec", "[1, 0, 0]"},           {"v", "vec", "[0, 1, 0]"},

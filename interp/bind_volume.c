@@ -233,7 +233,7 @@ static int volume_get(interp *I, const void *p, const char *name, value *out)
 static int save_type(interp *I, value opts, int *type)
 {
     double bits = 32;
-    if (opt_num(I, opts, "bits", &bits) < 0)
+    if (opts_check(I, opts, "rec{bits: int{8,16,32}}", "save") || opt_num(I, opts, "bits", &bits) < 0)
         return -1;
     if (bits == 8)
         *type = VIO_UCHAR;
@@ -364,7 +364,7 @@ static int mesh_save_hook(interp *I, const void *p, const char *path, value opts
     char ext[16];
     fileio_ext(path, ext, sizeof ext);
     double ascii = 0;
-    if (opt_num(I, opts, "ascii", &ascii) < 0)
+    if (opts_check(I, opts, "rec{ascii: bool}", "save") || opt_num(I, opts, "ascii", &ascii) < 0)
         return -1;
     rt_error e;
     rt_code c;
@@ -529,10 +529,10 @@ static const bparam p_mesh[] = {{"mesh", "mesh", NULL}};
 static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str", "\"z\""}, {"index", "int", "nil"},
                                  {"palette", "list", "nil"},  {"lo", "num", "nil"},    {"hi", "num", "nil"}};
 
-static const bparam p_orbit[] = {{"azimuth", "num", "30"}, {"elevation", "num", "20"}, {"distance", "num", "3"},
-                                 {"target", "vec", "[0, 0, 0]"}, {"fov", "num", "40"}};
-static const bparam p_look_at[] = {{"eye", "vec", NULL}, {"target", "vec", "[0, 0, 0]"}, {"up", "vec", "[0, 1, 0]"},
-                                   {"fov", "num", "40"}};
+static const bparam p_orbit[] = {{"azimuth", "num", "30"}, {"elevation", "num", "20"}, {"distance", "num>0", "3"},
+                                 {"target", "vec3", "[0, 0, 0]"}, {"fov", "num(0,179)", "40"}};
+static const bparam p_look_at[] = {{"eye", "vec3", NULL}, {"target", "vec3", "[0, 0, 0]"}, {"up", "vec3", "[0, 1, 0]"},
+                                   {"fov", "num(0,179)", "40"}};
 
 static const builtin volume_builtins[] = {
     BUILTIN("orbit", b_orbit, p_orbit,

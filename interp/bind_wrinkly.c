@@ -894,13 +894,10 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE,
                       "save: a wrinkly curve is saved as .svg (draw it with wrinkly_draw for a picture), got '.%s'", ext);
     double size = 512, width = 1.5, iters = -1;
-    if (opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
+    if (opts_check(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int>=0}", "save") ||
+        opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
         opt_num(I, opts, "iterations", &iters) < 0)
         return -1;
-    if (!(size >= 1 && size <= 1e6) || size != floor(size))
-        return err_at(I, NULL, ERR_VALUE, "save: size must be a whole number of pixels between 1 and 1000000, got %g", size);
-    if (!(width > 0 && width <= 1000))
-        return err_at(I, NULL, ERR_VALUE, "save: width must be between 0 and 1000 pixels, got %g", width);
     draw_view v;
     if (get_view(I, c, val_nil(), (int)size, (int)size, &v, "save"))
         return -1;

@@ -1,13 +1,28 @@
 /* builtin.h — native functions callable from scripts.
  *
- * Each builtin declares its parameters (name, accepted types, default) in a
- * table, so argument matching, type checks, error messages ("chaos: argument
- * 'points' must be a number, got string") and `:help NAME` come from one
- * place. Types are '|'-separated names: num, int, str, bool, list, vec (list
- * of numbers), rec, func, any, or an engine class name (image, ifs, …).
- * A default is literal text ("512", "[0, 0, 0]", "\"png\"", "true", "nil");
- * NULL means required. A builtin with variadic = 1 receives all positional
- * arguments as given (named ones still matched by name).
+ * Each builtin declares its parameters (name, type, default) in a table;
+ * the table is the contract: argument matching, every check of types,
+ * ranges and finiteness, the messages ("chaos: argument 'points' must be a
+ * number, got string"), `frac check` and `:help NAME` all come from it
+ * (contract.c compiles it once, at builtins_register; call_builtin checks
+ * it before the builtin runs). A builtin only reads what was declared.
+ *
+ * Types: '|'-separated alternatives, each a base name with optional parts:
+ *   num int str bool list vec rec func nil any, or an engine class (image, ifs…)
+ *   vec3            a list of exactly 3 numbers
+ *   [lo,hi] (lo,hi) a range ('(' ')' open ends), also >=x >x <=x <x;
+ *                   for vec it applies to every item
+ *   {8,16}          choices (num/int), {log,linear} (str, with did-you-mean)
+ *   rec{k: T, …}    the keys an (option) record may have, each with its type;
+ *                   any other key is an error (with did-you-mean)
+ *   +inf +nan       infinities / NaN allowed; numbers are finite otherwise,
+ *                   also inside lists ("list": numbers at any depth)
+ * e.g. "int[1,8]", "num>0", "vec2|num>0", "str{log,linear,sqrt}",
+ * "rec{bits: int{8,16}, channels: int[1,4]}".
+ * A default is literal text ("512", "[0, 0, 0]", "\"png\"", "true", "nil")
+ * or an expression evaluated once ("orbit()"); NULL means required; a nil
+ * default also accepts nil. A builtin with variadic = 1 receives all
+ * positional arguments as given (unchecked; named ones matched by name).
  */
 #ifndef BUILTIN_H
 #define BUILTIN_H
@@ -20,6 +35,11 @@ typedef struct bparam {
     const char *type;
     const char *def;
 } bparam;
+
+/* Type texts shared by several tables. */
+#define TY_COLOUR "num|vec|str"
+#define TY_CAMERA "rec{eye: vec3, target: vec3, up: vec3, fov: num(0,179)}"
+#define TY_SIZE "vec2[1,1000000]|int[1,1000000]"
 
 #define MAX_ARGS 32
 
@@ -83,7 +103,19 @@ int arg_size2(interp *I, value v, int *w, int *h, const char *what);
 int num_list_value(interp *I, const double *x, size_t n, value *out);
 void script_relative_path(interp *I, const char *p, char *buf, size_t n);
 
-/* Signature text "name(a, b: num = 2)" for help. */
+/* Errors about part of an argument: item `index` (0-based) of the list
+ * `container`, an argument of the builtin running. The caret goes on that
+ * item (a table's row) when the argument is a literal at the call, else on
+ * the argument, else on the call. */
+int err_item(interp *I, value container, size_t index, err_kind k, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+/* Check an option record whose keys depend on the value it goes with (save
+ * of an image, a mesh…) against a declared type text "rec{…}" (compiled
+ * once); nil passes. Errors point at the record's key when it is written at
+ * the call. */
+int opts_check(interp *I, value opts, const char *type, const char *who);
+
+/* Signature text "name(a, b: num[0,1] = 2)" for help: the declared types. */
 void builtin_signature(const builtin *b, struct bytebuf *out);
 const builtin *builtin_find(interp *I, const char *name);
 

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "builtin.h"
+#include "contract.h"
 #include "eval.h"
 #include "fileio.h"
 #include "lexer.h"
@@ -31,6 +32,8 @@ int builtins_register(interp *I, const builtin *b, int n)
             I->cap_builtins = nc;
         }
         I->builtins[I->nbuiltins++] = &b[i];
+        if (contract_register(I, &b[i]))
+            return -1;
         value v;
         v.k = V_BUILTIN;
         v.u.bi = &b[i];
@@ -47,22 +50,6 @@ const builtin *builtin_find(interp *I, const char *name)
         if (strcmp(I->builtins[i]->name, name) == 0)
             return I->builtins[i];
     return NULL;
-}
-
-void builtin_signature(const builtin *b, bytebuf *out)
-{
-    bytebuf_printf(out, "%s(", b->name);
-    if (b->variadic)
-        bytebuf_printf(out, "…%s", b->nparams ? ", " : "");
-    for (int i = 0; i < b->nparams; i++) {
-        const bparam *p = &b->params[i];
-        bytebuf_printf(out, "%s%s", i ? ", " : "", p->name);
-        if (p->type && strcmp(p->type, "any") != 0)
-            bytebuf_printf(out, ": %s", p->type);
-        if (p->def)
-            bytebuf_printf(out, " = %s", p->def);
-    }
-    bytebuf_printf(out, ")");
 }
 
 int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
@@ -87,8 +74,11 @@ int get_vec(interp *I, value v, double *out, size_t n, const char *what)
         return err_at(I, NULL, ERR_VALUE, "%s must be a list of %zu numbers, got %zu items", what, n, l->n);
     for (size_t i = 0; i < l->n; i++) {
         if (l->items[i].k != V_NUM)
-            return err_at(I, NULL, ERR_TYPE, "%s must contain numbers, but item %zu is %s", what, i,
-                          val_type_name(l->items[i]));
+            return err_item(I, v, i, ERR_TYPE, "%s must contain numbers, but item %zu is %s", what, i + 1,
+                            val_type_name(l->items[i]));
+        if (!isfinite(l->items[i].u.n))
+            return err_item(I, v, i, ERR_VALUE, "%s item %zu must be a finite number, got %s", what, i + 1,
+                            isnan(l->items[i].u.n) ? "nan" : l->items[i].u.n < 0 ? "-inf" : "inf");
         if (out)
             out[i] = l->items[i].u.n;
     }
@@ -97,13 +87,35 @@ int get_vec(interp *I, value v, double *out, size_t n, const char *what)
 
 int get_int(interp *I, value v, long lo, long hi, long *out, const char *what)
 {
-    if (v.k != V_NUM || v.u.n != floor(v.u.n))
-        return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what,
-                      v.k == V_NUM ? "a fraction" : val_type_name(v));
+    if (v.k != V_NUM || !isfinite(v.u.n) || v.u.n != floor(v.u.n)) {
+        if (v.k == V_NUM) {
+            char got[40];
+            fmt_number(v.u.n, got, sizeof got);
+            return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what,
+                          isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
+        }
+        return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what, val_type_name(v));
+    }
     if (v.u.n < (double)lo || v.u.n > (double)hi)
         return err_at(I, NULL, ERR_VALUE, "%s must be between %ld and %ld, got %.17g", what, lo, hi, v.u.n);
     *out = (long)v.u.n;
     return 0;
+}
+
+void builtin_signature(const builtin *b, bytebuf *out)
+{
+    bytebuf_printf(out, "%s(", b->name);
+    if (b->variadic)
+        bytebuf_printf(out, "…%s", b->nparams ? ", " : "");
+    for (int i = 0; i < b->nparams; i++) {
+        const bparam *p = &b->params[i];
+        bytebuf_printf(out, "%s%s", i ? ", " : "", p->name);
+        if (p->type && strcmp(p->type, "any") != 0)
+            bytebuf_printf(out, ": %s", p->type);
+        if (p->def)
+            bytebuf_printf(out, " = %s", p->def);
+    }
+    bytebuf_printf(out, ")");
 }
 
 /* ---- math -------------------------------------------------------------------- */
@@ -604,6 +616,13 @@ static int do_format(interp *I, const char *fmt, size_t flen, value *args, int n
                 return err_at(I, NULL, ERR_TYPE, "format: '{:%s}' needs a number, got %s", spec + 1,
                               val_type_name(v));
             } else if (conv == 'd' || conv == 'x') {
+                /* a long long holds only whole numbers up to 2^63: say so rather than cast */
+                if (!(fabs(v.u.n) < 9223372036854775808.0)) {
+                    char got[40];
+                    fmt_number(v.u.n, got, sizeof got);
+                    return err_at(I, NULL, ERR_VALUE, "format: '{:%s}' needs a number below 2^63 in size, got %s",
+                                  spec + 1, isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
+                }
                 spec[sl] = 0;
                 char sp2[40];
                 snprintf(sp2, sizeof sp2, "%sll%c", spec, conv);
@@ -691,15 +710,13 @@ static int b_assert(interp *I, value *a, int n, value *out)
 static uint64_t seed_of(interp *I, value s)
 {
     if (s.k == V_NUM)
-        return (uint64_t)(int64_t)s.u.n ^ 0x5eedull;
+        return (uint64_t)(int64_t)s.u.n ^ 0x5eedull; /* declared int: whole and at most 2^53 */
     return I->seed;
 }
 
 static int b_random(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    if (a[0].k != V_NUM || a[0].u.n < 0 || a[0].u.n != floor(a[0].u.n))
-        return err_at(I, NULL, ERR_VALUE, "random: the index must be a whole number ≥ 0");
     uint64_t h = rng_hash3(seed_of(I, a[1]), (uint64_t)a[0].u.n, 0x72616e64ull, 0);
     *out = val_num(rng_to_unit(h));
     return 0;
@@ -736,28 +753,28 @@ static int b_seed(interp *I, value *a, int n, value *out)
 
 /* ---- table ---------------------------------------------------------------------- */
 
-static const bparam p_x[] = {{"x", "num|list|field|image", NULL}};
+static const bparam p_x[] = {{"x", "num+inf+nan|list+inf+nan|field|image", NULL}};
 static const bparam p_xy[] = {{"x", "any", NULL}, {"y", "any", NULL}};
-static const bparam p_yx[] = {{"y", "num|field", NULL}, {"x", "num|field", NULL}};
+static const bparam p_yx[] = {{"y", "num+inf+nan|field", NULL}, {"x", "num+inf+nan|field", NULL}};
 static const bparam p_clamp[] = {{"x", "any", NULL}, {"lo", "any", "0"}, {"hi", "any", "1"}};
 static const bparam p_lerp[] = {{"a", "any", NULL}, {"b", "any", NULL}, {"t", "any", NULL}};
 static const bparam p_none[] = {{"_unused", "nil", "nil"}};
-static const bparam p_vec[] = {{"v", "vec", NULL}};
-static const bparam p_vv[] = {{"a", "vec", NULL}, {"b", "vec", NULL}};
+static const bparam p_vec[] = {{"v", "vec+inf+nan", NULL}};
+static const bparam p_vv[] = {{"a", "vec+inf+nan", NULL}, {"b", "vec+inf+nan", NULL}};
 static const bparam p_any[] = {{"value", "any", NULL}};
 static const bparam p_range[] = {{"start", "num", NULL}, {"stop", "num", "nil"}, {"step", "num", "nil"}};
 static const bparam p_linspace[] = {{"from", "num", NULL}, {"to", "num", NULL}, {"n", "int", NULL}};
-static const bparam p_listfn[] = {{"list", "list", NULL}, {"f", "func", NULL}};
-static const bparam p_fold[] = {{"list", "list", NULL}, {"init", "any", NULL}, {"f", "func", NULL}};
-static const bparam p_list[] = {{"list", "list", NULL}};
-static const bparam p_repeat[] = {{"value", "any", NULL}, {"times", "int", NULL}};
+static const bparam p_listfn[] = {{"list", "list+inf+nan", NULL}, {"f", "func", NULL}};
+static const bparam p_fold[] = {{"list", "list+inf+nan", NULL}, {"init", "any", NULL}, {"f", "func", NULL}};
+static const bparam p_list[] = {{"list", "list+inf+nan", NULL}};
+static const bparam p_repeat[] = {{"value", "any", NULL}, {"times", "int>=0", NULL}};
 static const bparam p_rec[] = {{"record", "rec", NULL}};
 static const bparam p_has[] = {{"record", "rec", NULL}, {"key", "str", NULL}};
 static const bparam p_var[] = {{"_", "nil", "nil"}};
 static const bparam p_msg[] = {{"message", "str", NULL}};
 static const bparam p_assert[] = {{"cond", "any", NULL}, {"message", "str", "nil"}};
-static const bparam p_random[] = {{"i", "num", NULL}, {"seed", "num", "nil"}};
-static const bparam p_randoms[] = {{"n", "int", NULL}, {"seed", "num", "nil"}};
+static const bparam p_random[] = {{"i", "int[0,9007199254740992]", NULL}, {"seed", "int", "nil"}};
+static const bparam p_randoms[] = {{"n", "int>=0", NULL}, {"seed", "int", "nil"}};
 
 static const builtin core[] = {
     BUILTIN("sqrt", b_sqrt, p_x, "Square root; element-wise on lists, symbolic on fields."),

@@ -100,6 +100,9 @@ image *lang_as_image(value v)
 int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
 {
     if (v.k == V_NUM) {
+        if (!isfinite(v.u.n))
+            return err_at(I, NULL, ERR_VALUE, "%s must be a finite number, got %s", what,
+                          isnan(v.u.n) ? "nan" : v.u.n < 0 ? "-inf" : "inf");
         rgba[0] = rgba[1] = rgba[2] = (float)v.u.n;
         rgba[3] = 1;
         return 0;
@@ -323,24 +326,13 @@ static int b_save(interp *I, value *a, int n, value *out)
 static int image_save_hook(interp *I, const void *p, const char *path, value opts)
 {
     image_save_opts o = {0, 0};
-    if (opts.k == V_REC) {
-        const char *kb = intern(I, "bits", 4), *kc = intern(I, "channels", 8);
-        value *bits = rec_get(AS_REC(opts), kb), *ch = rec_get(AS_REC(opts), kc);
-        long x;
-        if (bits) {
-            if (get_int(I, *bits, 8, 16, &x, "save: bits") || (x != 8 && x != 16))
-                return I->err.active ? -1 : err_at(I, NULL, ERR_VALUE, "save: bits must be 8 or 16");
-            o.bits = (int)x;
-        }
-        if (ch) {
-            if (get_int(I, *ch, 1, 4, &x, "save: channels"))
-                return -1;
-            o.channels = (int)x;
-        }
-    } else if (opts.k != V_NIL) {
-        return err_at(I, NULL, ERR_TYPE, "save: options must be a record like {bits: 16}, got %s",
-                      val_type_name(opts));
-    }
+    if (opts_check(I, opts, "rec{bits: int{8,16}, channels: int[1,4]}", "save"))
+        return -1;
+    double x;
+    if (opt_num(I, opts, "bits", &x) == 1)
+        o.bits = (int)x;
+    if (opt_num(I, opts, "channels", &x) == 1)
+        o.channels = (int)x;
     rt_error e;
     if (image_save(p, path, &o, &e))
         return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
@@ -403,12 +395,12 @@ static int stack(interp *I, value *a, int n, value *out, int horizontal)
 static int b_hstack(interp *I, value *a, int n, value *out) { return stack(I, a, n, out, 1); }
 static int b_vstack(interp *I, value *a, int n, value *out) { return stack(I, a, n, out, 0); }
 
-static const bparam p_stack[] = {{"gap", "int", "0"}, {"background", "any", "0"}};
-static const bparam p_image[] = {{"size", "vec|num", NULL}, {"colour", "any", "0"}};
-static const bparam p_gradient[] = {{"size", "vec|num", NULL}, {"from", "any", "0"}, {"to", "any", "1"},
+static const bparam p_stack[] = {{"gap", "int[0,100000]", "0"}, {"background", TY_COLOUR, "0"}};
+static const bparam p_image[] = {{"size", TY_SIZE, NULL}, {"colour", TY_COLOUR, "0"}};
+static const bparam p_gradient[] = {{"size", TY_SIZE, NULL}, {"from", TY_COLOUR, "0"}, {"to", TY_COLOUR, "1"},
                                     {"angle", "num", "0"}};
-static const bparam p_checker[] = {{"size", "vec|num", NULL}, {"cell", "int", "8"}, {"a", "any", "0"},
-                                   {"b", "any", "1"}};
+static const bparam p_checker[] = {{"size", TY_SIZE, NULL}, {"cell", "int>=1", "8"}, {"a", TY_COLOUR, "0"},
+                                   {"b", TY_COLOUR, "1"}};
 static const bparam p_pixel[] = {{"image", "image", NULL}, {"x", "int", NULL}, {"y", "int", NULL}};
 static const bparam p_load[] = {{"path", "str", NULL}};
 static const bparam p_save[] = {{"value", "any", NULL}, {"path", "str", NULL}, {"options", "rec", "nil"}};

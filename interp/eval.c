@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "builtin.h"
+#include "contract.h"
 #include "fileio.h"
 #include "lexer.h"
 #include "parser.h"
@@ -248,185 +249,74 @@ done:
     return rc;
 }
 
-static int type_matches(value v, const char *types)
-{
-    const char *p = types;
-    while (*p) {
-        const char *q = strchr(p, '|');
-        size_t n = q ? (size_t)(q - p) : strlen(p);
-#define IS(s) (n == sizeof(s) - 1 && memcmp(p, s, n) == 0)
-        if (IS("any"))
-            return 1;
-        if (IS("num") && v.k == V_NUM)
-            return 1;
-        if (IS("int") && v.k == V_NUM && v.u.n == floor(v.u.n) && fabs(v.u.n) < 9e15)
-            return 1;
-        if (IS("str") && v.k == V_STR)
-            return 1;
-        if (IS("bool") && v.k == V_BOOL)
-            return 1;
-        if (IS("list") && v.k == V_LIST)
-            return 1;
-        if (IS("vec") && v.k == V_LIST) {
-            int ok = 1;
-            for (size_t i = 0; i < AS_LIST(v)->n; i++)
-                ok &= AS_LIST(v)->items[i].k == V_NUM;
-            if (ok)
-                return 1;
-        }
-        if (IS("rec") && v.k == V_REC)
-            return 1;
-        if (IS("func") && (v.k == V_FUNC || v.k == V_BUILTIN))
-            return 1;
-        if (IS("nil") && v.k == V_NIL)
-            return 1;
-        if (v.k == V_OBJ && strlen(AS_OBJ(v)->cls->name) == n && memcmp(AS_OBJ(v)->cls->name, p, n) == 0)
-            return 1;
-#undef IS
-        if (!q)
-            break;
-        p = q + 1;
-    }
-    return 0;
-}
-
-static void describe_types(const char *types, char *buf, size_t size)
-{
-    size_t k = 0;
-    const char *p = types;
-    buf[0] = 0;
-    while (*p && k + 32 < size) {
-        const char *q = strchr(p, '|');
-        size_t n = q ? (size_t)(q - p) : strlen(p);
-        const char *word = NULL;
-#define IS(s) (n == sizeof(s) - 1 && memcmp(p, s, n) == 0)
-        if (IS("num")) word = "a number";
-        else if (IS("int")) word = "a whole number";
-        else if (IS("str")) word = "a string";
-        else if (IS("bool")) word = "a boolean";
-        else if (IS("list")) word = "a list";
-        else if (IS("vec")) word = "a list of numbers";
-        else if (IS("rec")) word = "a record";
-        else if (IS("func")) word = "a function";
-        else if (IS("nil")) word = "nil";
-#undef IS
-        if (k)
-            k += (size_t)snprintf(buf + k, size - k, q ? ", " : " or ");
-        if (word)
-            k += (size_t)snprintf(buf + k, size - k, "%s", word);
-        else
-            k += (size_t)snprintf(buf + k, size - k, "%s %.*s",
-                                  strchr("aeiou", *p) ? "an" : "a", (int)n, p);
-        if (!q)
-            break;
-        p = q + 1;
-    }
-}
-
-int eval_text(interp *I, const char *srcname, const char *text, value *out);
-
-static int default_value(interp *I, const builtin *b, const bparam *bp, value *out)
-{
-    if (strcmp(bp->def, "nil") == 0) {
-        *out = val_nil();
-        return 0;
-    }
-    char *endp;
-    double d = strtod(bp->def, &endp);
-    if (*endp == 0 && endp != bp->def) {
-        *out = val_num(d);
-        return 0;
-    }
-    char name[128];
-    snprintf(name, sizeof name, "<default of %s %s>", b->name, bp->name);
-    return eval_text(I, name, bp->def, out);
-}
-
+/* Bind a builtin's arguments to its declared parameters and check each
+ * against its declaration (contract.c): the one place builtin arguments are
+ * checked. anodes (may be NULL) are the argument expressions, for carets. */
 static int call_builtin(interp *I, const builtin *b, const value *pos, int npos, const char **names,
-                        const value *named, int nnamed, const node *call, value *out)
+                        const value *named, int nnamed, const node *const *anodes, const node *call,
+                        value *out)
 {
+    const bspec *spec = contract_spec(I, b);
+    if (!spec)
+        return err_at(I, call, ERR_RUNTIME, "internal error: builtin %s is not registered", b->name);
+    if ((b->variadic ? npos : 0) + b->nparams > MAX_ARGS || npos + nnamed > MAX_ARGS)
+        return err_at(I, call, ERR_TYPE, "%s: too many arguments", b->name);
+    const char *pnames[MAX_ARGS], *anames[MAX_ARGS];
+    int required[MAX_ARGS], slot[MAX_ARGS];
+    for (int j = 0; j < spec->n; j++) {
+        pnames[j] = spec->p[j].name;
+        required[j] = spec->p[j].required;
+    }
+    for (int i = 0; i < npos; i++)
+        anames[i] = NULL;
+    for (int k = 0; k < nnamed; k++)
+        anames[npos + k] = names[k];
+    if (contract_match(I, b->name, pnames, required, spec->n, b->variadic, "at most ", anames, anodes,
+                       npos + nnamed, call, slot))
+        return -1;
     value args[MAX_ARGS];
-    int owned[MAX_ARGS] = {0};
+    const node *nodes[MAX_ARGS];
     int have[MAX_ARGS] = {0};
-    int nargs;
-    int fixed = b->variadic ? 0 : b->nparams;
-    if (b->variadic) {
-        if (npos + b->nparams > MAX_ARGS)
-            return err_at(I, call, ERR_TYPE, "%s: too many arguments", b->name);
-        for (int i = 0; i < npos; i++)
-            args[i] = pos[i];
-        nargs = npos + b->nparams;
-        for (int j = 0; j < b->nparams; j++)
-            have[npos + j] = 0;
-    } else {
-        if (npos > b->nparams)
-            return err_at(I, call, ERR_TYPE, "%s takes at most %d argument%s, but %d were given",
-                          b->name, b->nparams, b->nparams == 1 ? "" : "s", npos);
-        for (int i = 0; i < npos; i++) {
-            args[i] = pos[i];
-            have[i] = 1;
-        }
-        nargs = b->nparams;
-    }
     int base = b->variadic ? npos : 0;
-    for (int k = 0; k < nnamed; k++) {
-        int j;
-        for (j = 0; j < b->nparams; j++)
-            if (strcmp(b->params[j].name, names[k]) == 0)
-                break;
-        if (j == b->nparams) {
-            const char *cands[MAX_ARGS];
-            for (int i = 0; i < b->nparams && i < MAX_ARGS; i++)
-                cands[i] = b->params[i].name;
-            const char *s = suggest_name(names[k], cands, (size_t)b->nparams);
-            return err_at(I, call, ERR_TYPE, "%s has no parameter '%s'%s%s%s", b->name, names[k],
-                          s ? " (did you mean '" : "", s ? s : "", s ? "'?)" : "");
+    int nargs = base + spec->n;
+    for (int i = 0; i < npos + nnamed; i++) {
+        int s = slot[i] < 0 ? i : base + slot[i];
+        args[s] = i < npos ? pos[i] : named[i - npos];
+        nodes[s] = anodes ? anodes[i] : NULL;
+        have[s] = 1;
+    }
+    for (int j = 0; j < spec->n; j++) {
+        const cparam *cp = &spec->p[j];
+        int s = base + j;
+        if (!have[s]) {
+            if (contract_default(I, spec, j, &args[s]))
+                return -1;
+            nodes[s] = NULL;
+            continue;
         }
-        if (have[base + j])
-            return err_at(I, call, ERR_TYPE, "%s: argument '%s' given twice", b->name, names[k]);
-        args[base + j] = named[k];
-        have[base + j] = 1;
+        if (args[s].k == V_NIL && cp->def_nil)
+            continue;
+        char what[160];
+        snprintf(what, sizeof what, "argument '%s'", cp->name);
+        cpos at = {nodes[s] ? nodes[s] : call, -1, 0, 0};
+        if (contract_check_value(I, cp->type, args[s], b->name, what, at))
+            return -1;
     }
-    int rc = -1;
-    for (int j = 0; j < b->nparams; j++) {
-        const bparam *bp = &b->params[j];
-        int slot = base + j;
-        if (!have[slot]) {
-            if (!bp->def) {
-                err_at(I, call, ERR_TYPE, "%s: missing argument '%s'", b->name, bp->name);
-                goto done;
-            }
-            if (default_value(I, b, bp, &args[slot]))
-                goto done;
-            owned[slot] = 1;
-        } else if (bp->type && !(args[slot].k == V_NIL && bp->def && strcmp(bp->def, "nil") == 0) &&
-                   !type_matches(args[slot], bp->type)) {
-            char want[160];
-            describe_types(bp->type, want, sizeof want);
-            const node *at = call;
-            err_at(I, at, ERR_TYPE, "%s: argument '%s' must be %s, got %s", b->name, bp->name, want,
-                   val_type_name(args[slot]));
-            goto done;
-        }
-    }
-    (void)fixed;
-    {
-        const node *save = I->cur;
-        I->cur = call;
-        rc = b->fn(I, args, b->variadic ? npos : nargs, out);
-        I->cur = save;
-        if (rc == 0 && I->err.active)
-            rc = -1;
-    }
-done:
-    for (int j = 0; j < nargs; j++)
-        if (owned[j])
-            val_unref(I, args[j]);
+    const node *save = I->cur;
+    const bcall *save_call = I->bcall;
+    bcall bc = {b, args, nodes, nargs};
+    I->cur = call;
+    I->bcall = &bc;
+    int rc = b->fn(I, args, b->variadic ? npos : nargs, out);
+    I->cur = save;
+    I->bcall = save_call;
+    if (rc == 0 && I->err.active)
+        rc = -1;
     return rc;
 }
 
 static int call_any(interp *I, value fn, const value *pos, int npos, const char **names,
-                    const value *named, int nnamed, const node *call, value *out)
+                    const value *named, int nnamed, const node *const *anodes, const node *call, value *out)
 {
     *out = val_nil();
     if (check_interrupt(I, call))
@@ -434,13 +324,13 @@ static int call_any(interp *I, value fn, const value *pos, int npos, const char 
     if (fn.k == V_FUNC)
         return call_user(I, AS_FUNC(fn), pos, npos, names, named, nnamed, call, out);
     if (fn.k == V_BUILTIN)
-        return call_builtin(I, fn.u.bi, pos, npos, names, named, nnamed, call, out);
+        return call_builtin(I, fn.u.bi, pos, npos, names, named, nnamed, anodes, call, out);
     return err_at(I, call, ERR_TYPE, "cannot call %s (it is not a function)", val_type_name(fn));
 }
 
 int call_value(interp *I, value fn, const value *args, int nargs, value *out)
 {
-    return call_any(I, fn, args, nargs, NULL, NULL, 0, I->cur, out);
+    return call_any(I, fn, args, nargs, NULL, NULL, 0, NULL, I->cur, out);
 }
 
 static int eval_call(interp *I, env *e, const node *n, value *out)
@@ -455,6 +345,7 @@ static int eval_call(interp *I, env *e, const node *n, value *out)
     }
     value pos[MAX_ARGS], named[MAX_ARGS];
     const char *names[MAX_ARGS];
+    const node *posn[MAX_ARGS], *anodes[MAX_ARGS];
     int npos = 0, nnamed = 0, rc = -1;
     for (int i = 1; i <= nargs; i++) {
         value v;
@@ -462,12 +353,17 @@ static int eval_call(interp *I, env *e, const node *n, value *out)
             goto done;
         if (n->names[i]) {
             names[nnamed] = n->names[i];
+            anodes[MAX_ARGS - 1 - nnamed] = n->kids[i];
             named[nnamed++] = v;
         } else {
+            posn[npos] = n->kids[i];
             pos[npos++] = v;
         }
     }
-    rc = call_any(I, fn, pos, npos, names, named, nnamed, n, out);
+    /* argument nodes in call order: positional ones, then named ones */
+    for (int k = 0; k < nnamed; k++)
+        posn[npos + k] = anodes[MAX_ARGS - 1 - k];
+    rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
 done:
     for (int i = 0; i < npos; i++)
         val_unref(I, pos[i]);

@@ -3,6 +3,7 @@
 
 #include <string.h>
 
+#include "check.h"
 #include "eval.h"
 #include "parser.h"
 
@@ -82,6 +83,9 @@ typedef struct resolver {
     env *globals;
     const char *visiting[64]; /* modules being scanned (cycle guard) */
     int nvisiting;
+    check_names bound;        /* names the program binds, for the call checks */
+    env *mods[64];            /* scopes of the modules imported without an alias */
+    int nmods;
 } resolver;
 
 static int declare(resolver *r, scope *s, const char *name)
@@ -163,6 +167,8 @@ static int module_names(resolver *r, scope *s, const node *imp)
         return -1;
     if (imp->names[0])
         return declare(r, s, imp->names[0]);
+    if (r->nmods < 64)
+        r->mods[r->nmods++] = m;
     for (size_t i = 0; i < m->n; i++)
         if (declare(r, s, m->names[i]))
             return -1;
@@ -217,6 +223,11 @@ static int resolve_node(resolver *r, scope *s, const node *n)
     }
     case N_FIELD:
         return resolve_node(r, s, n->kids[0]);
+    case N_CALL:
+        for (int i = 0; i < n->nkids; i++)
+            if (resolve_node(r, s, n->kids[i]))
+                return -1;
+        return check_call(r->I, &r->bound, r->mods, r->nmods, n);
     default:
         for (int i = 0; i < n->nkids; i++)
             if (resolve_node(r, s, n->kids[i]))
@@ -290,7 +301,10 @@ int resolve_program(interp *I, const node *prog, env *globals)
     r.I = I;
     r.globals = globals;
     scope top = {0};
-    int rc = resolve_block(&r, &top, prog);
+    int rc = check_collect(I, prog, &r.bound);
+    if (rc == 0)
+        rc = resolve_block(&r, &top, prog);
     scope_free(I, &top);
+    check_names_free(I, &r.bound);
     return rc;
 }

@@ -138,6 +138,8 @@ typedef struct interp {
     /* builtin registry */
     const builtin **builtins;
     int nbuiltins, cap_builtins;
+    struct contract_cache *contract; /* compiled declarations (contract.c) */
+    const struct bcall *bcall;       /* the builtin call running, for positions */
 } interp;
 
 /* Allocation hook: every interpreter allocation goes through here; it
