@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "builtin.h"
+#include "lang_objects.h"
 
 int arg_seed(interp *I, value v, uint64_t *seed, const char *what)
 {
@@ -49,11 +50,40 @@ int num_list_value(interp *I, const double *x, size_t n, value *out)
     return 0;
 }
 
-void script_relative_path(interp *I, const char *p, char *buf, size_t n)
+err_kind lang_rt_kind(rt_code c)
+{
+    switch (c) {
+    case RT_ENOMEM: return ERR_MEMORY;
+    case RT_EIO: return ERR_IO;
+    case RT_ECANCEL: return ERR_INTERRUPT;
+    case RT_OK: /* not a failure; callers never pass it */
+    case RT_EFORMAT:
+    case RT_EINVAL: break;
+    }
+    return ERR_VALUE;
+}
+
+int lang_join_path(interp *I, const node *at, const char *dir, const char *p, size_t plen, char *buf, size_t n,
+                   const char *what)
+{
+    const char *sep = what && *what ? ": " : "";
+    if (memchr(p, 0, plen))
+        return err_at(I, at, ERR_VALUE, "%s%sthe file name contains a NUL byte (\\0)", what, sep);
+    if (p[0] == '/' || !dir || strcmp(dir, ".") == 0)
+        dir = NULL;
+    size_t need = dir ? strlen(dir) + 1 + plen : plen;
+    if (need >= n)
+        return err_at(I, at, ERR_IO, "%s%spath too long: '%.40s…' (%zu bytes; the limit is %zu)", what, sep, p, need,
+                      n - 1);
+    if (dir)
+        snprintf(buf, n, "%s/%.*s", dir, (int)plen, p);
+    else
+        snprintf(buf, n, "%.*s", (int)plen, p);
+    return 0;
+}
+
+int script_relative_path(interp *I, value v, char *buf, size_t n, const char *what)
 {
     const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
-    if (p[0] == '/' || strcmp(dir, ".") == 0)
-        snprintf(buf, n, "%s", p);
-    else
-        snprintf(buf, n, "%s/%s", dir, p);
+    return lang_join_path(I, NULL, dir, AS_STR(v)->s, AS_STR(v)->len, buf, n, what);
 }

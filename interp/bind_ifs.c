@@ -905,7 +905,8 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
+    if (script_relative_path(I, a[0], path, sizeof path, "load_ifs"))
+        return -1;
     fractint_list fl;
     rt_error e;
     rt_code c = fractint_load(path, &fl, &e);

@@ -86,7 +86,7 @@ rt_run lang_run(interp *I)
 
 int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
 {
-    err_kind k = c == RT_EIO ? ERR_IO : c == RT_ENOMEM ? ERR_MEMORY : c == RT_ECANCEL ? ERR_INTERRUPT : ERR_VALUE;
+    err_kind k = lang_rt_kind(c);
     if (c == RT_ECANCEL)
         return err_at(I, NULL, k, "%s: interrupted", what);
     return err_at(I, NULL, k, "%s: %s", what, e->msg);
@@ -274,7 +274,7 @@ static int volume_save(interp *I, const void *p, const char *path, value opts)
                       "save: cannot save a volume as '.%s' (use .nrrd, .nhdr/.raw or .vtk)", ext);
     }
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, c, &e, "save");
     return 0;
 }
 
@@ -375,7 +375,7 @@ static int mesh_save_hook(interp *I, const void *p, const char *path, value opts
     else
         return err_at(I, NULL, ERR_VALUE, "save: cannot save a mesh as '.%s' (use .ply, .obj or .stl)", ext);
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, c, &e, "save");
     return 0;
 }
 
@@ -408,13 +408,14 @@ static int b_load_volume(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096], ext[16];
-    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
+    if (script_relative_path(I, a[0], path, sizeof path, "load_volume"))
+        return -1;
     fileio_ext(path, ext, sizeof ext);
     volume tmp;
     rt_error e;
     rt_code c = strcmp(ext, "vtk") == 0 ? vio_load_vtk(path, &tmp, &e) : vio_load_nrrd(path, &tmp, &e);
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_volume: %s", e.msg);
+        return lang_rt_error(I, c, &e, "load_volume");
     volume *v;
     if (lang_volume_new(I, tmp.nx, tmp.ny, tmp.nz, tmp.lo, tmp.hi, &v)) {
         volume_free(&tmp);
@@ -429,7 +430,8 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
+    if (script_relative_path(I, a[0], path, sizeof path, "load_mesh"))
+        return -1;
     mesh *m = malloc(sizeof *m);
     if (!m)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -437,7 +439,7 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
     rt_code c = mio_load(path, m, &e);
     if (c) {
         free(m);
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_mesh: %s", e.msg);
+        return lang_rt_error(I, c, &e, "load_mesh");
     }
     return lang_mesh_value(I, m, out);
 }

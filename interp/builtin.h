@@ -101,7 +101,13 @@ int get_int(interp *I, value v, long lo, long hi, long *out, const char *what);
 int arg_seed(interp *I, value v, uint64_t *seed, const char *what);
 int arg_size2(interp *I, value v, int *w, int *h, const char *what);
 int num_list_value(interp *I, const double *x, size_t n, value *out);
-void script_relative_path(interp *I, const char *p, char *buf, size_t n);
+/* A path string v relative to the script's folder, into buf; 0, or -1 with
+ * an error "WHAT: path too long: …" (never truncated) or a NUL byte error. */
+int script_relative_path(interp *I, value v, char *buf, size_t n, const char *what);
+/* dir/p (p alone if it is absolute or dir is NULL or "."), checked the same
+ * way; errors are at node at (NULL: the current call). */
+int lang_join_path(interp *I, const node *at, const char *dir, const char *p, size_t plen, char *buf, size_t n,
+                   const char *what);
 
 /* Errors about part of an argument: item `index` (0-based) of the list
  * `container`, an argument of the builtin running. The caret goes on that

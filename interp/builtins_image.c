@@ -280,11 +280,14 @@ static int b_load(interp *I, value *a, int n, value *out)
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     char path[4096];
-    script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
+    if (script_relative_path(I, a[0], path, sizeof path, "load")) {
+        free(im);
+        return -1;
+    }
     rt_error e;
     if (image_load(im, path, &e)) {
         free(im);
-        return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "load: %s", e.msg);
+        return lang_rt_error(I, e.code, &e, "load");
     }
     if ((double)im->w * im->h > I->lim.max_pixels) {
         image_destroy(im);
@@ -293,15 +296,11 @@ static int b_load(interp *I, value *a, int n, value *out)
     return lang_image_value(I, im, out);
 }
 
-int lang_output_path(interp *I, const char *path, char *buf, size_t size)
+int lang_output_path(interp *I, value path, char *buf, size_t size)
 {
-    if (path[0] == 0)
+    if (AS_STR(path)->len == 0)
         return err_at(I, NULL, ERR_VALUE, "save: the file name is empty");
-    if (path[0] == '/' || !I->out_dir)
-        snprintf(buf, size, "%s", path);
-    else
-        snprintf(buf, size, "%s/%s", I->out_dir, path);
-    return 0;
+    return lang_join_path(I, NULL, I->out_dir, AS_STR(path)->s, AS_STR(path)->len, buf, size, "save");
 }
 
 static int b_save(interp *I, value *a, int n, value *out)
@@ -312,7 +311,7 @@ static int b_save(interp *I, value *a, int n, value *out)
         return err_at(I, NULL, ERR_TYPE, "save: cannot save %s (images, volumes, meshes… can be saved)",
                       val_type_name(v));
     char path[4096];
-    if (lang_output_path(I, AS_STR(a[1])->s, path, sizeof path))
+    if (lang_output_path(I, a[1], path, sizeof path))
         return -1;
     if (AS_OBJ(v)->cls->save(I, AS_OBJ(v)->payload, path, a[2]))
         return -1;
@@ -335,7 +334,7 @@ static int image_save_hook(interp *I, const void *p, const char *path, value opt
         o.channels = (int)x;
     rt_error e;
     if (image_save(p, path, &o, &e))
-        return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, e.code, &e, "save");
     return 0;
 }
 

@@ -9,6 +9,7 @@
 #include "builtin.h"
 #include "contract.h"
 #include "fileio.h"
+#include "lang_objects.h"
 #include "lexer.h"
 #include "parser.h"
 #include "stdlib_embed.h"
@@ -912,10 +913,8 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     size_t filelen = 0;
     if (is_file_import(name)) {
         const char *dir = at && at->src >= 0 ? I->srcs[at->src].dir : ".";
-        if (name[0] == '/')
-            snprintf(key, sizeof key, "%s", name);
-        else
-            snprintf(key, sizeof key, "%s/%s", dir, name);
+        if (lang_join_path(I, at, dir, name, strlen(name), key, sizeof key, "import"))
+            return -1;
     } else {
         snprintf(key, sizeof key, "std:%s", name);
     }
@@ -956,7 +955,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     } else {
         rt_error re;
         if (fileio_read_all(key, 64u << 20, &filedata, &filelen, &re))
-            return err_at(I, at, ERR_IO, "cannot import \"%s\": %s", name, re.msg);
+            return err_at(I, at, lang_rt_kind(re.code), "cannot import \"%s\": %s", name, re.msg);
         text = (const char *)filedata;
         const char *dir = at && at->src >= 0 ? I->srcs[at->src].dir : ".";
         if (name[0] == '/')

@@ -20,6 +20,6 @@ void lang_image_discard(image *im);
  * discard im and report "WHAT: message"; otherwise wrap im into *out. */
 int lang_image_finish(interp *I, image *im, rt_code c, const rt_error *e, const char *what, value *out);
 /* Join a relative output path with --out-dir. */
-int lang_output_path(interp *I, const char *path, char *buf, size_t size);
+int lang_output_path(interp *I, value path, char *buf, size_t size);
 
 #endif

@@ -51,9 +51,12 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
-/* Turn a runtime failure into a script error: RT_EIO -> ERR_IO, RT_ENOMEM ->
- * ERR_MEMORY, RT_ECANCEL -> ERR_INTERRUPT, others -> ERR_VALUE. The message
- * is "WHAT: e->msg". Returns -1. */
+/* The one map from runtime codes to error kinds (args.c): RT_ENOMEM ->
+ * ERR_MEMORY (exit 70), RT_EIO -> ERR_IO (74), RT_ECANCEL -> ERR_INTERRUPT
+ * (130), RT_EFORMAT and RT_EINVAL -> ERR_VALUE (65). */
+err_kind lang_rt_kind(rt_code c);
+/* Turn a runtime failure into a script error of kind lang_rt_kind(c). The
+ * message is "WHAT: e->msg" ("WHAT: interrupted" for RT_ECANCEL). Returns -1. */
 int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what);
 
 #endif

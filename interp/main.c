@@ -82,8 +82,10 @@ static volatile sig_atomic_t interrupted;
 static void on_sigint(int sig)
 {
     (void)sig;
-    if (interrupted) /* a second Ctrl-C stops at once */
+    if (interrupted) { /* a second Ctrl-C stops at once, leaving no temp file */
+        fileio_cleanup_temps();
         _exit(130);
+    }
     interrupted = 1;
 }
 
@@ -519,6 +521,7 @@ static int run_frac(interp *I, opts *o)
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
+    fileio_install_signal_cleanup();
     I->interrupt = &interrupted;
 
     int check = strcmp(o->mode, "check") == 0;

@@ -216,7 +216,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
     I->is_repl = 1;
     char hist[4096] = "";
     const char *home = getenv("HOME");
-    if (r.tty && home && *home)
+    if (r.tty && home && *home && strlen(home) + sizeof "/.frac_history" <= sizeof hist) /* else no history */
         snprintf(hist, sizeof hist, "%s/.frac_history", home);
     r.le = lineedit_new(0, 1, hist[0] ? hist : NULL, 1000);
     if (!r.le) {

@@ -1,9 +1,25 @@
 /* fileio.h — whole-file reads and safe writes.
  *
- * fileio_write_atomic writes data to a temporary file in the same directory
- * as path and renames it into place only when every byte is written and
- * flushed, so an error or a crash never leaves a half-written file over a
- * good one.
+ * fileio_write_atomic never leaves a partial or misplaced file:
+ *  - a target that exists and is not a regular file (a symbolic link, a
+ *    folder, a device, a FIFO, a socket) is refused with RT_EIO: the write
+ *    never goes through a link or replaces a node such as /dev/null;
+ *  - missing parent folders of the target are created (mkdir -p; an error
+ *    names the folder that could not be made);
+ *  - the data goes to a new temporary file beside the target, created with
+ *    O_EXCL (a fresh name per try, retried on EEXIST), written fully, fsync'd
+ *    and renamed into place; then the folder is fsync'd (where the file system
+ *    allows it). On any error the temporary file is removed;
+ *  - paths of FILEIO_PATH_MAX bytes or more are refused ("path too long"),
+ *    never truncated.
+ * Writes may run on any thread at once. Up to FILEIO_MAX_TEMPS temporary files
+ * being written are kept in a fixed table that fileio_cleanup_temps() (safe to
+ * call from a signal handler) unlinks; a write beyond that many concurrent ones
+ * still works but is not covered. fileio_install_signal_cleanup() installs
+ * SIGTERM and SIGHUP handlers that unlink the temporary files and then re-raise
+ * the signal with its default action, so the exit status still says "killed by
+ * signal N" (an ignored signal, as under nohup, stays ignored). A SIGINT
+ * handler that ends the process should call fileio_cleanup_temps() first.
  */
 #ifndef FILEIO_H
 #define FILEIO_H
@@ -12,9 +28,17 @@
 
 #include "rt.h"
 
+#define FILEIO_PATH_MAX 4096 /* bytes in a path, with its NUL (Linux PATH_MAX) */
+#define FILEIO_MAX_TEMPS 64
+
 rt_code fileio_write_atomic(const char *path, const void *data, size_t n, rt_error *e);
-/* Read a whole file into a malloc'd buffer (NUL-terminated for convenience;
- * *n excludes the NUL). Files larger than max_bytes are refused. */
+/* Create the missing parent folders of path (mkdir -p of its dirname). */
+rt_code fileio_make_parents(const char *path, rt_error *e);
+/* Unlink every temporary file being written. Async-signal-safe. */
+void fileio_cleanup_temps(void);
+/* SIGTERM/SIGHUP: clean up, then die of the signal. Returns 0, or -1 if a
+ * sigaction failed. */
+int fileio_install_signal_cleanup(void);
 rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data, size_t *n,
                         rt_error *e);
 

@@ -397,8 +397,25 @@ static void run_lang_dir(const char *frac, const char *dir)
  * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings),
  * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
  * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
- * folder first on PATH; the args follow it). @TMP@ in the args is a fresh
- * empty folder, removed afterwards. */
+ * folder first on PATH; the args follow it). In all of them $TMP stands for
+ * a fresh empty folder, removed after the test. */
+static int rm_tree(const char *dir);
+
+/* s[0..l) with every "$TMP" replaced by tmp, appended to out. */
+static void add_subst(buf *out, const char *s, size_t l, const char *tmp)
+{
+    for (size_t i = 0; i < l;) {
+        if (tmp && l - i >= 4 && memcmp(s + i, "$TMP", 4) == 0) {
+            buf_add(out, tmp, strlen(tmp));
+            i += 4;
+        } else {
+            buf_add(out, s + i, 1);
+            i++;
+        }
+    }
+    if (!out->d)
+        buf_add(out, "", 0);
+}
 static int split_args(char *s, char **argv, int max)
 {
     int n = 0;
@@ -433,44 +450,37 @@ static void run_cli_dir(const char *frac)
         if (!matches_filter(path))
             continue;
         char *text = read_file(path, NULL);
-        buf in = {0}, why = {0};
-        char *outs[32], *errs[32], argline[4096] = "", stdout_to[4096] = "", exec_path[4096] = "";
+        buf in = {0}, why = {0}, argb = {0};
+        char *outs[32], *errs[32], stdout_to[4096] = "", exec_path[4096] = "";
         int nout = 0, nerr = 0, exit_code = 0;
+        char tmpl[] = "/tmp/frac-cli-XXXXXX";
+        char *tmp = text && strstr(text, "$TMP") ? mkdtemp(tmpl) : NULL;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
             size_t l = e ? (size_t)(e - p) : strlen(p);
-            if (strncmp(p, "# args: ", 8) == 0)
-                snprintf(argline, sizeof argline, "%.*s", (int)(l - 8), p + 8);
-            else if (strncmp(p, "# stdout-to: ", 13) == 0)
+            if (strncmp(p, "# args: ", 8) == 0) {
+                argb.n = 0;
+                add_subst(&argb, p + 8, l - 8, tmp);
+            } else if (strncmp(p, "# stdout-to: ", 13) == 0)
                 snprintf(stdout_to, sizeof stdout_to, "%.*s", (int)(l - 13), p + 13);
             else if (strncmp(p, "# exec: ", 8) == 0)
                 snprintf(exec_path, sizeof exec_path, "%.*s", (int)(l - 8), p + 8);
             else if (strncmp(p, "# stdin: ", 9) == 0) {
-                buf_add(&in, p + 9, l - 9);
+                add_subst(&in, p + 9, l - 9, tmp);
                 buf_add(&in, "\n", 1);
             } else if (strncmp(p, "# exit: ", 8) == 0)
                 exit_code = atoi(p + 8);
-            else if (strncmp(p, "# stdout: ", 10) == 0 && nout < 32)
-                outs[nout++] = strndup(p + 10, l - 10);
-            else if (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)
-                errs[nerr++] = strndup(p + 10, l - 10);
+            else if ((strncmp(p, "# stdout: ", 10) == 0 && nout < 32) || (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)) {
+                buf b = {0};
+                add_subst(&b, p + 10, l - 10, tmp);
+                if (strncmp(p, "# stdout: ", 10) == 0)
+                    outs[nout++] = b.d;
+                else
+                    errs[nerr++] = b.d;
+            }
             p = e ? e + 1 : p + l;
         }
-        char tmpdir[] = "/tmp/frac-cli-XXXXXX";
-        if (strstr(argline, "@TMP@") && mkdtemp(tmpdir)) {
-            char sub[4096], *o = sub, *q = argline, *at;
-            while ((at = strstr(q, "@TMP@")) && o - sub + (at - q) + sizeof tmpdir < sizeof sub) {
-                memcpy(o, q, (size_t)(at - q));
-                o += at - q;
-                memcpy(o, tmpdir, sizeof tmpdir - 1);
-                o += sizeof tmpdir - 1;
-                q = at + 5;
-            }
-            snprintf(o, sizeof sub - (size_t)(o - sub), "%s", q);
-            snprintf(argline, sizeof argline, "%s", sub);
-        } else {
-            tmpdir[0] = 0;
-        }
+        char *argline = argb.d ? argb.d : "";
         char *argv[64];
         argv[0] = exec_path[0] ? exec_path : (char *)frac;
         int k = 1 + split_args(argline, argv + 1, 60);
@@ -484,12 +494,6 @@ static void run_cli_dir(const char *frac)
         child_path_dir = exec_path[0] ? fracdir : NULL;
         int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
         child_stdout = child_path_dir = NULL;
-        if (tmpdir[0]) {
-            char rm[64];
-            snprintf(rm, sizeof rm, "rm -rf '%s'", tmpdir);
-            if (system(rm) != 0)
-                buf_fmt(&why, "  could not remove %s\n", tmpdir);
-        }
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
@@ -510,7 +514,9 @@ static void run_cli_dir(const char *frac)
         if (!ok)
             buf_fmt(&why, "  stdout was:\n%.2000s\n  stderr was:\n%.2000s", out.d, err.d);
         result(path, ok, &why);
-        free(text); free(in.d); free(out.d); free(err.d); free(why.d);
+        if (tmp)
+            rm_tree(tmp);
+        free(text); free(in.d); free(out.d); free(err.d); free(why.d); free(argb.d);
     }
     free(names);
 }
@@ -575,8 +581,6 @@ static void run_repl_dir(const char *frac, const char *dir)
         free(text); free(in.d); free(want.d); free(out.d); free(err.d); free(why.d);
     }
 }
-
-static int rm_tree(const char *dir);
 
 /* ---- interactive sessions on a pseudo-terminal ---------------------------------------
  * tests/pty/NAME.pty are ptyrun scripts played against `frac repl` on a
