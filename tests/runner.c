@@ -16,7 +16,8 @@
  *   # stdin: TEXT                  a line of standard input
  * REPL tests (.repl files in tests/repl/): lines "in: TEXT" are piped to `frac repl`;
  * "out: TEXT" lines are the whole stdout, in order; "err: TEXT" must appear
- * in stderr in order; "exit: N" (default 0).
+ * in stderr in order; "exit: N" (default 0); "stdin-from: PATH" and
+ * "stdout-to: PATH" replace the pipes with that file (read and write errors).
  * Golden tests: every examples/NAME.frac runs with --threads 1 and with
  * --threads 3 into fresh directories; every file written and the stdout must
  * equal tests/golden/NAME/ byte for byte (both thread counts).
@@ -75,6 +76,10 @@ static int passed, failed;
 static const char *filter;
 static double timeout_s = 120;
 
+/* When set, the next run() gives the child this file as stdin / stdout
+ * instead of the pipe (REPL tests of read and write errors). */
+static const char *child_stdin, *child_stdout;
+
 /* Run argv with stdin text (may be NULL), capture stdout/stderr; returns the
  * exit code, 128+signal, or -1 on timeout. */
 static int run(char *const argv[], const char *in, buf *out, buf *err, double timeout)
@@ -95,6 +100,18 @@ static int run(char *const argv[], const char *in, buf *out, buf *err, double ti
         dup2(pout[1], 1);
         dup2(perr[1], 2);
         close(pin[0]); close(pin[1]); close(pout[0]); close(pout[1]); close(perr[0]); close(perr[1]);
+        if (child_stdin) {
+            int fd = open(child_stdin, O_RDONLY);
+            if (fd < 0 || dup2(fd, 0) < 0)
+                _exit(127);
+            close(fd);
+        }
+        if (child_stdout) {
+            int fd = open(child_stdout, O_WRONLY);
+            if (fd < 0 || dup2(fd, 1) < 0)
+                _exit(127);
+            close(fd);
+        }
         execv(argv[0], argv);
         fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
         _exit(127);
@@ -479,7 +496,7 @@ static void run_repl_dir(const char *frac, const char *dir)
             continue;
         char *text = read_file(path, NULL);
         buf in = {0}, want = {0}, why = {0};
-        char *errs[64];
+        char *errs[64], stdin_from[1024] = "", stdout_to[1024] = "";
         int nerr = 0, exit_code = 0;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
@@ -496,12 +513,19 @@ static void run_repl_dir(const char *frac, const char *dir)
                 errs[nerr++] = strndup(p + 5, l - 5);
             } else if (strncmp(p, "exit: ", 6) == 0) {
                 exit_code = atoi(p + 6);
+            } else if (strncmp(p, "stdin-from: ", 12) == 0) {
+                snprintf(stdin_from, sizeof stdin_from, "%.*s", (int)(l - 12), p + 12);
+            } else if (strncmp(p, "stdout-to: ", 11) == 0) {
+                snprintf(stdout_to, sizeof stdout_to, "%.*s", (int)(l - 11), p + 11);
             }
             p = e ? e + 1 : p + l;
         }
         char *argv[] = {(char *)frac, "--quiet", "repl", NULL};
         buf out = {0}, err = {0};
+        child_stdin = stdin_from[0] ? stdin_from : NULL;
+        child_stdout = stdout_to[0] ? stdout_to : NULL;
         int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
+        child_stdin = child_stdout = NULL;
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
