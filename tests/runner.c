@@ -398,7 +398,11 @@ static void run_lang_dir(const char *frac, const char *dir)
 /* ---- command-line tests --------------------------------------------------------------
  * tests/cli/NAME.cli: "# args: A B C" (the whole command line after frac;
  * quoted 'single words' keep their spaces), "# stdin: TEXT" lines,
- * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings). */
+ * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings).
+ * $TMP in the args is a fresh folder, removed afterwards; "# file: NAME:
+ * TEXT" requires the file $TMP/NAME to contain TEXT. */
+static int rm_tree(const char *dir);
+
 static int split_args(char *s, char **argv, int max)
 {
     int n = 0;
@@ -434,8 +438,8 @@ static void run_cli_dir(const char *frac)
             continue;
         char *text = read_file(path, NULL);
         buf in = {0}, why = {0};
-        char *outs[32], *errs[32], argline[4096] = "";
-        int nout = 0, nerr = 0, exit_code = 0;
+        char *outs[32], *errs[32], *files[32], argline[4096] = "";
+        int nout = 0, nerr = 0, nfile = 0, exit_code = 0;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
             size_t l = e ? (size_t)(e - p) : strlen(p);
@@ -450,7 +454,23 @@ static void run_cli_dir(const char *frac)
                 outs[nout++] = strndup(p + 10, l - 10);
             else if (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)
                 errs[nerr++] = strndup(p + 10, l - 10);
+            else if (strncmp(p, "# file: ", 8) == 0 && nfile < 32)
+                files[nfile++] = strndup(p + 8, l - 8);
             p = e ? e + 1 : p + l;
+        }
+        char tmpl[] = "/tmp/frac-cli-XXXXXX", *tmp = NULL;
+        char *dollar = strstr(argline, "$TMP");
+        if (dollar || nfile) {
+            if (!(tmp = mkdtemp(tmpl))) {
+                perror("mkdtemp");
+                exit(2);
+            }
+        }
+        while (dollar) {
+            char rest[4096];
+            snprintf(rest, sizeof rest, "%s", dollar + 4);
+            snprintf(dollar, sizeof argline - (size_t)(dollar - argline), "%s%s", tmp, rest);
+            dollar = strstr(dollar + strlen(tmp), "$TMP");
         }
         char *argv[64];
         argv[0] = (char *)frac;
@@ -475,6 +495,22 @@ static void run_cli_dir(const char *frac)
             }
             free(errs[j]);
         }
+        for (int j = 0; j < nfile; j++) {
+            char *colon = strstr(files[j], ": ");
+            char fpath[8192];
+            if (colon)
+                *colon = 0;
+            snprintf(fpath, sizeof fpath, "%s/%s", tmp, files[j]);
+            char *ft = read_file(fpath, NULL);
+            if (!colon || !ft || !strstr(ft, colon + 2)) {
+                ok = 0;
+                buf_fmt(&why, "  %s lacks: %s\n%.2000s\n", files[j], colon ? colon + 2 : "", ft ? ft : "(no file)");
+            }
+            free(ft);
+            free(files[j]);
+        }
+        if (tmp)
+            rm_tree(tmp);
         if (!ok)
             buf_fmt(&why, "  stdout was:\n%.2000s\n  stderr was:\n%.2000s", out.d, err.d);
         result(path, ok, &why);
