@@ -226,7 +226,9 @@ static const char help_text[] =
     "  :time EXPR     evaluate and print how long it took\n"
     "  :show NAME     preview an image (or anything showable) in the terminal\n"
     "  :quit          leave (also Ctrl-D on an empty line)\n"
-    "Type any statement or expression; bare expressions print their value.\n";
+    "Type any statement or expression; bare expressions print their value.\n"
+    "Unfinished input continues on a '..' line; a line starting with elif, else\n"
+    "or |> continues the entry before it (which then runs again, joined).\n";
 
 static void cmd_help(repl *r, const char *arg)
 {
