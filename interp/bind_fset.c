@@ -909,7 +909,8 @@ static int shape_save(interp *I, const void *p, const char *path, value opts)
     bytebuf b;
     bytebuf_init(&b);
     rt_error e;
-    rt_code c = draw_svg(&b, &view, s, &st, has_bg == 1 ? bg : NULL, (int)prec, &e);
+    /* fill: true fills with the stroke colour */
+    rt_code c = draw_svg_fill(&b, &view, s, &st, has_fill == 1 ? fillc : NULL, has_bg == 1 ? bg : NULL, (int)prec, &e);
     if (!c)
         c = b.failed ? rt_fail(&e, RT_ENOMEM, "out of memory writing SVG") : fileio_write_atomic(path, b.data, b.len, &e);
     bytebuf_free(&b);

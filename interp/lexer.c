@@ -103,12 +103,13 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
         token t;
         memset(&t, 0, sizeof t);
         /* white space and comments */
-        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '#' || (*p == '\\' && p[1] == '\n')) {
+        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '#' ||
+               (*p == '\\' && (p[1] == '\n' || (p[1] == '\r' && p[2] == '\n')))) {
             if (*p == '#') {
                 while (*p && *p != '\n')
                     p++;
             } else if (*p == '\\') { /* explicit line continuation */
-                p += 2;
+                p += p[1] == '\r' ? 3 : 2;
                 line++;
                 line_start = p;
             } else {
@@ -224,6 +225,12 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             case '|':
                 if (p[1] == '>') { t.type = T_PIPE; two = 1; }
                 else t.err = "unexpected '|' (the pipe is '|>')";
+                break;
+            case '\\':
+                /* the REPL asks for the next line (the parser marks this
+                 * error incomplete); a script has none to join */
+                t.err = p[1] == 0 ? "'\\' at the end of the input has no next line to join"
+                                  : "unexpected '\\' (only at the end of a line, to join it with the next)";
                 break;
             default:
                 t.err = "unexpected character";

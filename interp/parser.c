@@ -20,6 +20,8 @@ typedef struct parser {
     size_t pos;
     int skip_nl;    /* newlines are insignificant here */
     int table_mode; /* parsing an entry of a table row */
+    int closing;    /* the error being reported is a missing closer */
+    const token *construct; /* innermost 'if', 'fn' or 'for' being parsed */
     int failed;
 } parser;
 
@@ -74,6 +76,41 @@ static void skip_newlines(parser *p)
         p->pos++;
 }
 
+/* The innermost bracket or 'do' still open before token index `upto`
+ * (closers pop whatever is open, so a mismatch is reported elsewhere). */
+static const token *innermost_open(const parser *p, size_t upto)
+{
+    const token *stack[64];
+    size_t n = 0, deeper = 0;
+    for (size_t i = 0; i < upto; i++) {
+        const token *t = &p->tl.toks[i];
+        tok_type k = t->type;
+        if (k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO) {
+            if (n < 64)
+                stack[n++] = t;
+            else
+                deeper++;
+        } else if (k == T_RPAREN || k == T_RBRACKET || k == T_RBRACE || k == T_END) {
+            if (deeper)
+                deeper--;
+            else if (n)
+                n--;
+        }
+    }
+    return n ? stack[n - 1] : NULL;
+}
+
+static void note_opened_here(parser *p, const token *open)
+{
+    err_state *e = &p->I->err;
+    tok_type k = open->type;
+    int bracket = k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO;
+    snprintf(e->note, sizeof e->note, "%s %s here", lex_name(k), bracket ? "opened" : "started");
+    e->note_src = open->src;
+    e->note_line = open->line;
+    e->note_col = open->col;
+}
+
 static int syntax_error(parser *p, const token *t, const char *fmt, const char *a)
 {
     if (p->failed)
@@ -81,11 +118,32 @@ static int syntax_error(parser *p, const token *t, const char *fmt, const char *
     p->failed = 1;
     if (t->type == T_ERROR) {
         err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, "%s", t->err);
+        /* a '\' ending the input asks for the line it joins (REPL) */
+        if (t->start[0] == '\\' && t->start[1] == 0)
+            p->I->err.incomplete = 1;
         return -1;
     }
     err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, fmt, a);
-    if (t->type == T_EOF)
+    if (t->type == T_EOF) {
         p->I->err.incomplete = 1;
+        /* input that ends inside a construct names where it opened (an
+         * expected closer says so itself, see expect_close) */
+        const token *open = p->closing ? NULL : innermost_open(p, (size_t)(t - p->tl.toks));
+        const token *c = p->closing ? NULL : p->construct;
+        if (c && (!open || c > open)) {
+            err_state *e = &p->I->err;
+            size_t l = strlen(e->msg);
+            snprintf(e->msg + l, sizeof e->msg - l, " (%s at line %d is not finished)", lex_name(c->type),
+                     c->line);
+            note_opened_here(p, c);
+        } else if (open) {
+            err_state *e = &p->I->err;
+            size_t l = strlen(e->msg);
+            snprintf(e->msg + l, sizeof e->msg - l, " (%s opened at line %d is not closed)",
+                     lex_name(open->type), open->line);
+            note_opened_here(p, open);
+        }
+    }
     return -1;
 }
 
@@ -122,12 +180,9 @@ static int expect_close(parser *p, tok_type t, const token *open)
     char buf[64], msg[256];
     snprintf(msg, sizeof msg, "expected %s to close %s opened at line %d, found %%s", lex_name(t),
              lex_name(open->type), open->line);
+    p->closing = 1;
     syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
-    err_state *e = &p->I->err;
-    snprintf(e->note, sizeof e->note, "%s opened here", lex_name(open->type));
-    e->note_src = open->src;
-    e->note_line = open->line;
-    e->note_col = open->col;
+    note_opened_here(p, open);
     return -1;
 }
 
@@ -458,6 +513,9 @@ static node *make_lambda(parser *p, const token *at, nodevec *params, node *body
 /* lambda body -> '=' expr | 'do' block 'end' | '=>' expr */
 static node *parse_lambda_rest(parser *p, const token *at, const char *name)
 {
+    const token *save_c = p->construct;
+    if (at->type == T_FN)
+        p->construct = at;
     nodevec params = {0};
     if (parse_params(p, &params))
         return NULL;
@@ -479,6 +537,7 @@ static node *parse_lambda_rest(parser *p, const token *at, const char *name)
     }
     if (!body)
         return NULL;
+    p->construct = save_c;
     return make_lambda(p, at, &params, body, name);
 }
 
@@ -668,7 +727,9 @@ static node *parse_if(parser *p, token *at)
     if (!n->kids)
         return NULL;
     int save_tm = p->table_mode;
+    const token *save_c = p->construct;
     p->table_mode = 0;
+    p->construct = at;
     n->kids[0] = parse_expr(p);
     if (!n->kids[0] || expect(p, T_THEN, "after the condition of 'if'"))
         return NULL;
@@ -694,6 +755,7 @@ static node *parse_if(parser *p, token *at)
         p->pos = save;
     }
     p->table_mode = save_tm;
+    p->construct = save_c;
     return n;
 }
 
@@ -1022,6 +1084,8 @@ static node *parse_statement(parser *p)
     }
     case T_FOR: {
         next(p);
+        const token *save_c = p->construct;
+        p->construct = t;
         const char *var = expect_name(p, "a variable name after 'for'");
         if (!var || expect(p, T_IN, "after the loop variable"))
             return NULL;
@@ -1034,6 +1098,7 @@ static node *parse_statement(parser *p)
         node *body = parse_block_until(p, d, 0);
         if (!body || expect_close(p, T_END, d))
             return NULL;
+        p->construct = save_c;
         node *n = mk2(p, N_FOR, t, it, body);
         if (n)
             n->str = var;

@@ -5,6 +5,16 @@
  * interrupts a running evaluation. Piped: no prompts and no escape
  * sequences; values to stdout one per line, errors to stderr, and the exit
  * code is 65 if any input failed, so sessions can be tested by piping.
+ *
+ * Entries are parsed exactly as a script would parse the same lines. A
+ * script's expression may go on after a line break when the next line starts
+ * with 'elif', 'else' or '|>' (parse_if, parse_binary). Piped input is read
+ * one line ahead to see that. A terminal cannot be read ahead, so there a
+ * line starting with one of those tokens joins the entry before it: the
+ * global bindings that entry changed are put back and the joined text runs
+ * as one entry (docs/repl.md). Input that ends inside an open construct is
+ * the parser's error (65); a read error on standard input or a failed write
+ * to standard output is 74.
  */
 #include "repl.h"
 
@@ -17,6 +27,7 @@
 #include "builtin.h"
 #include "eval.h"
 #include "fileio.h"
+#include "lexer.h"
 #include "lineedit.h"
 #include "parser.h"
 #include "session.h"
@@ -24,20 +35,48 @@
 typedef struct repl {
     interp *I;
     lineedit *le;
-    int tty;
-    int line_no; /* session line number of the next input line */
-    int failed;
+    int tty;      /* stdin and stdout are terminals: prompts, banner */
+    int in_tty;   /* stdin is a terminal: no reading ahead */
+    int line_no;  /* session line number of the next input line */
+    int failed;   /* an entry failed: exit 65 when piped */
+    int io_error; /* reading stdin or writing stdout failed: exit 74 */
+    char **ahead; /* lines read ahead (piped), oldest first */
+    size_t nahead, capahead;
+    /* the previous entry (terminal), for a line that continues it */
+    char *prev_text;
+    int prev_first;
+    value *snap; /* global values before it ran, one per binding then */
+    size_t nsnap;
 } repl;
 
+/* The tokens that continue a script's expression from the line before. */
+static int continues_previous(tok_type t) { return t == T_ELIF || t == T_ELSE || t == T_PIPE; }
+
+/* The type of the first token of a line (T_EOF for blank or comment lines). */
+static tok_type first_token(const char *line)
+{
+    token_list tl;
+    if (lex_all(line, 0, 1, &tl))
+        return T_EOF;
+    tok_type t = (tok_type)tl.toks[0].type;
+    lex_free(&tl);
+    return t;
+}
+
 /* Read one line (without the newline) into a malloc'd string; NULL at the
- * end of input. Ctrl-C on a terminal cancels the line: *cancelled is set and
- * an empty line is returned. */
+ * end of input or on a read error (r->io_error). Ctrl-C on a terminal
+ * cancels the line: *cancelled is set and an empty line is returned. */
 static char *read_line(repl *r, const char *prompt, int *cancelled)
 {
     *cancelled = 0;
+    if (r->nahead && prompt) {
+        char *l = r->ahead[0];
+        memmove(r->ahead, r->ahead + 1, --r->nahead * sizeof *r->ahead);
+        return l;
+    }
     char *line = NULL;
     for (;;) {
-        lineedit_result res = lineedit_read(r->le, prompt, &line);
+        lineedit_result res = lineedit_read(r->le, prompt ? prompt : "", &line);
         if (res == LINEEDIT_LINE)
             return line;
         if (res == LINEEDIT_INTERRUPT) {
@@ -49,10 +88,112 @@ static char *read_line(repl *r, const char *prompt, int *cancelled)
                 line[0] = 0;
             return line;
         }
-        if (res == LINEEDIT_ERROR)
+        if (res == LINEEDIT_ERROR) {
             fprintf(stderr, "frac: %s\n", lineedit_errmsg(r->le));
+            r->io_error = 1;
+        }
         return NULL;
     }
+}
+
+/* Piped input: read ahead past blank and comment lines to the next line
+ * with a token. If it continues the entry (see continues_previous), append
+ * the comment lines and it to *text and return 1; otherwise keep the lines
+ * for read_line and return 0. */
+static int join_next(repl *r, char **text, size_t *len)
+{
+    for (;;) {
+        size_t k = r->nahead;
+        tok_type t = T_EOF;
+        if (k && (t = first_token(r->ahead[k - 1])) != T_EOF)
+            break;
+        int cancelled;
+        char *line = read_line(r, NULL, &cancelled); /* NULL: past the lines read ahead */
+        if (!line)
+            return 0;
+        if (r->nahead == r->capahead) {
+            size_t nc = r->capahead ? 2 * r->capahead : 8;
+            char **na = realloc(r->ahead, nc * sizeof *na);
+            if (!na) {
+                free(line);
+                return 0;
+            }
+            r->ahead = na;
+            r->capahead = nc;
+        }
+        r->ahead[r->nahead++] = line;
+    }
+    if (!continues_previous(first_token(r->ahead[r->nahead - 1])))
+        return 0;
+    /* take every line read ahead; empty lines are not counted (as at the prompt) */
+    for (size_t i = 0; i < r->nahead; i++) {
+        char *l = r->ahead[i];
+        size_t ml = strlen(l);
+        if (ml) {
+            char *nt = realloc(*text, *len + ml + 2);
+            if (!nt) {
+                for (; i < r->nahead; i++)
+                    free(r->ahead[i]);
+                r->nahead = 0;
+                return 0;
+            }
+            *text = nt;
+            nt[*len] = '\n';
+            memcpy(nt + *len + 1, l, ml + 1);
+            *len += ml + 1;
+            r->line_no++;
+        }
+        free(l);
+    }
+    r->nahead = 0;
+    return 1;
+}
+
+/* Terminal: remember the global values before an entry runs, so that a
+ * continuation line can put them back and run the joined entry. */
+static void snap_drop(repl *r)
+{
+    for (size_t i = 0; i < r->nsnap; i++)
+        val_unref(r->I, r->snap[i]);
+    free(r->snap);
+    r->snap = NULL;
+    r->nsnap = 0;
+}
+
+static void snap_take(repl *r)
+{
+    snap_drop(r);
+    env *g = r->I->globals;
+    if (!g->n || !(r->snap = malloc(g->n * sizeof *r->snap)))
+        return;
+    for (size_t i = 0; i < g->n; i++) {
+        r->snap[i] = g->vals[i];
+        val_ref(g->vals[i]);
+    }
+    r->nsnap = g->n;
+}
+
+/* Bindings made by the entry after the snapshot stay (the joined entry
+ * defines them again); those it changed get their old values back. */
+static void snap_restore(repl *r)
+{
+    env *g = r->I->globals;
+    for (size_t i = 0; i < r->nsnap && i < g->n; i++) {
+        val_unref(r->I, g->vals[i]);
+        g->vals[i] = r->snap[i];
+    }
+    for (size_t i = g->n; i < r->nsnap; i++)
+        val_unref(r->I, r->snap[i]);
+    free(r->snap);
+    r->snap = NULL;
+    r->nsnap = 0;
+}
+
+static void forget_prev(repl *r)
+{
+    free(r->prev_text);
+    r->prev_text = NULL;
+    snap_drop(r);
 }
 
 static void print_value(repl *r, value v)
@@ -85,7 +226,9 @@ static const char help_text[] =
     "  :time EXPR     evaluate and print how long it took\n"
     "  :show NAME     preview an image (or anything showable) in the terminal\n"
     "  :quit          leave (also Ctrl-D on an empty line)\n"
-    "Type any statement or expression; bare expressions print their value.\n";
+    "Type any statement or expression; bare expressions print their value.\n"
+    "Unfinished input continues on a '..' line; a line starting with elif, else\n"
+    "or |> continues the entry before it (which then runs again, joined).\n";
 
 static void cmd_help(repl *r, const char *arg)
 {
@@ -207,11 +350,44 @@ static int run_command(repl *r, char *line)
     return 0;
 }
 
+/* Add an entry as a source for the parser. It is parsed as the lines of a
+ * script are, with the line break after its last line: so an operator or
+ * keyword that a script does not continue past a line break is an error
+ * here too, not a request for more input. A '\\' at the end is left last,
+ * so that piped input ending there says so. */
+static int add_entry_source(interp *I, const char *text, size_t len)
+{
+    if (len && text[len - 1] == '\\')
+        return interp_add_source(I, "<repl>", text, len);
+    char *t = malloc(len + 2);
+    if (!t)
+        return -1;
+    memcpy(t, text, len);
+    t[len] = '\n';
+    t[len + 1] = 0;
+    int src = interp_add_source(I, "<repl>", t, len + 1);
+    free(t);
+    return src;
+}
+
+/* A failed write to standard output ends the session with 74. */
+static int stdout_failed(repl *r)
+{
+    if (r->io_error == 2)
+        return 1;
+    if (fflush(stdout) == 0 && !ferror(stdout))
+        return 0;
+    fprintf(stderr, "frac: cannot write to standard output\n");
+    r->io_error = 2;
+    return 1;
+}
+
 int repl_main(interp *I, volatile sig_atomic_t *interrupted)
 {
     repl r = {0};
     r.I = I;
-    r.tty = isatty(0) && isatty(1);
+    r.in_tty = isatty(0);
+    r.tty = r.in_tty && isatty(1);
     r.line_no = 1;
     I->is_repl = 1;
     char hist[4096] = "";
@@ -225,7 +401,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
     }
     if (r.tty)
         printf("frac %s — type :help for help, :quit or Ctrl-D to leave\n", FRAC_VERSION);
-    for (;;) {
+    while (!stdout_failed(&r)) {
         *interrupted = 0;
         int cancelled;
         char *line = read_line(&r, "frac> ", &cancelled);
@@ -237,6 +413,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         }
         int first = r.line_no++;
         if (line[0] == ':') {
+            forget_prev(&r);
             lineedit_history_add(r.le, line);
             int quit = run_command(&r, line);
             free(line);
@@ -244,26 +421,49 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
                 break;
             continue;
         }
-        /* accumulate continuation lines while the input is incomplete */
         size_t len = strlen(line);
         char *text = line;
+        int joined = 0;
+        if (r.prev_text && continues_previous(first_token(line))) {
+            /* terminal: this line goes on with the entry before it */
+            size_t pl = strlen(r.prev_text);
+            char *nt = malloc(pl + len + 2);
+            if (nt) {
+                memcpy(nt, r.prev_text, pl);
+                nt[pl] = '\n';
+                memcpy(nt + pl + 1, line, len + 1);
+                free(line);
+                text = nt;
+                len += pl + 1;
+                first = r.prev_first;
+                joined = 1;
+            }
+        }
+        /* accumulate continuation lines while the input is incomplete */
         int dropped = 0;
         for (;;) {
-            int src = interp_add_source(I, "<repl>", text, len);
+            int src = add_entry_source(I, text, len);
             node *prog;
             if (src < 0)
                 break;
             I->srcs[src].first_line = first;
-            if (parse_source(I, src, &prog) == 0 || !I->err.incomplete)
-                break;
-            err_clear(I);
-            char *more = read_line(&r, "..    ", &cancelled);
-            if (!more || cancelled) {
-                /* Ctrl-C or end of input abandons the unfinished entry */
-                free(more);
-                dropped = 1;
+            if (parse_source(I, src, &prog) == 0) {
+                if (!r.in_tty && join_next(&r, &text, &len))
+                    continue;
                 break;
             }
+            if (!I->err.incomplete)
+                break;
+            char *more = read_line(&r, "..    ", &cancelled);
+            if (!more || cancelled) {
+                /* piped input that ends here is the parser's error; on a
+                 * terminal Ctrl-C or Ctrl-D abandons the unfinished entry */
+                free(more);
+                if (r.in_tty || r.io_error)
+                    dropped = 1;
+                break;
+            }
+            err_clear(I);
             r.line_no++;
             size_t ml = strlen(more);
             char *nt = realloc(text, len + ml + 2);
@@ -277,16 +477,36 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             len += ml + 1;
             free(more);
         }
-        lineedit_history_add(r.le, text);
-        if (dropped) {
-            err_clear(I);
-        } else if (I->err.active) {
-            report(&r);
-        } else {
-            eval_entry(&r, text, first, 0);
+        lineedit_history_add(r.le, joined ? text + strlen(r.prev_text) + 1 : text);
+        if (dropped || I->err.active) {
+            if (dropped)
+                err_clear(I);
+            else
+                report(&r);
+            free(text);
+            forget_prev(&r);
+            continue;
         }
-        free(text);
+        if (joined)
+            snap_restore(&r);
+        else if (r.in_tty)
+            snap_take(&r);
+        eval_entry(&r, text, first, 0);
+        if (r.in_tty) {
+            free(r.prev_text);
+            r.prev_text = text;
+            r.prev_first = first;
+        } else {
+            free(text);
+        }
     }
+    stdout_failed(&r);
+    for (size_t i = 0; i < r.nahead; i++)
+        free(r.ahead[i]);
+    free(r.ahead);
+    forget_prev(&r);
     lineedit_free(r.le);
+    if (r.io_error)
+        return 74;
     return r.failed && !r.tty ? 65 : 0;
 }

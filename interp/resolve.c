@@ -5,7 +5,9 @@
 
 #include "check.h"
 #include "eval.h"
+#include "lexer.h"
 #include "parser.h"
+#include "stdlib_embed.h"
 
 typedef struct scope {
     const char **names;
@@ -128,6 +130,38 @@ static int push_candidate(interp *I, const char ***c, size_t *n, size_t *cap, co
     return 0;
 }
 
+/* The standard module whose top level defines `name` (a `let`, `fn` or
+ * `param` at the start of a statement outside any bracket or block), or
+ * NULL. Only scanned when a name is unknown, so the modules are lexed then,
+ * not at every start. */
+static const char *stdlib_defining(const char *name)
+{
+    size_t nl = strlen(name);
+    for (const stdlib_module *m = stdlib_modules; m->name; m++) {
+        token_list tl;
+        if (lex_all(m->source, 0, 1, &tl))
+            continue;
+        int depth = 0, at_start = 1, found = 0;
+        for (size_t i = 0; i + 1 < tl.n && !found; i++) {
+            const token *t = &tl.toks[i];
+            tok_type k = (tok_type)t->type;
+            if (k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO)
+                depth++;
+            else if ((k == T_RPAREN || k == T_RBRACKET || k == T_RBRACE || k == T_END) && depth > 0)
+                depth--;
+            const token *nt = t + 1;
+            if (depth == 0 && at_start && (k == T_LET || k == T_FN || k == T_PARAM) && nt->type == T_IDENT &&
+                (size_t)nt->len == nl && memcmp(nt->start, name, nl) == 0)
+                found = 1;
+            at_start = k == T_NEWLINE || k == T_SEMI;
+        }
+        lex_free(&tl);
+        if (found)
+            return m->name;
+    }
+    return NULL;
+}
+
 static int unknown(resolver *r, scope *s, const node *at, const char *name)
 {
     /* gather candidates from every scope and the globals */
@@ -141,9 +175,13 @@ static int unknown(resolver *r, scope *s, const node *at, const char *name)
         for (size_t i = 0; i < e->n; i++)
             if (push_candidate(r->I, &c, &n, &cap, e->names[i]))
                 return -1;
-    const char *sug = suggest_name(name, c, n);
-    err_at(r->I, at, ERR_NAME, "unknown name '%s'%s%s%s", name, sug ? " (did you mean '" : "",
-           sug ? sug : "", sug ? "'?)" : "");
+    const char *mod = stdlib_defining(name);
+    const char *sug = mod ? NULL : suggest_name(name, c, n);
+    if (mod)
+        err_at(r->I, at, ERR_NAME, "unknown name '%s' (import \"%s\" defines it)", name, mod);
+    else
+        err_at(r->I, at, ERR_NAME, "unknown name '%s'%s%s%s", name, sug ? " (did you mean '" : "",
+               sug ? sug : "", sug ? "'?)" : "");
     mem_free(r->I, c);
     return -1;
 }

@@ -242,6 +242,12 @@ static void put_colour(bytebuf *b, const char *attr, const float c[4])
 rt_code draw_svg(bytebuf *b, const draw_view *v, const detiter_shape *s, const draw_style *st,
                  const float *bg, int precision, rt_error *e)
 {
+    return draw_svg_fill(b, v, s, st, NULL, bg, precision, e);
+}
+
+rt_code draw_svg_fill(bytebuf *b, const draw_view *v, const detiter_shape *s, const draw_style *st,
+                      const float *fill_rgba, const float *bg, int precision, rt_error *e)
+{
     if (precision < 0 || precision > 9)
         return rt_fail(e, RT_EINVAL, "SVG precision %d (expected 0 to 9)", precision);
     int d = s->dim;
@@ -256,8 +262,9 @@ rt_code draw_svg(bytebuf *b, const draw_view *v, const detiter_shape *s, const d
         bytebuf_printf(b, "/>\n");
     }
     bytebuf_printf(b, "<g");
+    const float *fillc = fill_rgba ? fill_rgba : st->color;
     if (st->fill)
-        put_colour(b, "fill", st->color);
+        put_colour(b, "fill", fillc);
     else
         bytebuf_printf(b, " fill=\"none\"");
     if (st->width > 0) {
@@ -281,7 +288,9 @@ rt_code draw_svg(bytebuf *b, const draw_view *v, const detiter_shape *s, const d
             bytebuf_printf(b, "\" r=\"");
             put_num(b, st->radius, precision);
             bytebuf_printf(b, "\"");
-            if (!st->fill)
+            /* points are discs of the stroke colour, as draw() paints them
+             * over the fill (without a stroke, of the fill colour) */
+            if (!st->fill || (fillc != st->color && st->width > 0))
                 put_colour(b, "fill", st->color);
             bytebuf_printf(b, "/>\n");
             continue;

@@ -66,5 +66,10 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
  * decimals for coordinates, 0 .. 9. */
 rt_code draw_svg(bytebuf *b, const draw_view *v, const detiter_shape *s, const draw_style *st,
                  const float *bg, int precision, rt_error *e);
+/* The same with the fill in its own colour fill_rgba (NULL: st->color);
+ * points are discs of st->color when there is a stroke, as draw() paints
+ * them over the fill. */
+rt_code draw_svg_fill(bytebuf *b, const draw_view *v, const detiter_shape *s, const draw_style *st,
+                      const float *fill_rgba, const float *bg, int precision, rt_error *e);
 
 #endif

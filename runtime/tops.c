@@ -246,7 +246,7 @@ rt_code tops_colour(const tops_buf *t, int nsym, const ramp *r, const float bg[4
             continue;
         }
         double prefix = t->nmaps < 2 ? 0 : (double)(t->cell[i].key / div);
-        ramp_eval(r, (prefix + 0.5) / span, px);
+        ramp_eval(r, span > 1 ? prefix / (span - 1) : 0, px);
     }
     return RT_OK;
 }

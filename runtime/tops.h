@@ -79,7 +79,10 @@ void tops_free(tops_buf *t);
 int tops_symbol(const tops_buf *t, uint64_t key, int i);
 
 /* Colour each pixel by the first nsym symbols of its top address, read as a
- * base-N number p, through the ramp at (p + ½)/N^nsym; empty pixels get bg.
+ * base-N number p, through the ramp at p/(N^nsym − 1) (0 for one map); empty
+ * pixels get bg. With nsym = 1 that is k/(N − 1) for map k, the colour
+ * chaos() gives map k (CHAOS_COLOUR_LAST), so a palette of one colour per map
+ * shows each map in its own colour in both.
  * out must be t->w × t->h. */
 rt_code tops_colour(const tops_buf *t, int nsym, const ramp *r, const float bg[4], image *out,
                     rt_error *e);

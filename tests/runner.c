@@ -16,7 +16,10 @@
  *   # stdin: TEXT                  a line of standard input
  * REPL tests (.repl files in tests/repl/): lines "in: TEXT" are piped to `frac repl`;
  * "out: TEXT" lines are the whole stdout, in order; "err: TEXT" must appear
- * in stderr in order; "exit: N" (default 0).
+ * in stderr in order; "exit: N" (default 0); "stdin-from: PATH" and
+ * "stdout-to: PATH" replace the pipes with that file (read and write errors).
+ * Doc tests: every fenced code block in README.md and docs/NAME.md (the
+ * convention is in docs/internals.md, "Docs are tests").
  * Golden tests: every examples/NAME.frac runs with --threads 1 and with
  * --threads 3 into fresh directories; every file written and the stdout must
  * equal tests/golden/NAME/ byte for byte (both thread counts).
@@ -74,9 +77,11 @@ static void buf_fmt(buf *b, const char *fmt, ...)
 static int passed, failed;
 static const char *filter;
 static double timeout_s = 120;
-/* CLI tests: where the child's stdout goes instead of the pipe (e.g. /dev/full),
- * and a folder to put first on its PATH (so `#!/usr/bin/env frac` finds frac). */
-static const char *child_stdout, *child_path_dir;
+/* When set, the next run() gives the child this file as stdin / stdout
+ * instead of the pipe (REPL and CLI tests of read and write errors, e.g.
+ * /dev/full), runs it in child_cwd, and puts child_path_dir first on its
+ * PATH (so `#!/usr/bin/env frac` finds frac). */
+static const char *child_stdin, *child_stdout, *child_cwd, *child_path_dir;
 
 /* Run argv with stdin text (may be NULL), capture stdout/stderr; returns the
  * exit code, 128+signal, or -1 on timeout. */
@@ -98,9 +103,18 @@ static int run(char *const argv[], const char *in, buf *out, buf *err, double ti
         dup2(pout[1], 1);
         dup2(perr[1], 2);
         close(pin[0]); close(pin[1]); close(pout[0]); close(pout[1]); close(perr[0]); close(perr[1]);
-        int fd = child_stdout ? open(child_stdout, O_WRONLY) : -1;
-        if (fd >= 0) {
-            dup2(fd, 1);
+        if (child_cwd && chdir(child_cwd) != 0)
+            _exit(127);
+        if (child_stdin) {
+            int fd = open(child_stdin, O_RDONLY);
+            if (fd < 0 || dup2(fd, 0) < 0)
+                _exit(127);
+            close(fd);
+        }
+        if (child_stdout) {
+            int fd = open(child_stdout, O_WRONLY);
+            if (fd < 0 || dup2(fd, 1) < 0)
+                _exit(127);
             close(fd);
         }
         if (child_path_dir) {
@@ -397,8 +411,9 @@ static void run_lang_dir(const char *frac, const char *dir)
  * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings),
  * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
  * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
- * folder first on PATH; the args follow it). In all of them $TMP stands for
- * a fresh empty folder, removed after the test. */
+ * folder first on PATH; the args follow it), "# file: NAME: TEXT" (the file
+ * $TMP/NAME must contain TEXT). In all of them $TMP stands for a fresh empty
+ * folder, removed after the test. */
 static int rm_tree(const char *dir);
 
 /* s[0..l) with every "$TMP" replaced by tmp, appended to out. */
@@ -451,10 +466,10 @@ static void run_cli_dir(const char *frac)
             continue;
         char *text = read_file(path, NULL);
         buf in = {0}, why = {0}, argb = {0};
-        char *outs[32], *errs[32], stdout_to[4096] = "", exec_path[4096] = "";
-        int nout = 0, nerr = 0, exit_code = 0;
+        char *outs[32], *errs[32], *files[32], stdout_to[4096] = "", exec_path[4096] = "";
+        int nout = 0, nerr = 0, nfile = 0, exit_code = 0;
         char tmpl[] = "/tmp/frac-cli-XXXXXX";
-        char *tmp = text && strstr(text, "$TMP") ? mkdtemp(tmpl) : NULL;
+        char *tmp = text && (strstr(text, "$TMP") || strstr(text, "# file: ")) ? mkdtemp(tmpl) : NULL;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
             size_t l = e ? (size_t)(e - p) : strlen(p);
@@ -477,7 +492,8 @@ static void run_cli_dir(const char *frac)
                     outs[nout++] = b.d;
                 else
                     errs[nerr++] = b.d;
-            }
+            } else if (strncmp(p, "# file: ", 8) == 0 && nfile < 32)
+                files[nfile++] = strndup(p + 8, l - 8);
             p = e ? e + 1 : p + l;
         }
         char *argline = argb.d ? argb.d : "";
@@ -511,6 +527,20 @@ static void run_cli_dir(const char *frac)
             }
             free(errs[j]);
         }
+        for (int j = 0; j < nfile; j++) {
+            char *colon = strstr(files[j], ": ");
+            char fpath[8192];
+            if (colon)
+                *colon = 0;
+            snprintf(fpath, sizeof fpath, "%s/%s", tmp, files[j]);
+            char *ft = read_file(fpath, NULL);
+            if (!colon || !ft || !strstr(ft, colon + 2)) {
+                ok = 0;
+                buf_fmt(&why, "  %s lacks: %s\n%.2000s\n", files[j], colon ? colon + 2 : "", ft ? ft : "(no file)");
+            }
+            free(ft);
+            free(files[j]);
+        }
         if (!ok)
             buf_fmt(&why, "  stdout was:\n%.2000s\n  stderr was:\n%.2000s", out.d, err.d);
         result(path, ok, &why);
@@ -534,7 +564,7 @@ static void run_repl_dir(const char *frac, const char *dir)
             continue;
         char *text = read_file(path, NULL);
         buf in = {0}, want = {0}, why = {0};
-        char *errs[64];
+        char *errs[64], stdin_from[1024] = "", stdout_to[1024] = "";
         int nerr = 0, exit_code = 0;
         for (char *p = text; p && *p;) {
             char *e = strchr(p, '\n');
@@ -551,12 +581,19 @@ static void run_repl_dir(const char *frac, const char *dir)
                 errs[nerr++] = strndup(p + 5, l - 5);
             } else if (strncmp(p, "exit: ", 6) == 0) {
                 exit_code = atoi(p + 6);
+            } else if (strncmp(p, "stdin-from: ", 12) == 0) {
+                snprintf(stdin_from, sizeof stdin_from, "%.*s", (int)(l - 12), p + 12);
+            } else if (strncmp(p, "stdout-to: ", 11) == 0) {
+                snprintf(stdout_to, sizeof stdout_to, "%.*s", (int)(l - 11), p + 11);
             }
             p = e ? e + 1 : p + l;
         }
         char *argv[] = {(char *)frac, "--quiet", "repl", NULL};
         buf out = {0}, err = {0};
+        child_stdin = stdin_from[0] ? stdin_from : NULL;
+        child_stdout = stdout_to[0] ? stdout_to : NULL;
         int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
+        child_stdin = child_stdout = NULL;
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
@@ -802,6 +839,156 @@ static void run_golden(const char *frac, int update)
     rm_tree(tmp);
 }
 
+/* ---- docs are tests ------------------------------------------------------------------
+ * A block opens with ``` and a tag (its indent is removed from its lines):
+ *   frac    run by piping it to `frac --quiet repl` in a fresh folder (outputs
+ *           written there): exit 0, and stdout must equal the ```output block
+ *           that directly follows it, or be empty if none does;
+ *   output  that expected output;
+ *   text, c shown, never run (transcripts, messages, formulas, C excerpts);
+ *   anything else (sh, …) and any block after a line "<!-- not run: REASON -->"
+ *           is not run, and must carry that line with a reason.
+ * A block without a tag is an error, so no block is left unchecked by accident. */
+typedef struct doc_block {
+    char tag[32];
+    int line;      /* of the opening fence */
+    int not_run;   /* 1: marked with a reason; -1: marked without one */
+    buf text;
+} doc_block;
+
+static int read_doc_blocks(const char *path, doc_block **out)
+{
+    char *text = read_file(path, NULL);
+    int n = 0, cap = 0, line = 0, in = 0;
+    size_t indent = 0;
+    int marked = 0;
+    doc_block *v = NULL;
+    for (char *p = text; p && *p;) {
+        char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        line++;
+        size_t sp = 0;
+        while (sp < l && p[sp] == ' ')
+            sp++;
+        int fence = l - sp >= 3 && strncmp(p + sp, "```", 3) == 0;
+        if (in) {
+            if (fence && l - sp == 3) {
+                in = 0;
+            } else {
+                size_t cut = sp < indent ? sp : indent;
+                buf_add(&v[n - 1].text, p + cut, l - cut);
+                buf_add(&v[n - 1].text, "\n", 1);
+            }
+        } else if (fence) {
+            if (n == cap) {
+                cap = cap ? 2 * cap : 16;
+                v = realloc(v, (size_t)cap * sizeof *v);
+                if (!v)
+                    exit(2);
+            }
+            doc_block *b = &v[n++];
+            memset(b, 0, sizeof *b);
+            snprintf(b->tag, sizeof b->tag, "%.*s", (int)(l - sp - 3), p + sp + 3);
+            b->line = line;
+            b->not_run = marked;
+            buf_add(&b->text, "", 0);
+            in = 1;
+            indent = sp;
+            marked = 0;
+        } else if (l > sp) {
+            const char *m = "<!-- not run:";
+            if (strncmp(p + sp, m, strlen(m)) == 0) {
+                const char *r = p + sp + strlen(m);
+                while (*r == ' ')
+                    r++;
+                marked = strncmp(r, "-->", 3) == 0 ? -1 : 1;
+            } else {
+                marked = 0;
+            }
+        }
+        p = e ? e + 1 : p + l;
+    }
+    free(text);
+    *out = v;
+    return n;
+}
+
+static void run_doc_file(const char *frac, const char *path)
+{
+    doc_block *b;
+    int n = read_doc_blocks(path, &b);
+    for (int i = 0; i < n; i++) {
+        char label[4200];
+        snprintf(label, sizeof label, "docs %s:%d", path, b[i].line);
+        if (!matches_filter(label) || strcmp(b[i].tag, "output") == 0)
+            continue;
+        buf why = {0};
+        int ok = 1;
+        const char *tag = b[i].tag;
+        int next_output = i + 1 < n && strcmp(b[i + 1].tag, "output") == 0;
+        if (b[i].not_run < 0) {
+            ok = 0;
+            buf_fmt(&why, "  <!-- not run: --> needs a reason\n");
+        } else if (!*tag) {
+            ok = 0;
+            buf_fmt(&why, "  a code block needs a tag: frac (run), output, text or another with <!-- not run: REASON -->\n");
+        } else if (b[i].not_run || strcmp(tag, "text") == 0 || strcmp(tag, "c") == 0) {
+            if (next_output && !b[i].not_run) {
+                ok = 0;
+                buf_fmt(&why, "  an output block follows a block that is not run\n");
+            }
+        } else if (strcmp(tag, "frac") != 0) {
+            ok = 0;
+            buf_fmt(&why, "  a ```%s block is not run: mark it <!-- not run: REASON -->\n", tag);
+        } else {
+            char tmpl[] = "/tmp/frac-doc-XXXXXX";
+            char *dir = mkdtemp(tmpl);
+            if (!dir) {
+                perror("mkdtemp");
+                exit(2);
+            }
+            char *argv[] = {(char *)frac, "--quiet", "--threads", "2", "repl", NULL};
+            buf out = {0}, err = {0};
+            child_cwd = dir;
+            int rc = run(argv, b[i].text.d, &out, &err, timeout_s);
+            child_cwd = NULL;
+            const char *want = next_output ? b[i + 1].text.d : "";
+            if (rc != 0) {
+                ok = 0;
+                buf_fmt(&why, "  exit code %d, expected 0\n", rc);
+            }
+            if (strcmp(out.d, want) != 0) {
+                ok = 0;
+                buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, want);
+            }
+            if (!ok)
+                buf_fmt(&why, "  stderr was:\n%.3000s", err.d);
+            rm_tree(dir);
+            free(out.d);
+            free(err.d);
+        }
+        result(label, ok, &why);
+        free(why.d);
+    }
+    for (int i = 0; i < n; i++)
+        free(b[i].text.d);
+    free(b);
+}
+
+static void run_docs(const char *frac)
+{
+    run_doc_file(frac, "README.md");
+    int n;
+    char **names = list_dir("docs", ".md", &n);
+    for (int i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "docs/%s", names[i]);
+        run_doc_file(frac, path);
+        free(names[i]);
+    }
+    free(names);
+}
+
 int main(int argc, char **argv)
 {
     const char *frac = NULL, *unit = NULL, *ptyrun = NULL;
@@ -839,6 +1026,7 @@ int main(int argc, char **argv)
     run_lang_dir(fracabs, "tests/regression");
     run_cli_dir(fracabs);
     run_repl_dir(fracabs, "tests/repl");
+    run_docs(fracabs);
     if (ptyrun) {
         static char ptyabs[4096];
         if (realpath(ptyrun, ptyabs))
