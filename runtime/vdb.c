@@ -728,8 +728,7 @@ static rt_code rd_grid(rd *r, size_t grid_pos, int comps, const char *gname, dou
         return r->e->code;
     if (comp & (COMPRESS_ZIP | COMPRESS_BLOSC))
         return rt_fail(r->e, RT_EFORMAT,
-                       "grid '%s' is compressed with %s; frac reads uncompressed .vdb files (save them without "
-                       "compression, e.g. in Houdini or with vdb_tool)",
+                       "grid '%s' is compressed with %s; frac reads .vdb files saved without zip or blosc",
                        gname, comp & COMPRESS_BLOSC ? "blosc" : "zip");
     if (comp & ~7u)
         return rt_fail(r->e, RT_EFORMAT, "grid '%s' has unknown compression flags 0x%x", gname, comp);

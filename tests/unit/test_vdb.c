@@ -264,13 +264,11 @@ static void test_refusals(void)
     memcpy(m.data, b.data, b.len);
     put32(&m, grid_pos, 3);
     refuse(m.data, m.len, RT_EFORMAT,
-           "grid 'density' is compressed with zip; frac reads uncompressed .vdb files (save them without "
-           "compression, e.g. in Houdini or with vdb_tool)",
+           "grid 'density' is compressed with zip; frac reads .vdb files saved without zip or blosc",
            "zip");
     put32(&m, grid_pos, 6);
     refuse(m.data, m.len, RT_EFORMAT,
-           "grid 'density' is compressed with blosc; frac reads uncompressed .vdb files (save them without "
-           "compression, e.g. in Houdini or with vdb_tool)",
+           "grid 'density' is compressed with blosc; frac reads .vdb files saved without zip or blosc",
            "blosc");
     memcpy(m.data, b.data, b.len);
     put32(&m, 100, (uint32_t)b.len + 1); /* grid offset past the end */
