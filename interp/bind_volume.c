@@ -9,6 +9,7 @@
 #include "lang_image.h"
 #include "lang_objects.h"
 #include "mesh_io.h"
+#include "vdb.h"
 #include "volume_io.h"
 
 /* ---- colour ramps -------------------------------------------------------------- */
@@ -246,6 +247,42 @@ static int save_type(interp *I, value opts, int *type)
     return 0;
 }
 
+/* save(v, "x.vdb", {grids: {temperature: t, color: [r, g, b]}}): v is the
+ * grid "density"; each extra grid is a volume (float grid) or a list of 3
+ * (vec3 grid). */
+static int volume_save_vdb(interp *I, const volume *v, const char *path, value opts, int type, rt_error *e,
+                           rt_code *c)
+{
+    *c = RT_OK;
+    if (type != VIO_FLOAT)
+        return err_at(I, NULL, ERR_VALUE, "save: .vdb volumes are written as 32-bit float (drop the bits option)");
+    vdb_grid g[16] = {{"density", 1, {v, NULL, NULL}}};
+    int n = 1;
+    value *gr = NULL;
+    const char *k = opts.k == V_REC ? intern(I, "grids", 5) : NULL;
+    if (k && (gr = rec_get(AS_REC(opts), k)) && gr->k != V_REC)
+        return err_at(I, NULL, ERR_TYPE, "save: option 'grids' must be a record {name: volume}, got %s",
+                      val_type_name(*gr));
+    for (size_t i = 0; gr && i < AS_REC(*gr)->n; i++, n++) {
+        value x = AS_REC(*gr)->vals[i];
+        if (n == 16)
+            return err_at(I, NULL, ERR_VALUE, "save: at most 15 extra grids in a .vdb file");
+        g[n] = (vdb_grid){AS_REC(*gr)->keys[i], 1, {lang_as_volume(x), NULL, NULL}};
+        if (x.k == V_LIST && AS_LIST(x)->n == 3) {
+            g[n].channels = 3;
+            for (int j = 0; j < 3; j++)
+                g[n].vol[j] = lang_as_volume(AS_LIST(x)->items[j]);
+        }
+        for (int j = 0; j < g[n].channels; j++)
+            if (!g[n].vol[j])
+                return err_at(I, NULL, ERR_TYPE,
+                              "save: grid '%s' must be a volume or a list of 3 volumes [r, g, b], got %s",
+                              g[n].name, val_type_name(x));
+    }
+    *c = vdb_save(path, g, n, 0, e);
+    return 0;
+}
+
 static int volume_save(interp *I, const void *p, const char *path, value opts)
 {
     const volume *v = &((const vol_payload *)p)->v;
@@ -269,9 +306,12 @@ static int volume_save(interp *I, const void *p, const char *path, value opts)
         if (type != VIO_FLOAT)
             return err_at(I, NULL, ERR_VALUE, "save: VTK volumes are written as float (drop the bits option)");
         c = vio_save_vtk(path, v, &e);
+    } else if (strcmp(ext, "vdb") == 0) {
+        if (volume_save_vdb(I, v, path, opts, type, &e, &c))
+            return -1;
     } else {
         return err_at(I, NULL, ERR_VALUE,
-                      "save: cannot save a volume as '.%s' (use .nrrd, .nhdr/.raw or .vtk)", ext);
+                      "save: cannot save a volume as '.%s' (use .nrrd, .nhdr/.raw, .vtk or .vdb)", ext);
     }
     if (c)
         return lang_rt_error(I, c, &e, "save");
@@ -404,6 +444,37 @@ mesh *lang_as_mesh(value v)
 
 /* ---- builtins ----------------------------------------------------------------------------- */
 
+/* A float grid as a volume, a vec3 grid as a list of 3 volumes [r, g, b]. */
+static int load_vdb(interp *I, const char *path, value grid, value *out)
+{
+    volume tmp[3];
+    int ch = 0;
+    rt_error e;
+    rt_code c = vdb_load(path, grid.k == V_STR ? AS_STR(grid)->s : NULL, I->lim.max_voxels, tmp, &ch, &e);
+    if (c)
+        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_volume: %s", e.msg);
+    value l = ch == 3 ? val_list(I, 3) : val_nil();
+    int rc = ch == 3 && l.k == V_NIL ? -1 : 0;
+    for (int i = 0; i < ch && !rc; i++) {
+        volume *v;
+        value x;
+        rc = lang_volume_new(I, tmp[i].nx, tmp[i].ny, tmp[i].nz, tmp[i].lo, tmp[i].hi, &v);
+        if (!rc) {
+            memcpy(v->v, tmp[i].v, (size_t)tmp[i].nx * tmp[i].ny * tmp[i].nz * sizeof(float));
+            rc = lang_volume_value(I, v, ch == 3 ? &x : out) || (ch == 3 && list_push(I, AS_LIST(l), x));
+        }
+    }
+    for (int i = 0; i < ch; i++)
+        volume_free(&tmp[i]);
+    if (ch == 3) {
+        if (rc)
+            val_unref(I, l);
+        else
+            *out = l;
+    }
+    return rc ? -1 : 0;
+}
+
 static int b_load_volume(interp *I, value *a, int n, value *out)
 {
     (void)n;
@@ -411,6 +482,10 @@ static int b_load_volume(interp *I, value *a, int n, value *out)
     if (script_relative_path(I, a[0], path, sizeof path, "load_volume"))
         return -1;
     fileio_ext(path, ext, sizeof ext);
+    if (strcmp(ext, "vdb") == 0)
+        return load_vdb(I, path, a[1], out);
+    if (a[1].k != V_NIL)
+        return err_at(I, NULL, ERR_VALUE, "load_volume: only .vdb files have named grids (drop grid:)");
     volume tmp;
     rt_error e;
     rt_code c = strcmp(ext, "vtk") == 0 ? vio_load_vtk(path, &tmp, &e) : vio_load_nrrd(path, &tmp, &e);
@@ -527,6 +602,7 @@ static int b_slice(interp *I, value *a, int n, value *out)
 }
 
 static const bparam p_path[] = {{"path", "str", NULL}};
+static const bparam p_load_volume[] = {{"path", "str", NULL}, {"grid", "str", "nil"}};
 static const bparam p_mesh[] = {{"mesh", "mesh", NULL}};
 static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str", "\"z\""}, {"index", "int", "nil"},
                                  {"palette", "list", "nil"},  {"lo", "num", "nil"},    {"hi", "num", "nil"}};
@@ -540,7 +616,8 @@ static const builtin volume_builtins[] = {
     BUILTIN("orbit", b_orbit, p_orbit,
             "A camera looking at `target` from `distance`, turned `azimuth` degrees around +y (0: from +z) and raised `elevation` degrees; fov is the vertical field of view. Returns a record {eye, target, up, fov}."),
     BUILTIN("look_at", b_look_at, p_look_at, "A camera at `eye` looking at `target` (a record {eye, target, up, fov})."),
-    BUILTIN("load_volume", b_load_volume, p_path, "Load a volume from .nrrd, .nhdr or .vtk (relative to the script)."),
+    BUILTIN("load_volume", b_load_volume, p_load_volume,
+            "Load a volume from .nrrd, .nhdr, .vtk or .vdb (relative to the script); grid: the .vdb grid (default \"density\")."),
     BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
     BUILTIN("mesh_stats", b_mesh_stats, p_mesh,
             "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight}."),

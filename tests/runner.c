@@ -699,6 +699,32 @@ static void run_fail_alloc(const char *frac, const char *script)
     free(why.d);
 }
 
+/* ---- checks with outside tools --------------------------------------------------------
+ * tests/tools/vdb_check.py opens frac's .vdb files with the OpenVDB library
+ * (Debian python3-openvdb, for /usr/bin/python3). Its exit 77 (the module or
+ * python missing) prints its "skipped: …" line and counts neither way. */
+static void run_vdb_check(const char *frac)
+{
+    const char *label = "tools/vdb_check.py";
+    if (!matches_filter(label))
+        return;
+    if (access("/usr/bin/python3", X_OK) != 0) {
+        printf("%s skipped: /usr/bin/python3 not installed\n", label);
+        return;
+    }
+    char *argv[] = {"/usr/bin/python3", "tests/tools/vdb_check.py", (char *)frac, NULL};
+    buf out = {0}, err = {0}, why = {0};
+    int rc = run(argv, NULL, &out, &err, 120);
+    if (rc == 77) {
+        printf("%s %s", label, out.d);
+    } else {
+        if (rc != 0)
+            buf_fmt(&why, "  exit %d\n  stdout: %.3000s\n  stderr: %.3000s", rc, out.d, err.d);
+        result(label, rc == 0, &why);
+    }
+    free(out.d); free(err.d); free(why.d);
+}
+
 /* ---- golden tests ---------------------------------------------------------------------- */
 
 static int rm_tree(const char *dir)
@@ -1032,6 +1058,7 @@ int main(int argc, char **argv)
         if (realpath(ptyrun, ptyabs))
             run_pty_dir(fracabs, ptyabs);
     }
+    run_vdb_check(fracabs);
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
