@@ -231,10 +231,12 @@ static int volume_get(interp *I, const void *p, const char *name, value *out)
     return 1;
 }
 
-static int save_type(interp *I, value opts, int *type)
+static int save_type(interp *I, value opts, int vdb, int *type)
 {
     double bits = 32;
-    if (opts_check(I, opts, "rec{bits: int{8,16,32}}", "save") || opt_num(I, opts, "bits", &bits) < 0)
+    /* `grids` (extra named grids) exists only in .vdb files */
+    if (opts_check(I, opts, vdb ? "rec{bits: int{8,16,32}, grids: rec}" : "rec{bits: int{8,16,32}}", "save") ||
+        opt_num(I, opts, "bits", &bits) < 0)
         return -1;
     if (bits == 8)
         *type = VIO_UCHAR;
@@ -289,7 +291,7 @@ static int volume_save(interp *I, const void *p, const char *path, value opts)
     char ext[16];
     fileio_ext(path, ext, sizeof ext);
     int type = VIO_FLOAT;
-    if (save_type(I, opts, &type))
+    if (save_type(I, opts, strcmp(ext, "vdb") == 0, &type))
         return -1;
     rt_error e;
     rt_code c;
