@@ -57,12 +57,12 @@ int lang_image_new(interp *I, int w, int h, image **out)
         return err_at(I, NULL, ERR_LIMIT,
                       "image of %d×%d pixels exceeds the limit of %.0f pixels (raise it with --max-pixels)",
                       w, h, I->lim.max_pixels);
-    image *im = malloc(sizeof *im);
+    image *im = mem_alloc(I, sizeof *im);
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     rt_error e;
     if (image_init(im, w, h, &e)) {
-        free(im);
+        mem_free(I, im);
         return err_at(I, NULL, ERR_MEMORY, "%s", e.msg);
     }
     *out = im;
@@ -79,7 +79,7 @@ void lang_image_discard(image *im)
 {
     if (im) {
         image_free(im);
-        free(im);
+        rt_free(im);
     }
 }
 
@@ -273,14 +273,14 @@ static int b_pixel(interp *I, value *a, int n, value *out)
 static int b_load(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    image *im = malloc(sizeof *im);
+    image *im = mem_alloc(I, sizeof *im);
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     char path[4096];
     script_relative_path(I, AS_STR(a[0])->s, path, sizeof path);
     rt_error e;
     if (image_load(im, path, &e)) {
-        free(im);
+        mem_free(I, im);
         return err_at(I, NULL, e.code == RT_EIO ? ERR_IO : ERR_VALUE, "load: %s", e.msg);
     }
     if ((double)im->w * im->h > I->lim.max_pixels) {

@@ -85,7 +85,8 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
     rt_error e;
     if (strcmp(path, "-") == 0) {
         size_t cap = 1 << 16, n = 0;
-        unsigned char *buf = malloc(cap + 1);
+        /* rt_malloc, like fileio_read_all below: the same hook as mem_alloc */
+        unsigned char *buf = rt_malloc(cap + 1);
         if (!buf)
             return EX_SOFTWARE;
         size_t r;
@@ -93,13 +94,13 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
             n += r;
             if (n == cap) {
                 if (cap >= (64u << 20)) {
-                    free(buf);
+                    rt_free(buf);
                     fprintf(stderr, "frac: error: the script on standard input is larger than 64 MiB\n");
                     return EX_IO;
                 }
-                unsigned char *nb = realloc(buf, cap * 2 + 1);
+                unsigned char *nb = rt_realloc(buf, cap * 2 + 1);
                 if (!nb) {
-                    free(buf);
+                    rt_free(buf);
                     return EX_SOFTWARE;
                 }
                 buf = nb;
@@ -117,7 +118,7 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
     }
     if (memchr(*text, 0, *len)) {
         fprintf(stderr, "frac: error: '%s' is not a text file (it contains NUL bytes)\n", path);
-        free(*text);
+        rt_free(*text);
         return EX_SCRIPT;
     }
     return 0;
@@ -168,7 +169,7 @@ int main(int argc, char **argv)
         o.mode = argv[i];
         i++;
     }
-    param_override *ov = calloc((size_t)argc, sizeof *ov);
+    param_override *ov = mem_calloc(I, (size_t)argc, sizeof *ov);
     if (!ov)
         return EX_SOFTWARE;
     int nov = 0, rc;
@@ -178,15 +179,15 @@ int main(int argc, char **argv)
         double d;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage_text, stdout);
-            free(ov);
+            mem_free(I, ov);
             return EX_OK;
         } else if (strcmp(a, "--version") == 0) {
             printf("frac %s\n", FRAC_VERSION);
-            free(ov);
+            mem_free(I, ov);
             return EX_OK;
         } else if (strcmp(a, "-e") == 0) {
             if (!val) {
-                free(ov);
+                mem_free(I, ov);
                 return usage_error("%s needs an expression", a);
             }
             o.mode = "eval";
@@ -194,7 +195,7 @@ int main(int argc, char **argv)
             i++;
         } else if (strcmp(a, "-o") == 0 || strcmp(a, "--out-dir") == 0) {
             if (!val) {
-                free(ov);
+                mem_free(I, ov);
                 return usage_error("%s needs a directory", a);
             }
             I->out_dir = val;
@@ -205,7 +206,7 @@ int main(int argc, char **argv)
                 i++;
             const char *eq = def ? strchr(def, '=') : NULL;
             if (!eq || eq == def) {
-                free(ov);
+                mem_free(I, ov);
                 return usage_error("-D needs NAME=VALUE, got '%s'", def ? def : "");
             }
             ov[nov].name = (const char *)def; /* interned below */
@@ -244,7 +245,7 @@ int main(int argc, char **argv)
         } else if (strcmp(a, "--params") == 0) {
             o.list_params = 1;
         } else if (a[0] == '-' && a[1] != 0) {
-            free(ov);
+            mem_free(I, ov);
             if (strncmp(a, "--", 2) == 0 && !val)
                 return usage_error("option %s is unknown or needs a value", a);
             return usage_error("unknown option or bad value: %s (see --help)", a);
@@ -260,18 +261,18 @@ int main(int argc, char **argv)
     if (!o.mode)
         o.mode = o.expr ? "eval" : o.script ? "run" : "repl";
     if ((strcmp(o.mode, "run") == 0 || strcmp(o.mode, "check") == 0) && !o.script) {
-        free(ov);
+        mem_free(I, ov);
         return usage_error("%s needs a script file (or - for standard input)", o.mode);
     }
     if (o.list_params && strcmp(o.mode, "check") != 0) {
-        free(ov);
+        mem_free(I, ov);
         return usage_error("%s", "--params goes with `frac check`");
     }
 
     if (session_setup(I)) {
         rc = session_report(I);
         interp_free(I);
-        free(ov);
+        mem_free(I, ov);
         return rc ? rc : EX_SOFTWARE;
     }
     I->noverrides = nov;
@@ -282,7 +283,7 @@ int main(int argc, char **argv)
         I->overrides[k].text = ov[k].text;
         I->overrides[k].used = 0;
     }
-    free(ov);
+    mem_free(I, ov);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_sigint;
@@ -320,7 +321,7 @@ int main(int argc, char **argv)
         return rc;
     }
     if (set_script_args(I, &o)) {
-        free(text);
+        mem_free(I, text);
         rc = session_report(I);
         interp_free(I);
         return rc;
@@ -334,7 +335,7 @@ int main(int argc, char **argv)
         if (check && o.list_params)
             print_params(I);
     }
-    free(text);
+    mem_free(I, text);
     fflush(stdout);
     if (ferror(stdout) && rc == EX_OK)
         rc = EX_IO;

@@ -44,7 +44,7 @@ static char *read_line(repl *r, const char *prompt, int *cancelled)
             if (!r->tty)
                 continue;
             *cancelled = 1;
-            line = malloc(1);
+            line = rt_malloc(1); /* like lineedit's lines: freed with rt_free */
             if (line)
                 line[0] = 0;
             return line;
@@ -192,7 +192,7 @@ static int run_command(repl *r, char *line)
         } else {
             if (session_run(I, arg, (char *)text, len, 0, NULL))
                 report(r);
-            free(text);
+            mem_free(I, text);
         }
     } else if (strcmp(cmd, "time") == 0) {
         eval_entry(r, arg, r->line_no - 1, 1);
@@ -232,14 +232,14 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         if (!line)
             break;
         if (cancelled || line[0] == 0) {
-            free(line);
+            mem_free(I, line);
             continue;
         }
         int first = r.line_no++;
         if (line[0] == ':') {
             lineedit_history_add(r.le, line);
             int quit = run_command(&r, line);
-            free(line);
+            mem_free(I, line);
             if (quit)
                 break;
             continue;
@@ -260,22 +260,22 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             char *more = read_line(&r, "..    ", &cancelled);
             if (!more || cancelled) {
                 /* Ctrl-C or end of input abandons the unfinished entry */
-                free(more);
+                mem_free(I, more);
                 dropped = 1;
                 break;
             }
             r.line_no++;
             size_t ml = strlen(more);
-            char *nt = realloc(text, len + ml + 2);
+            char *nt = mem_realloc(I, text, len + ml + 2);
             if (!nt) {
-                free(more);
+                mem_free(I, more);
                 break;
             }
             text = nt;
             text[len] = '\n';
             memcpy(text + len + 1, more, ml + 1);
             len += ml + 1;
-            free(more);
+            mem_free(I, more);
         }
         lineedit_history_add(r.le, text);
         if (dropped) {
@@ -285,7 +285,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         } else {
             eval_entry(&r, text, first, 0);
         }
-        free(text);
+        mem_free(I, text);
     }
     lineedit_free(r.le);
     return r.failed && !r.tty ? 65 : 0;

@@ -1,5 +1,6 @@
 /* mesh_io.c — PLY, OBJ and binary STL writers and readers (see mesh_io.h). */
 #include "mesh_io.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -458,7 +459,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     k++;
                 }
                 if (k < 3) {
-                    free(vn);
+                    rt_free(vn);
                     if (pass == 1)
                         mesh_free(m);
                     return rt_fail(e, RT_EFORMAT, "OBJ line %d: vertex needs 3 coordinates", lineno);
@@ -480,16 +481,16 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                 for (int k = 0; k < 3; k++) {
                     c[k] = strtod(p, &q);
                     if (q == p) {
-                        free(vn);
+                        rt_free(vn);
                         return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal needs 3 components", lineno);
                     }
                     p = q;
                 }
                 if (nvn == cap_vn) {
                     cap_vn = cap_vn ? 2 * cap_vn : 64;
-                    float *nb = realloc(vn, cap_vn * 3 * sizeof(float));
+                    float *nb = rt_realloc(vn, cap_vn * 3 * sizeof(float));
                     if (!nb) {
-                        free(vn);
+                        rt_free(vn);
                         return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
                     }
                     vn = nb;
@@ -509,7 +510,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     char *q;
                     long vi = obj_index(p, &q, nv), ni = 0;
                     if (!vi || k == 256) {
-                        free(vn);
+                        rt_free(vn);
                         mesh_free(m);
                         return rt_fail(e, RT_EFORMAT, "OBJ line %d: face index out of 1..%zu", lineno, nv);
                     }
@@ -522,7 +523,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                             p++;
                             ni = obj_index(p, &q, nvn);
                             if (!ni) {
-                                free(vn);
+                                rt_free(vn);
                                 mesh_free(m);
                                 return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal index out of 1..%zu", lineno, nvn);
                             }
@@ -534,7 +535,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     idx[k++] = (double)(vi - 1);
                 }
                 if (k < 3) {
-                    free(vn);
+                    rt_free(vn);
                     mesh_free(m);
                     return rt_fail(e, RT_EFORMAT, "OBJ line %d: face has fewer than 3 vertices", lineno);
                 }
@@ -542,7 +543,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
             }
         }
     }
-    free(vn);
+    rt_free(vn);
     return reader_oom(m, e);
 }
 
@@ -565,7 +566,7 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     size_t cap = 16;
     while (cap < (size_t)nt * 6 + 16)
         cap *= 2;
-    weld_slot *tab = malloc(cap * sizeof *tab);
+    weld_slot *tab = rt_malloc(cap * sizeof *tab);
     if (!tab)
         return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
     for (size_t i = 0; i < cap; i++)
@@ -594,7 +595,7 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
         }
         mesh_add_tri(m, v[0], v[1], v[2]);
     }
-    free(tab);
+    rt_free(tab);
     return reader_oom(m, e);
 }
 
@@ -614,6 +615,6 @@ rt_code mio_load(const char *path, mesh *m, rt_error *e)
     mesh_free(m);
     rc = kind == 0 ? mio_ply_from_mem(d, n, m, e) : kind == 1 ? mio_obj_from_mem(d, n, m, e)
                                                            : mio_stl_from_mem(d, n, m, e);
-    free(d);
+    rt_free(d);
     return rc;
 }

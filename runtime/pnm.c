@@ -1,6 +1,7 @@
 /* pnm.c — P5/P6 (netpbm) and PF/Pf (Portable Float Map) reading and writing.
  * Not from the seed papers; formats as described in pnm.h. */
 #include "pnm.h"
+#include "rt_alloc.h"
 
 #include <limits.h>
 #include <math.h>
@@ -96,7 +97,7 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
     unsigned maxval = bits == 16 ? 65535 : 255;
     bytebuf_printf(out, "P%c\n%d %d\n%u\n", channels == 1 ? '5' : '6', im->w, im->h, maxval);
     size_t rb = (size_t)im->w * (size_t)channels * (size_t)(bits / 8);
-    unsigned char *row = malloc(rb ? rb : 1);
+    unsigned char *row = rt_malloc(rb ? rb : 1);
     if (!row)
         return rt_fail(e, RT_ENOMEM, "out of memory writing a %d×%d image", im->w, im->h);
     for (int y = 0; y < im->h; y++) {
@@ -115,7 +116,7 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
         }
         bytebuf_append(out, row, rb);
     }
-    free(row);
+    rt_free(row);
     if (out->failed)
         return rt_fail(e, RT_ENOMEM, "out of memory writing a %d×%d image", im->w, im->h);
     return RT_OK;

@@ -5,6 +5,7 @@
  * quantisation conventions are in volume_io.h.
  */
 #include "volume_io.h"
+#include "rt_alloc.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -457,7 +458,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         if (!dir)
             return rt_fail(e, RT_EFORMAT, "NRRD detached data file '%s' cannot be located", datafile);
         size_t pl = strlen(dir) + strlen(datafile) + 2;
-        char *path = malloc(pl);
+        char *path = rt_malloc(pl);
         if (!path)
             return rt_fail(e, RT_ENOMEM, "out of memory");
         if (datafile[0] == '/' || !dir[0])
@@ -466,7 +467,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
             snprintf(path, pl, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", datafile);
         rt_code rc = fileio_read_all(path, need + (byte_skip > 0 ? (size_t)byte_skip : 0) + (1u << 20) + need,
                                      &file, &dn, e);
-        free(path);
+        rt_free(path);
         if (rc)
             return rc;
         data = file;
@@ -486,7 +487,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     else
         at += (size_t)byte_skip;
     if (at > dn || dn - at < need) {
-        free(file);
+        rt_free(file);
         return rt_fail(e, RT_EFORMAT, "NRRD data is %zu bytes, expected %zu (%ld×%ld×%ld samples of %zu byte(s))",
                        at > dn ? 0 : dn - at, need, sizes[0], sizes[1], sizes[2], tsize(type));
     }
@@ -505,13 +506,13 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     }
     rt_code rc = volume_init(v, (int)sizes[0], (int)sizes[1], (int)sizes[2], lo, hi, e);
     if (rc) {
-        free(file);
+        rt_free(file);
         return rc;
     }
     size_t ts = tsize(type);
     for (size_t i = 0; i < count; i++)
         v->v[i] = decode(data + at + i * ts, type, endian == 1);
-    free(file);
+    rt_free(file);
     return RT_OK;
 }
 
@@ -524,16 +525,16 @@ rt_code vio_load_nrrd(const char *path, volume *v, rt_error *e)
     if (rc)
         return rc;
     size_t dl = dir_len(path);
-    char *dir = malloc(dl + 1);
+    char *dir = rt_malloc(dl + 1);
     if (!dir) {
-        free(d);
+        rt_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory");
     }
     memcpy(dir, path, dl);
     dir[dl] = 0;
     rc = vio_nrrd_from_mem(d, n, dir, v, e);
-    free(dir);
-    free(d);
+    rt_free(dir);
+    rt_free(d);
     return rc;
 }
 
@@ -632,7 +633,7 @@ rt_code vio_load_vtk(const char *path, volume *v, rt_error *e)
     if (rc)
         return rc;
     rc = vio_vtk_from_mem(d, n, v, e);
-    free(d);
+    rt_free(d);
     return rc;
 }
 

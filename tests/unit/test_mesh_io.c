@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "mesh_io.h"
 
 #define DATA "tests/data/formats/"
@@ -42,7 +43,7 @@ static int same_as_file(const bytebuf *b, const char *path)
     int ok = n == b->len && memcmp(d, b->data, n) == 0;
     if (!ok)
         fprintf(stderr, "%s: %zu bytes, writer gave %zu\n", path, n, b->len);
-    free(d);
+    rt_free(d);
     return ok;
 }
 

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "mesh.h"
 #include "rng.h"
 #include "wrinkly.h"
@@ -108,7 +109,7 @@ static void test_curve(void)
 /* Torus-like control mesh: major radius 3, minor 1. */
 static wrinkly_point *torus(int nu, int nv, uint64_t seed)
 {
-    wrinkly_point *p = calloc((size_t)nu * nv, sizeof *p);
+    wrinkly_point *p = rt_calloc((size_t)nu * nv, sizeof *p);
     rng r;
     rng_init(&r, seed, 0);
     for (int j = 0; j < nv; j++)
@@ -223,7 +224,7 @@ static void test_surface(void)
     CHECK(wrinkly_surface_mesh(&bad, &o, NULL, &m, NULL, &e) == RT_EINVAL, "nu = 0 refused");
     CHECK(strcmp(e.msg, "wrinkly surface (u axis) needs at least 1 control point, got 0") == 0, "msg: %s", e.msg);
     mesh_free(&m);
-    free(p);
+    rt_free(p);
 }
 
 int main(void)
