@@ -274,7 +274,7 @@ static int volume_save(interp *I, const void *p, const char *path, value opts)
                       "save: cannot save a volume as '.%s' (use .nrrd, .nhdr/.raw or .vtk)", ext);
     }
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, c, &e, "save");
     return 0;
 }
 
@@ -372,7 +372,7 @@ static int mesh_save_hook(interp *I, const void *p, const char *path, value opts
     else
         return err_at(I, NULL, ERR_VALUE, "save: cannot save a mesh as '.%s' (use .ply, .obj or .stl)", ext);
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, c, &e, "save");
     return 0;
 }
 
@@ -411,7 +411,7 @@ static int b_load_volume(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code c = strcmp(ext, "vtk") == 0 ? vio_load_vtk(path, &tmp, &e) : vio_load_nrrd(path, &tmp, &e);
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_volume: %s", e.msg);
+        return lang_rt_error(I, c, &e, "load_volume");
     volume *v;
     if (lang_volume_new(I, tmp.nx, tmp.ny, tmp.nz, tmp.lo, tmp.hi, &v)) {
         volume_free(&tmp);
@@ -434,7 +434,7 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
     rt_code c = mio_load(path, m, &e);
     if (c) {
         mem_free(I, m);
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_mesh: %s", e.msg);
+        return lang_rt_error(I, c, &e, "load_mesh");
     }
     return lang_mesh_value(I, m, out);
 }

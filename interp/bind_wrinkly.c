@@ -920,7 +920,7 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
         rc = b.failed ? rt_fail(&e, RT_ENOMEM, "out of memory writing SVG") : fileio_write_atomic(path, b.data, b.len, &e);
     bytebuf_free(&b);
     if (rc)
-        return err_at(I, NULL, rc == RT_EIO ? ERR_IO : rc == RT_ENOMEM ? ERR_MEMORY : ERR_VALUE, "save: %s", e.msg);
+        return lang_rt_error(I, rc, &e, "save");
     return 0;
 }
 

@@ -52,8 +52,9 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
 /* Turn a runtime failure into a script error: RT_EIO -> ERR_IO, RT_ENOMEM ->
- * ERR_MEMORY, RT_ECANCEL -> ERR_INTERRUPT, others -> ERR_VALUE. The message
- * is "WHAT: e->msg". Returns -1. */
+ * why the allocation hook refused (mem_engine_error: ERR_LIMIT for the
+ * memory limit, ERR_MEMORY otherwise), RT_ELIMIT -> ERR_LIMIT, RT_ECANCEL ->
+ * ERR_INTERRUPT, others -> ERR_VALUE. The message is "WHAT: e->msg". Returns -1. */
 int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what);
 
 #endif

@@ -357,6 +357,16 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                 have_c |= strcmp(el[i].prop[k].name, "red") == 0;
             }
         }
+    /* the declared vertices and faces (one triangle each at least), before
+     * any is read */
+    double nfaces = 0;
+    for (int i = 0; i < nel; i++)
+        if (strcmp(el[i].name, "face") == 0)
+            nfaces = (double)el[i].count;
+    rt_code lc = rt_check_bytes((double)nverts * (12 + (have_n ? 12 : 0) + (have_c ? 16 : 0)) + nfaces * 12,
+                                "reading the PLY vertices and faces", e);
+    if (lc)
+        return lc;
     mesh_free(m);
     mesh_init(m, have_n, have_c);
     ply_in in = {d, n, pos, fmt, 0};
@@ -566,6 +576,11 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     size_t cap = 16;
     while (cap < (size_t)nt * 6 + 16)
         cap *= 2;
+    /* the weld table and up to 3 vertices and one triangle per facet */
+    rt_code lc = rt_check_bytes((double)cap * sizeof(weld_slot) + (double)nt * (3 * 12 + 12),
+                                "reading the STL triangles", e);
+    if (lc)
+        return lc;
     weld_slot *tab = rt_malloc(cap * sizeof *tab);
     if (!tab)
         return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");

@@ -535,7 +535,8 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
                 c = rt_fail(e, RT_EFORMAT, "first PNG chunk is '%s', expected IHDR", type);
                 goto fail;
             }
-            if ((c = parse_ihdr(p, len, &D->info, e)))
+            if ((c = parse_ihdr(p, len, &D->info, e)) ||
+                (c = rt_check_pixels(D->info.w, D->info.h, e))) /* before any buffer of that size */
                 goto fail;
         } else if (!strcmp(type, "IHDR")) {
             c = rt_fail(e, RT_EFORMAT, "PNG has a second IHDR chunk");
@@ -621,6 +622,10 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
             total += k;
         }
     }
+    /* the inflated rows and the float image, before either is allocated */
+    if ((c = rt_check_bytes((double)total + (double)D->info.w * D->info.h * 4 * sizeof(float),
+                            "decoding the PNG image", e)))
+        goto fail;
     c = inflate_zlib(idat.data, idat.len, total, &raw, e);
     if (c) {
         if (c == RT_EFORMAT) {

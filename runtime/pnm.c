@@ -138,7 +138,7 @@ rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     size_t bps = maxval < 256 ? 1 : 2, need;
     if ((c = check_size(h.what, (int)w, (int)ht, ch, bps, n - h.pos, &need, e)))
         return c;
-    if ((c = image_init(im, (int)w, (int)ht, e)))
+    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
         return c;
     const unsigned char *s = d + h.pos;
     size_t np = (size_t)w * (size_t)ht;
@@ -223,7 +223,7 @@ rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     size_t need;
     if ((c = check_size("PFM", (int)w, (int)ht, ch, 4, n - h.pos, &need, e)))
         return c;
-    if ((c = image_init(im, (int)w, (int)ht, e)))
+    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
         return c;
     int le = scale < 0;
     const unsigned char *s = d + h.pos;

@@ -450,6 +450,9 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     size_t need = rt_mul_size(count, tsize(type));
     if (!need)
         return rt_fail(e, RT_EFORMAT, "NRRD sizes are too large");
+    rt_code lc = rt_check_voxels((double)sizes[0], (double)sizes[1], (double)sizes[2], e);
+    if (lc) /* before reading a detached data file or allocating the volume */
+        return lc;
 
     const unsigned char *data = d;
     size_t dn = n;
@@ -609,6 +612,9 @@ rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *
     size_t count = rt_mul_size(rt_mul_size((size_t)dims[0], (size_t)dims[1]), (size_t)dims[2]);
     if (!count || !rt_mul_size(count, 4))
         return rt_fail(e, RT_EFORMAT, "VTK dimensions are too large");
+    rt_code lc = rt_check_voxels((double)dims[0], (double)dims[1], (double)dims[2], e);
+    if (lc)
+        return lc;
     if (n - pos < count * 4)
         return rt_fail(e, RT_EFORMAT, "VTK data is %zu bytes, expected %zu", n - pos, count * 4);
     double lo[3], hi[3];
