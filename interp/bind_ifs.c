@@ -918,7 +918,10 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
         c = ifs_build(&li->f, en->maps, en->n, en->p, IFS_NORMALISE | IFS_ALLOW_EXPANDING, &e);
         if (c) {
             mem_free(I, li);
-            err_at(I, NULL, ERR_VALUE, "load_ifs: %s:%d: entry '%s': %s", path, en->line, en->name, e.msg);
+            if (c == RT_ENOMEM) /* the alias table: an allocation the hook refused */
+                lang_rt_error(I, c, &e, "load_ifs");
+            else
+                err_at(I, NULL, ERR_VALUE, "load_ifs: %s:%d: entry '%s': %s", path, en->line, en->name, e.msg);
             fractint_free(&fl);
             val_unref(I, r);
             return -1;

@@ -112,9 +112,10 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
         *len = n;
         return 0;
     }
-    if (fileio_read_all(path, 64u << 20, text, len, &e)) {
+    rt_code c = fileio_read_all(path, 64u << 20, text, len, &e);
+    if (c) {
         fprintf(stderr, "frac: error: %s\n", e.msg);
-        return EX_IO;
+        return c == RT_ENOMEM ? EX_SOFTWARE : EX_IO; /* the buffer goes through the allocation hook */
     }
     if (memchr(*text, 0, *len)) {
         fprintf(stderr, "frac: error: '%s' is not a text file (it contains NUL bytes)\n", path);
@@ -238,6 +239,7 @@ int main(int argc, char **argv)
             i++;
         } else if (strcmp(a, "--fail-alloc") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
             I->fail_alloc_at = (long)d;
+            I->alloc_count = 0; /* count from here: the option's own parsing allocated */
             i++;
         } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
             I->quiet = 1;
