@@ -9,8 +9,12 @@
  * rt_realloc, rt_free, with overflow-checked sizes), never with malloc. The
  * interpreter installs one process-wide hook there at start, so every engine
  * and codec buffer is counted against --max-memory and can be failed by the
- * fail-the-N-th-allocation test; rt_alloc.h says why the hook is process-wide
- * and how it stays thread-safe. Without a hook (C tests) it is plain malloc.
+ * fail-the-N-th-allocation test. The hook is process-wide, not a parameter,
+ * because most runtime calls (codecs, images, meshes) take no context object
+ * and a process runs one interpreter at a time; it is set before any worker
+ * thread starts, and the interpreter's hook counts with C11 atomics because
+ * engines allocate on their worker threads (details in rt_alloc.h). Without
+ * a hook (C tests) it is plain malloc.
  * The interpreter checks user-controlled sizes before calling an engine for
  * a clear message; an engine handles a NULL from rt_malloc (RT_ENOMEM).
  * Decoders check the sizes a file declares with rt_check_pixels/_voxels/
