@@ -56,6 +56,7 @@ err_kind lang_rt_kind(rt_code c)
     case RT_ENOMEM: return ERR_MEMORY;
     case RT_EIO: return ERR_IO;
     case RT_ECANCEL: return ERR_INTERRUPT;
+    case RT_ELIMIT: return ERR_LIMIT;
     case RT_OK: /* not a failure; callers never pass it */
     case RT_EFORMAT:
     case RT_EINVAL: break;

@@ -33,7 +33,7 @@ static void fv_destroy(void *p)
     field_val *fv = p;
     field_prog_free(fv->prog);
     field_unref(fv->f);
-    free(fv);
+    rt_free(fv);
 }
 
 static void fv_summary(const void *p, bytebuf *out)
@@ -64,7 +64,7 @@ int lang_field_value(interp *I, field *f, value *out)
 {
     if (!f)
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
-    field_val *fv = calloc(1, sizeof *fv);
+    field_val *fv = mem_calloc(I, 1, sizeof *fv);
     if (!fv) {
         field_unref(f);
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
@@ -93,7 +93,7 @@ static void vol_release(void *ctx)
 {
     vol_ref *r = ctx;
     heap_unref(r->I, r->h);
-    free(r);
+    rt_free(r);
 }
 
 /* A new reference to the field node for a field, number or volume value;
@@ -109,7 +109,7 @@ field *lang_to_field(interp *I, value v, const char *what)
         return field_const(v.u.b);
     volume *vol = lang_as_volume(v);
     if (vol) {
-        vol_ref *r = malloc(sizeof *r);
+        vol_ref *r = mem_alloc(I, sizeof *r);
         if (!r) {
             err_at(I, NULL, ERR_MEMORY, "out of memory");
             return NULL;
@@ -149,7 +149,7 @@ static int fv_preview(interp *I, const void *p, image **out)
     image *im;
     if (lang_image_new(I, N, N, &im))
         return -1;
-    double *v = malloc(sizeof(double) * N * N);
+    double *v = mem_alloc(I, sizeof(double) * N * N);
     if (!v) {
         lang_image_discard(im);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -174,7 +174,7 @@ static int fv_preview(interp *I, const void *p, image **out)
         im->px[4 * i] = im->px[4 * i + 1] = im->px[4 * i + 2] = g;
         im->px[4 * i + 3] = 1;
     }
-    free(v);
+    mem_free(I, v);
     *out = im;
     return 0;
 }
@@ -646,7 +646,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         o.colour_ctx[0] = cprog;
         o.colour_ramp = &r;
     }
-    mesh *m = malloc(sizeof *m);
+    mesh *m = mem_alloc(I, sizeof *m);
     if (!m) {
         lang_field_fn_done(ctmp, cown);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -665,7 +665,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         const field_prog *prog;
         if (get_grid(I, a[2], g, "isosurface: grid") || get_bounds(I, a[3], a[4], lo, hi, "isosurface") ||
             lang_field_fn(I, a[0], &tmp, &own, &prog, "isosurface")) {
-            free(m);
+            mem_free(I, m);
             lang_field_fn_done(ctmp, cown);
             return -1;
         }
@@ -675,7 +675,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
     lang_field_fn_done(ctmp, cown);
     if (c) {
         mesh_free(m); /* what the engine built before it failed */
-        free(m);
+        mem_free(I, m);
         return lang_rt_error(I, c, &e, "isosurface");
     }
     return lang_mesh_value(I, m, out);

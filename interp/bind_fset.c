@@ -43,13 +43,13 @@ static void fset_destroy(void *pp)
 {
     lang_fset *f = pp;
     for (int i = 0; i < f->n; i++) {
-        free(f->maps[i]);
-        free(f->p[i]);
+        rt_free(f->maps[i]);
+        rt_free(f->p[i]);
     }
-    free(f->maps);
-    free(f->p);
-    free(f->sets);
-    free(f);
+    rt_free(f->maps);
+    rt_free(f->p);
+    rt_free(f->sets);
+    rt_free(f);
 }
 
 static void fset_summary(const void *pp, bytebuf *out)
@@ -81,19 +81,19 @@ static const obj_class fset_class = {
     .get = fset_get,
 };
 
-static lang_fset *fset_alloc(int n)
+static lang_fset *fset_alloc(interp *I, int n)
 {
-    lang_fset *f = calloc(1, sizeof *f);
+    lang_fset *f = mem_calloc(I, 1, sizeof *f);
     if (!f)
         return NULL;
-    f->maps = calloc((size_t)n, sizeof *f->maps);
-    f->p = calloc((size_t)n, sizeof *f->p);
-    f->sets = calloc((size_t)n, sizeof *f->sets);
+    f->maps = mem_calloc(I, (size_t)n, sizeof *f->maps);
+    f->p = mem_calloc(I, (size_t)n, sizeof *f->p);
+    f->sets = mem_calloc(I, (size_t)n, sizeof *f->sets);
     if (!f->maps || !f->p || !f->sets) {
-        free(f->maps);
-        free(f->p);
-        free(f->sets);
-        free(f);
+        mem_free(I, f->maps);
+        mem_free(I, f->p);
+        mem_free(I, f->sets);
+        mem_free(I, f);
         return NULL;
     }
     f->n = n;
@@ -119,7 +119,7 @@ static int fset_put(interp *I, lang_fset *f, int i, value v, const char *what)
     if (has < 0)
         return -1;
     if (!has) {
-        free(f->p[i]);
+        mem_free(I, f->p[i]);
         f->p[i] = NULL;
     }
     f->sets[i].n = cnt;
@@ -168,7 +168,7 @@ static int get_fset(interp *I, value v, int list_is_sets, value *out, const char
         return err_at(I, NULL, ERR_VALUE, "%s: the function set is empty (give at least one IFS)", what);
     if (n > 4096)
         return err_at(I, NULL, ERR_VALUE, "%s: %d IFSs, at most 4096", what, n);
-    lang_fset *f = fset_alloc(n);
+    lang_fset *f = fset_alloc(I, n);
     if (!f)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     for (int i = 0; i < n; i++) {
@@ -200,9 +200,9 @@ typedef struct lang_order {
 static void order_destroy(void *pp)
 {
     lang_order *o = pp;
-    free(o->seq);
-    free(o->p);
-    free(o);
+    rt_free(o->seq);
+    rt_free(o->p);
+    rt_free(o);
 }
 
 static void order_summary(const void *pp, bytebuf *out)
@@ -284,23 +284,23 @@ static int b_order(interp *I, value *a, int n, value *out)
     if (sq.k == V_NIL && pr.k == V_NIL)
         return err_at(I, NULL, ERR_VALUE,
                       "order: give a sequence (a list of set numbers or \"W2 ∘ W1\") or probabilities: [p1, p2, …]");
-    lang_order *o = calloc(1, sizeof *o);
+    lang_order *o = mem_calloc(I, 1, sizeof *o);
     if (!o)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     if (pr.k != V_NIL) {
         size_t np = AS_LIST(pr)->n;
         if (val_truthy(a[1])) {
-            free(o);
+            mem_free(I, o);
             return err_at(I, NULL, ERR_VALUE, "order: repeat applies to a sequence, not to a random order");
         }
         if (np < 1 || np > 4096) {
-            free(o);
+            mem_free(I, o);
             return err_at(I, NULL, ERR_VALUE, "order: probabilities must be 1 to 4096 numbers (one per set), got %zu",
                           np);
         }
-        o->p = malloc(sizeof(double) * np);
+        o->p = mem_alloc(I, sizeof(double) * np);
         if (!o->p) {
-            free(o);
+            mem_free(I, o);
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         }
         if (get_vec(I, pr, o->p, np, "order: probabilities") || arg_seed(I, a[3], &o->o.seed, "order")) {
@@ -326,7 +326,7 @@ static int b_order(interp *I, value *a, int n, value *out)
         o->o.p = o->p;
     } else {
         if (a[3].k != V_NIL) {
-            free(o);
+            mem_free(I, o);
             return err_at(I, NULL, ERR_VALUE, "order: seed applies to a random order (probabilities:), not to a sequence");
         }
         if (sq.k == V_STR) {
@@ -334,7 +334,7 @@ static int b_order(interp *I, value *a, int n, value *out)
             rt_error e;
             rt_code c = fset_order_parse(AS_STR(sq)->s, 0, &o->seq, &o->o.len, &off, &e);
             if (c) {
-                free(o);
+                mem_free(I, o);
                 if (c == RT_EINVAL && strncmp(e.msg, "order: ", 7) == 0)
                     return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
                 return lang_rt_error(I, c, &e, "order");
@@ -342,12 +342,12 @@ static int b_order(interp *I, value *a, int n, value *out)
         } else if (sq.k == V_LIST) {
             size_t len = AS_LIST(sq)->n;
             if (len < 1 || len > 100000000) {
-                free(o);
+                mem_free(I, o);
                 return err_at(I, NULL, ERR_VALUE, "order: the sequence is empty (give set numbers like [1, 2, 1, 2])");
             }
-            o->seq = malloc(sizeof(int) * len);
+            o->seq = mem_alloc(I, sizeof(int) * len);
             if (!o->seq) {
-                free(o);
+                mem_free(I, o);
                 return err_at(I, NULL, ERR_MEMORY, "out of memory");
             }
             for (size_t i = 0; i < len; i++) {
@@ -356,15 +356,15 @@ static int b_order(interp *I, value *a, int n, value *out)
                     err_at(I, NULL, ERR_VALUE,
                            "order: item %zu must be a set number from 1 (W1) to 4096, got %s", i + 1,
                            x.k == V_NUM ? "a number out of range" : val_type_name(x));
-                    free(o->seq);
-                    free(o);
+                    mem_free(I, o->seq);
+                    mem_free(I, o);
                     return -1;
                 }
                 o->seq[i] = (int)x.u.n - 1;
             }
             o->o.len = (int)len;
         } else {
-            free(o);
+            mem_free(I, o);
             return err_at(I, NULL, ERR_TYPE, "order: sequence must be a list of set numbers or a string like \"W2 ∘ W1\", got %s",
                           val_type_name(sq));
         }
@@ -384,7 +384,7 @@ static int order_arg(interp *I, value v, int nsets, fset_order *o, int **tmp, co
     if (lo) {
         *o = lo->o;
     } else if (v.k == V_NIL) {
-        *tmp = malloc(sizeof(int) * (size_t)nsets);
+        *tmp = mem_alloc(I, sizeof(int) * (size_t)nsets);
         if (!*tmp)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         for (int i = 0; i < nsets; i++)
@@ -398,14 +398,14 @@ static int order_arg(interp *I, value v, int nsets, fset_order *o, int **tmp, co
                       what, val_type_name(v));
     }
     if (o->kind == FSET_RANDOM && lo->np != nsets) {
-        free(*tmp);
+        mem_free(I, *tmp);
         return err_at(I, NULL, ERR_VALUE, "%s: the random order has %d probabilities but the function set has %d sets",
                       what, lo->np, nsets);
     }
     if (o->kind != FSET_RANDOM)
         for (int i = 0; i < o->len; i++)
             if (o->seq[i] >= nsets) {
-                free(*tmp);
+                mem_free(I, *tmp);
                 return err_at(I, NULL, ERR_VALUE, "%s: the order uses W%d but the function set has %d set%s", what,
                               o->seq[i] + 1, nsets, nsets == 1 ? "" : "s");
             }
@@ -418,7 +418,7 @@ static void shape_destroy(void *pp)
 {
     detiter_shape *s = pp;
     detiter_shape_free(s);
-    free(s);
+    rt_free(s);
 }
 
 static void shape_bounds(const detiter_shape *s, double lo[2], double hi[2])
@@ -506,7 +506,7 @@ static const detiter_shape *as_shape(value v)
 
 static int shape_value(interp *I, detiter_shape *s, value *out)
 {
-    detiter_shape *p = malloc(sizeof *p);
+    detiter_shape *p = mem_alloc(I, sizeof *p);
     if (!p) {
         detiter_shape_free(s);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -521,9 +521,9 @@ static int shape_alloc(interp *I, detiter_shape *s, int dim, size_t nv, size_t n
 {
     memset(s, 0, sizeof *s);
     s->dim = dim;
-    s->v = malloc(sizeof(double) * (nv ? nv : 1) * (size_t)dim);
-    s->start = malloc(sizeof(size_t) * (np + 1));
-    s->closed = malloc(np ? np : 1);
+    s->v = mem_alloc(I, sizeof(double) * (nv ? nv : 1) * (size_t)dim);
+    s->start = mem_alloc(I, sizeof(size_t) * (np + 1));
+    s->closed = mem_alloc(I, np ? np : 1);
     if (!s->v || !s->start || !s->closed) {
         detiter_shape_free(s);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -631,25 +631,25 @@ static int make_shape(interp *I, value *a, int n, detiter_kind kind, const char 
     if (dim != 2 && dim != 3)
         return err_at(I, NULL, ERR_VALUE, "%s: point 1 must be [x, y] or [x, y, z], got %s", what,
                       pts[0].k == V_LIST ? "a list of another length" : val_type_name(pts[0]));
-    double *v = malloc(sizeof(double) * (size_t)np * (size_t)dim);
+    double *v = mem_alloc(I, sizeof(double) * (size_t)np * (size_t)dim);
     if (!v)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     for (int i = 0; i < np; i++) {
         if (pts[i].k != V_LIST || (int)AS_LIST(pts[i])->n != dim) {
-            free(v);
+            mem_free(I, v);
             return err_at(I, NULL, ERR_VALUE, "%s: point %d must be a list of %d numbers like point 1", what, i + 1, dim);
         }
         char w[64];
         snprintf(w, sizeof w, "%s: point %d", what, i + 1);
         if (get_vec(I, pts[i], v + (size_t)i * (size_t)dim, (size_t)dim, w)) {
-            free(v);
+            mem_free(I, v);
             return -1;
         }
     }
     detiter_shape s;
     rt_error e;
     rt_code c = detiter_shape_make(&s, dim, (size_t)np, v, kind, &e);
-    free(v);
+    mem_free(I, v);
     if (c)
         return lang_rt_error(I, c, &e, what);
     return shape_value(I, &s, out);
@@ -721,12 +721,11 @@ static int b_iterate(interp *I, value *a, int n, value *out)
         goto done;
     }
     double bytes = (double)need * (k0->dim * 8 + 9) * 2;
-    if (mem_reserve(I, bytes, "iterate: the shape"))
+    if (mem_precheck(I, bytes, "iterate: the shape"))
         goto done;
     rt_run run = lang_run(I);
     detiter_shape res;
     c = detiter_run(&f->fs, &o, (size_t)steps, k0, (size_t)need, &res, &run, &e);
-    mem_release(I, (size_t)bytes);
     if (c) {
         lang_rt_error(I, c, &e, "iterate");
         goto done;
@@ -735,7 +734,7 @@ static int b_iterate(interp *I, value *a, int n, value *out)
 done:
     if (own_k0)
         detiter_shape_free(&k0def);
-    free(tmp);
+    mem_free(I, tmp);
     val_unref(I, fv);
     return rc;
 }
@@ -1126,7 +1125,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
         err_at(I, NULL, ERR_LIMIT, "chaos_fset: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);
         goto done;
     }
-    if (mem_reserve(I, bytes, "chaos_fset: the histograms"))
+    if (mem_precheck(I, bytes, "chaos_fset: the histograms"))
         goto done;
     hist2 hs;
     image *im = NULL;
@@ -1137,7 +1136,6 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
             c = tonemap_apply(&hs, &t, im, &e);
         hist2_free(&hs);
     }
-    mem_release(I, (size_t)bytes);
     if (c || !im) {
         lang_image_discard(im);
         if (!I->err.active)
@@ -1146,7 +1144,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     }
     rc = lang_image_value(I, im, out);
 done:
-    free(tmp);
+    mem_free(I, tmp);
     val_unref(I, fv);
     return rc;
 }
@@ -1209,7 +1207,7 @@ static int b_top(interp *I, value *a, int n, value *out)
     if ((double)w * h > I->lim.max_pixels)
         return err_at(I, NULL, ERR_LIMIT, "top: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);
     double bytes = (double)w * h * sizeof(tops_cell) * (I->threads + 1);
-    if (mem_reserve(I, bytes, "top: the address buffers"))
+    if (mem_precheck(I, bytes, "top: the address buffers"))
         return -1;
     draw_view view;
     tops_buf tb;
@@ -1220,7 +1218,6 @@ static int b_top(interp *I, value *a, int n, value *out)
     rt_code c = draw_view_fit(&view, w, h, lo, hi, 1, &e);
     if (!c)
         c = tops_run(&f, &view, &to, &tb, &run, &e);
-    mem_release(I, (size_t)bytes);
     if (c)
         return lang_rt_error(I, c, &e, "top");
     if (nsym > tb.depth) {
@@ -1290,7 +1287,7 @@ static int b_steal(interp *I, value *a, int n, value *out)
     if (steal_args(I, a, 3, &s, pic->w, pic->h, "steal"))
         return -1;
     double bytes = (double)s.w * s.h * sizeof(tops_cell) * (I->threads + 1);
-    if (mem_reserve(I, bytes, "steal: the address buffers"))
+    if (mem_precheck(I, bytes, "steal: the address buffers"))
         return -1;
     draw_view sv, srcv;
     tops_buf tb;
@@ -1301,7 +1298,6 @@ static int b_steal(interp *I, value *a, int n, value *out)
         c = draw_view_fit(&srcv, pic->w, pic->h, s.slo, s.shi, 0, &e);
     if (!c)
         c = tops_steal(&s.f, &sv, &s.g, &srcv, &s.to, &tb, &run, &e);
-    mem_release(I, (size_t)bytes);
     if (c)
         return lang_rt_error(I, c, &e, "steal");
     image *im;
@@ -1323,40 +1319,40 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
         return err_at(I, NULL, ERR_VALUE, "fractal_filter: frames is empty (give a list of images of one size)");
     if (fl->n > 100000)
         return err_at(I, NULL, ERR_VALUE, "fractal_filter: %zu frames, at most 100000", fl->n);
-    image *frames = malloc(sizeof(image) * fl->n);
+    image *frames = mem_alloc(I, sizeof(image) * fl->n);
     if (!frames)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     for (size_t i = 0; i < fl->n; i++) {
         const image *im = lang_as_image(fl->items[i]);
         if (!im) {
-            free(frames);
+            mem_free(I, frames);
             return err_at(I, NULL, ERR_TYPE, "fractal_filter: frame %zu must be an image, got %s", i + 1,
                           val_type_name(fl->items[i]));
         }
         frames[i] = *im;
         if (im->w != frames[0].w || im->h != frames[0].h) {
             int w0 = frames[0].w, h0 = frames[0].h;
-            free(frames);
+            mem_free(I, frames);
             return err_at(I, NULL, ERR_VALUE, "fractal_filter: frame %zu is %d×%d but frame 1 is %d×%d", i + 1, im->w, im->h,
                           w0, h0);
         }
     }
     steal_setup s;
     if (steal_args(I, a, 3, &s, frames[0].w, frames[0].h, "fractal_filter")) {
-        free(frames);
+        mem_free(I, frames);
         return -1;
     }
     if ((double)s.w * s.h * (double)fl->n > I->lim.max_pixels * 64) {
-        free(frames);
+        mem_free(I, frames);
         return err_at(I, NULL, ERR_LIMIT, "fractal_filter: %zu frames of %d×%d pixels are too many (raise --max-pixels)",
                       fl->n, s.w, s.h);
     }
     double bytes = (double)s.w * s.h * sizeof(tops_cell) * (I->threads + 1);
-    if (mem_reserve(I, bytes, "fractal_filter: the address buffers")) {
-        free(frames);
+    if (mem_precheck(I, bytes, "fractal_filter: the address buffers")) {
+        mem_free(I, frames);
         return -1;
     }
-    image *res = calloc(fl->n, sizeof(image));
+    image *res = mem_calloc(I, fl->n, sizeof(image));
     value l = val_list(I, fl->n);
     draw_view sv;
     rt_error e;
@@ -1364,20 +1360,19 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
     rt_code c = !res ? rt_fail(&e, RT_ENOMEM, "out of memory") : draw_view_fit(&sv, s.w, s.h, s.lo, s.hi, 1, &e);
     if (!c && l.k != V_NIL)
         c = tops_filter(&s.f, &sv, &s.g, s.slo, s.shi, frames, (int)fl->n, &s.to, s.bg, res, &run, &e);
-    mem_release(I, (size_t)bytes);
-    free(frames);
+    mem_free(I, frames);
     if (c || l.k == V_NIL) {
         if (res)
             for (size_t i = 0; i < fl->n; i++)
                 image_free(&res[i]);
-        free(res);
+        mem_free(I, res);
         if (l.k != V_NIL)
             val_unref(I, l);
         return I->err.active ? -1 : lang_rt_error(I, c, &e, "fractal_filter");
     }
     size_t i = 0;
     for (; i < fl->n; i++) {
-        image *im = malloc(sizeof *im);
+        image *im = mem_alloc(I, sizeof *im);
         value v;
         if (!im) {
             err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -1393,11 +1388,11 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
     if (i < fl->n || I->err.active) {
         for (; i < fl->n; i++)
             image_free(&res[i]);
-        free(res);
+        mem_free(I, res);
         val_unref(I, l);
         return -1;
     }
-    free(res);
+    mem_free(I, res);
     *out = l;
     return 0;
 }
@@ -1414,7 +1409,7 @@ static void superifs_destroy(void *pp)
 {
     lang_superifs *s = pp;
     superifs_free(&s->st);
-    free(s);
+    rt_free(s);
 }
 
 static void superifs_summary(const void *pp, bytebuf *out)
@@ -1492,7 +1487,7 @@ static int b_superifs(interp *I, value *a, int n, value *out)
             err_at(I, NULL, ERR_VALUE, "superifs: probabilities must be a list of %d numbers (one per IFS), got %zu", f->n, np);
             goto done;
         }
-        P = malloc(sizeof(double) * np);
+        P = mem_alloc(I, sizeof(double) * np);
         if (!P) {
             err_at(I, NULL, ERR_MEMORY, "out of memory");
             goto done;
@@ -1521,20 +1516,18 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     so.points = (size_t)pts;
     so.steps = (uint64_t)steps;
     double bytes = (double)V * (double)pts * 16 * 2;
-    if (mem_reserve(I, bytes, "superifs: the buffers"))
+    if (mem_precheck(I, bytes, "superifs: the buffers"))
         goto done;
-    lang_superifs *ls = calloc(1, sizeof *ls);
+    lang_superifs *ls = mem_calloc(I, 1, sizeof *ls);
     if (!ls) {
-        mem_release(I, (size_t)bytes);
         err_at(I, NULL, ERR_MEMORY, "out of memory");
         goto done;
     }
     rt_error e;
     rt_run run = lang_run(I);
     rt_code c = superifs_run(&f->fs, P, &so, &ls->st, &run, &e);
-    mem_release(I, (size_t)bytes);
     if (c) {
-        free(ls);
+        mem_free(I, ls);
         lang_rt_error(I, c, &e, "superifs");
         goto done;
     }
@@ -1543,7 +1536,7 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     *out = val_obj(I, &superifs_class, ls);
     rc = out->k == V_NIL ? -1 : 0;
 done:
-    free(P);
+    mem_free(I, P);
     val_unref(I, fv);
     return rc;
 }
@@ -1607,7 +1600,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
 
 static int wrap_image(interp *I, image *res, value *out)
 {
-    image *im = malloc(sizeof *im);
+    image *im = mem_alloc(I, sizeof *im);
     if (!im) {
         image_free(res);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");

@@ -28,7 +28,7 @@
 
 /* ---- maps --------------------------------------------------------------------------- */
 
-static void map_destroy(void *p) { free(p); }
+static void map_destroy(void *p) { rt_free(p); }
 
 static void map_summary(const void *p, bytebuf *out)
 {
@@ -90,7 +90,7 @@ static const affine *as_map(value v)
 
 static int map_value(interp *I, affine a, value *out)
 {
-    affine *p = malloc(sizeof *p);
+    affine *p = mem_alloc(I, sizeof *p);
     if (!p)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     *p = a;
@@ -154,11 +154,11 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
     const lang_ifs *li = lang_as_ifs(v);
     if (li) {
         *n = li->f.n;
-        *maps = malloc(sizeof(affine) * (size_t)*n);
-        *p = malloc(sizeof(double) * (size_t)*n);
+        *maps = mem_alloc(I, sizeof(affine) * (size_t)*n);
+        *p = mem_alloc(I, sizeof(double) * (size_t)*n);
         if (!*maps || !*p) {
-            free(*maps);
-            free(*p);
+            mem_free(I, *maps);
+            mem_free(I, *p);
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         }
         memcpy(*maps, li->f.maps, sizeof(affine) * (size_t)*n);
@@ -173,11 +173,11 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         return err_at(I, NULL, ERR_VALUE, "%s: IFS has no maps", what);
     if (l->n > IFS_MAX_MAPS)
         return err_at(I, NULL, ERR_VALUE, "%s: %zu maps, at most %d", what, l->n, IFS_MAX_MAPS);
-    *maps = malloc(sizeof(affine) * l->n);
-    *p = malloc(sizeof(double) * l->n);
+    *maps = mem_alloc(I, sizeof(affine) * l->n);
+    *p = mem_alloc(I, sizeof(double) * l->n);
     if (!*maps || !*p) {
-        free(*maps);
-        free(*p);
+        mem_free(I, *maps);
+        mem_free(I, *p);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     int all_p = 1;
@@ -188,8 +188,8 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
             (*maps)[i] = *m;
             (*p)[i] = 0;
         } else if (row_to_map(I, v, l->items[i], &(*maps)[i], &(*p)[i], &has, (int)i, what)) {
-            free(*maps);
-            free(*p);
+            mem_free(I, *maps);
+            mem_free(I, *p);
             *maps = NULL;
             *p = NULL;
             return -1;
@@ -198,8 +198,8 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
             all_p = has;
         if (has != all_p) {
             /* the first row that differs from row 1 */
-            free(*maps);
-            free(*p);
+            mem_free(I, *maps);
+            mem_free(I, *p);
             *maps = NULL;
             *p = NULL;
             return err_item(I, v, i, ERR_VALUE,
@@ -208,8 +208,8 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         }
         if ((*maps)[i].dim != (*maps)[0].dim) {
             int di = (*maps)[i].dim, d0 = (*maps)[0].dim;
-            free(*maps);
-            free(*p);
+            mem_free(I, *maps);
+            mem_free(I, *p);
             *maps = NULL;
             *p = NULL;
             return err_item(I, v, i, ERR_VALUE, "%s: row %zu is a %d-D map but row 1 is %d-D", what, i + 1, di,
@@ -226,7 +226,7 @@ static void ifs_destroy(void *p)
 {
     lang_ifs *li = p;
     ifs_free(&li->f);
-    free(li);
+    rt_free(li);
 }
 
 static void ifs_summary(const void *p, bytebuf *out)
@@ -300,7 +300,7 @@ static void rifs_destroy(void *p)
 {
     lang_rifs *lr = p;
     rifs_free(&lr->r);
-    free(lr);
+    rt_free(lr);
 }
 
 static void rifs_summary(const void *p, bytebuf *out)
@@ -314,16 +314,16 @@ static int rifs_get(interp *I, const void *p, const char *name, value *out)
 {
     const rifs *r = &((const lang_rifs *)p)->r;
     if (strcmp(name, "stationary") == 0) {
-        double *pi = malloc(sizeof(double) * (size_t)r->n);
+        double *pi = mem_alloc(I, sizeof(double) * (size_t)r->n);
         if (!pi)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         rt_error e;
         if (rifs_stationary(r, pi, &e)) {
-            free(pi);
+            mem_free(I, pi);
             return lang_rt_error(I, e.code, &e, "stationary");
         }
         int rc = num_list_value(I, pi, (size_t)(r->n), out);
-        free(pi);
+        mem_free(I, pi);
         return rc;
     }
     if (strcmp(name, "contraction") == 0)
@@ -453,29 +453,29 @@ static int b_ifs(interp *I, value *a, int n, value *out)
         return -1;
     if (a[1].k != V_NIL) {
         if (a[1].k != V_LIST || (int)AS_LIST(a[1])->n != count) {
-            free(maps);
-            free(p);
+            mem_free(I, maps);
+            mem_free(I, p);
             return err_at(I, NULL, ERR_VALUE, "ifs: probabilities must be a list of %d numbers (one per map)", count);
         }
         if (get_vec(I, a[1], p, (size_t)count, "ifs: probabilities")) {
-            free(maps);
-            free(p);
+            mem_free(I, maps);
+            mem_free(I, p);
             return -1;
         }
         has_p = 1;
     }
-    lang_ifs *li = calloc(1, sizeof *li);
+    lang_ifs *li = mem_calloc(I, 1, sizeof *li);
     if (!li) {
-        free(maps);
-        free(p);
+        mem_free(I, maps);
+        mem_free(I, p);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_error e;
     rt_code c = ifs_build(&li->f, maps, count, has_p ? p : NULL, flags_of(a[2], a[3]), &e);
-    free(maps);
-    free(p);
+    mem_free(I, maps);
+    mem_free(I, p);
     if (c) {
-        free(li);
+        mem_free(I, li);
         return lang_rt_error(I, c, &e, "ifs");
     }
     if (li->f.warning[0] && !I->quiet)
@@ -492,22 +492,22 @@ static int b_rifs(interp *I, value *a, int n, value *out)
     int count;
     if (lang_get_maps(I, a[0], &maps, &p, &count, "rifs") < 0)
         return -1;
-    free(p);
+    mem_free(I, p);
     long order;
     if (get_int(I, a[2], 1, 2, &order, "rifs: order")) {
-        free(maps);
+        mem_free(I, maps);
         return -1;
     }
     int rows = order == 1 ? count : count * count;
     value M = a[1];
     if (M.k != V_LIST || (int)AS_LIST(M)->n != rows) {
-        free(maps);
+        mem_free(I, maps);
         return err_at(I, NULL, ERR_VALUE, "rifs: the matrix must have %d rows of %d numbers (%s), got %zu rows", rows,
                       count, order == 1 ? "one per map" : "one per pair of maps", M.k == V_LIST ? AS_LIST(M)->n : 0);
     }
-    double *P = malloc(sizeof(double) * (size_t)rows * (size_t)count);
+    double *P = mem_alloc(I, sizeof(double) * (size_t)rows * (size_t)count);
     if (!P) {
-        free(maps);
+        mem_free(I, maps);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     for (int i = 0; i < rows; i++) {
@@ -515,28 +515,28 @@ static int b_rifs(interp *I, value *a, int n, value *out)
         char what[64];
         snprintf(what, sizeof what, "rifs: matrix row %d", i + 1);
         if (row.k != V_LIST || (int)AS_LIST(row)->n != count) {
-            free(maps);
-            free(P);
+            mem_free(I, maps);
+            mem_free(I, P);
             return err_item(I, M, (size_t)i, ERR_VALUE, "%s must have %d numbers (one per map)", what, count);
         }
         if (get_vec(I, row, P + (size_t)i * count, (size_t)count, what)) {
-            free(maps);
-            free(P);
+            mem_free(I, maps);
+            mem_free(I, P);
             return -1;
         }
     }
-    lang_rifs *lr = calloc(1, sizeof *lr);
+    lang_rifs *lr = mem_calloc(I, 1, sizeof *lr);
     if (!lr) {
-        free(maps);
-        free(P);
+        mem_free(I, maps);
+        mem_free(I, P);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_error e;
     rt_code c = rifs_build(&lr->r, maps, count, (int)order, P, flags_of(a[3], a[4]), &e);
-    free(maps);
-    free(P);
+    mem_free(I, maps);
+    mem_free(I, P);
     if (c) {
-        free(lr);
+        mem_free(I, lr);
         return lang_rt_error(I, c, &e, "rifs");
     }
     if (lr->r.warning[0] && !I->quiet)
@@ -632,12 +632,11 @@ static int b_chaos(interp *I, value *a, int n, value *out)
         return err_at(I, NULL, ERR_LIMIT, "chaos: %d×%d pixels with supersample %ld exceed the pixel limit (raise it with --max-pixels)",
                       w, h, ss);
     double bytes = (double)w * h * ss * ss * (8 + (o.colour ? 12 : 0)) * (I->threads + 1);
-    if (mem_reserve(I, bytes, "chaos: the histograms"))
+    if (mem_precheck(I, bytes, "chaos: the histograms"))
         return -1;
     hist2 hs;
     c = hist2_init(&hs, w * (int)ss, h * (int)ss, lo, hi, o.colour != CHAOS_COLOUR_NONE, &e);
     if (c) {
-        mem_release(I, (size_t)bytes);
         return lang_rt_error(I, c, &e, "chaos");
     }
     rt_run run = lang_run(I);
@@ -647,7 +646,6 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     if (!c && !lang_image_new(I, w, h, &im))
         c = tonemap_apply(&hs, &t, im, &e);
     hist2_free(&hs);
-    mem_release(I, (size_t)bytes);
     if (c || !im) {
         lang_image_discard(im);
         return I->err.active ? -1 : lang_rt_error(I, c, &e, "chaos");
@@ -725,7 +723,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
         return -1;
     hist2 hs;
     double bytes = (double)w * h * 8 * (I->threads + 1);
-    if (mem_reserve(I, bytes, "measure: the histograms")) {
+    if (mem_precheck(I, bytes, "measure: the histograms")) {
         lang_image_discard(im);
         return -1;
     }
@@ -736,7 +734,6 @@ static int b_measure(interp *I, value *a, int n, value *out)
             c = chaos_measure2(&hs, nm, st.plotted, im, &e);
         hist2_free(&hs);
     }
-    mem_release(I, (size_t)bytes);
     return lang_image_finish(I, im, c, &e, "measure", out);
 }
 
@@ -752,21 +749,19 @@ static int b_points(interp *I, value *a, int n, value *out)
         arg_seed(I, a[4], &o.seed, NULL))
         return -1;
     o.ramp = &r;
-    if (mem_reserve(I, (double)o.points * 28, "points: the point cloud"))
+    if (mem_precheck(I, (double)o.points * 28, "points: the point cloud"))
         return -1;
-    mesh *m = malloc(sizeof *m);
+    mesh *m = mem_alloc(I, sizeof *m);
     if (!m) {
-        mem_release(I, (size_t)(o.points * 28));
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     mesh_init(m, 0, o.colour != CHAOS_COLOUR_NONE);
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c = chaos_points(&s, &o, m, &run, &e);
-    mem_release(I, (size_t)(o.points * 28));
     if (c) {
         mesh_free(m);
-        free(m);
+        mem_free(I, m);
         return lang_rt_error(I, c, &e, "points");
     }
     return lang_mesh_value(I, m, out);
@@ -793,7 +788,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     if (lang_image_new(I, w, h, &im))
         return -1;
     double bytes = (double)w * h * 16 * (I->threads + 1);
-    if (mem_reserve(I, bytes, "view: the depth buffers")) {
+    if (mem_precheck(I, bytes, "view: the depth buffers")) {
         lang_image_discard(im);
         return -1;
     }
@@ -801,7 +796,6 @@ static int b_view(interp *I, value *a, int n, value *out)
     chaos_stats st;
     rt_error e;
     rt_code c = chaos_project(&s, &o, &cam, im, &st, &run, &e);
-    mem_release(I, (size_t)bytes);
     return lang_image_finish(I, im, c, &e, "view", out);
 }
 
@@ -922,7 +916,7 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
     }
     for (int i = 0; i < fl.n; i++) {
         const fractint_entry *en = &fl.e[i];
-        lang_ifs *li = calloc(1, sizeof *li);
+        lang_ifs *li = mem_calloc(I, 1, sizeof *li);
         if (!li) {
             fractint_free(&fl);
             val_unref(I, r);
@@ -930,8 +924,11 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
         }
         c = ifs_build(&li->f, en->maps, en->n, en->p, IFS_NORMALISE | IFS_ALLOW_EXPANDING, &e);
         if (c) {
-            free(li);
-            err_at(I, NULL, ERR_VALUE, "load_ifs: %s:%d: entry '%s': %s", path, en->line, en->name, e.msg);
+            mem_free(I, li);
+            if (c == RT_ENOMEM) /* the alias table: an allocation the hook refused */
+                lang_rt_error(I, c, &e, "load_ifs");
+            else
+                err_at(I, NULL, ERR_VALUE, "load_ifs: %s:%d: entry '%s': %s", path, en->line, en->name, e.msg);
             fractint_free(&fl);
             val_unref(I, r);
             return -1;

@@ -219,7 +219,6 @@ typedef struct frac_ctx {
     double lo[3], ext[3]; /* world box: P -> (P - lo) / ext */
     int unit;             /* the box is the unit cube: no mapping */
     interp *I;
-    size_t reserved;      /* bytes reserved from the interpreter's budget */
 } frac_ctx;
 
 static void frac_fn(const void *ctx, size_t n, const double *x, const double *y, const double *z, double *out)
@@ -245,8 +244,7 @@ static void frac_release(void *ctx)
 {
     frac_ctx *c = ctx;
     mpd_free(&c->m);
-    mem_release(c->I, c->reserved);
-    free(c);
+    rt_free(c);
 }
 
 static const char *roman[5] = {"auto", "I", "II", "III", "IV"};
@@ -337,32 +335,28 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     p.budget = budget;
     size_t bytes = type == MPD_TYPE1 ? mpd_type1_bytes(p.R) : type == MPD_TYPE4 ? mpd_type1_bytes(R2) : 0;
     /* Arrays beyond --max-memory are refused by mpd_init with a message that
-     * names the strategy that fits; within it, reserve before allocating. */
-    size_t reserved = 0;
+     * names the strategy that fits; within it, check the budget first for a
+     * clear message (the allocation hook counts the array itself). */
     if (bytes && bytes <= maxmem) {
         char what[64];
         snprintf(what, sizeof what, "fractal: the Type %s array", roman[type]);
-        if (mem_reserve(I, (double)bytes, what))
+        if (mem_precheck(I, (double)bytes, what))
             return -1;
-        reserved = bytes;
     }
-    frac_ctx *c = calloc(1, sizeof *c);
+    frac_ctx *c = mem_calloc(I, 1, sizeof *c);
     if (!c) {
-        mem_release(I, reserved);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_run run = lang_run(I);
     rt_error e;
     rt_code rc = mpd_init(&c->m, &p, &run, &e);
     if (rc) {
-        free(c);
-        mem_release(I, reserved);
+        mem_free(I, c);
         if (rc == RT_EINVAL && bytes > maxmem) /* the array is over --max-memory */
             return err_at(I, NULL, ERR_LIMIT, "fractal: %s (the limit is --max-memory)", e.msg);
         return lang_rt_error(I, rc, &e, W);
     }
     c->I = I;
-    c->reserved = reserved;
     c->unit = 1;
     for (int i = 0; i < 3; i++) {
         c->lo[i] = lo[i];
@@ -425,7 +419,7 @@ static int b_marble(interp *I, value *a, int n, value *out)
     if (t->n < 1 || t->n > SOLID_MAX_LAYERS)
         return err_at(I, NULL, ERR_VALUE, "marble: layers must be a table of 1 to %d rows `c w alpha`, got %zu rows",
                       SOLID_MAX_LAYERS, t->n);
-    solid_marble *m = calloc(1, sizeof *m);
+    solid_marble *m = mem_calloc(I, 1, sizeof *m);
     if (!m)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     m->n = (int)t->n;
@@ -433,14 +427,14 @@ static int b_marble(interp *I, value *a, int n, value *out)
         value row = t->items[i];
         double v[3];
         if (row.k != V_LIST || AS_LIST(row)->n != 3) {
-            free(m);
+            mem_free(I, m);
             return err_at(I, NULL, ERR_VALUE, "marble: layer %zu must be a row `c w alpha` of 3 numbers, got %s", i + 1,
                           row.k == V_LIST ? "a row of another length" : val_type_name(row));
         }
         char w[48];
         snprintf(w, sizeof w, "marble: layer %zu", i + 1);
         if (get_vec(I, row, v, 3, w)) {
-            free(m);
+            mem_free(I, m);
             return -1;
         }
         m->layer[i].c = v[0];
@@ -450,14 +444,14 @@ static int b_marble(interp *I, value *a, int n, value *out)
     rt_error e;
     double ax[3];
     if (solid_marble_check(m, &e)) {
-        free(m);
+        mem_free(I, m);
         return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     }
     if (check_k(I, a[2].u.n, "marble") || get_axis(I, a[3], ax, "marble: axis")) {
-        free(m);
+        mem_free(I, m);
         return -1;
     }
-    field *g = field_external(solid_marble_fn, m, free, "marble");
+    field *g = field_external(solid_marble_fn, m, rt_free, "marble");
     if (!g)
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
     /* G is a function of z; the layers lie across `axis`: evaluate it at
@@ -482,7 +476,7 @@ static int b_marble(interp *I, value *a, int n, value *out)
 static int b_wood(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    solid_wood *w = calloc(1, sizeof *w);
+    solid_wood *w = mem_calloc(I, 1, sizeof *w);
     if (!w)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     w->spacing = a[0].u.n;
@@ -490,17 +484,17 @@ static int b_wood(interp *I, value *a, int n, value *out)
     rt_error e;
     if (get_axis(I, a[2], w->axis, "wood: axis") || get_vec3(I, a[3], w->origin, "wood: origin") ||
         check_k(I, a[5].u.n, "wood")) {
-        free(w);
+        mem_free(I, w);
         return -1;
     }
     if (solid_wood_check(w, &e)) {
-        free(w);
+        mem_free(I, w);
         return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     }
     double ax[3], o[3];
     memcpy(ax, w->axis, sizeof ax);
     memcpy(o, w->origin, sizeof o);
-    field *g = field_external(solid_wood_fn, w, free, "wood");
+    field *g = field_external(solid_wood_fn, w, rt_free, "wood");
     if (!g)
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
     if (a[4].k == V_NIL)

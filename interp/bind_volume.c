@@ -88,6 +88,8 @@ rt_run lang_run(interp *I)
 int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
 {
     err_kind k = lang_rt_kind(c);
+    if (c == RT_ENOMEM) /* why the allocation hook refused: limit, --fail-alloc or the system */
+        return mem_engine_error(I, what, e->msg);
     if (c == RT_ECANCEL)
         return err_at(I, NULL, k, "%s: interrupted", what);
     return err_at(I, NULL, k, "%s: %s", what, e->msg);
@@ -192,16 +194,13 @@ static int b_look_at(interp *I, value *a, int n, value *out)
 
 typedef struct vol_payload {
     volume v;
-    size_t bytes; /* reserved from the interpreter's budget */
-    interp *I;
 } vol_payload;
 
 static void volume_destroy(void *p)
 {
     vol_payload *vp = p;
-    mem_release(vp->I, vp->bytes);
     volume_free(&vp->v);
-    free(vp);
+    rt_free(vp);
 }
 
 static void volume_summary(const void *p, bytebuf *out)
@@ -342,17 +341,14 @@ int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const
         if (!(hi[i] > lo[i]) || !isfinite(lo[i]) || !isfinite(hi[i]))
             return err_at(I, NULL, ERR_VALUE, "volume bounds must have lo < hi on every axis");
     double bytes = voxels * sizeof(float);
-    if (mem_reserve(I, bytes, "the volume"))
+    if (mem_precheck(I, bytes, "the volume"))
         return -1;
-    vol_payload *vp = calloc(1, sizeof *vp);
+    vol_payload *vp = mem_calloc(I, 1, sizeof *vp);
     rt_error e;
     if (!vp || volume_init(&vp->v, nx, ny, nz, lo, hi, &e)) {
-        free(vp);
-        mem_release(I, (size_t)bytes);
+        mem_free(I, vp);
         return err_at(I, NULL, ERR_MEMORY, "out of memory for a %d×%d×%d volume", nx, ny, nz);
     }
-    vp->bytes = (size_t)bytes;
-    vp->I = I;
     *out = &vp->v;
     return 0;
 }
@@ -374,7 +370,7 @@ volume *lang_as_volume(value v)
 static void mesh_destroy(void *p)
 {
     mesh_free(p);
-    free(p);
+    rt_free(p);
 }
 
 static void mesh_summary(const void *p, bytebuf *out)
@@ -509,13 +505,13 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
     char path[4096];
     if (script_relative_path(I, a[0], path, sizeof path, "load_mesh"))
         return -1;
-    mesh *m = malloc(sizeof *m);
+    mesh *m = mem_alloc(I, sizeof *m);
     if (!m)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     rt_error e;
     rt_code c = mio_load(path, m, &e);
     if (c) {
-        free(m);
+        mem_free(I, m);
         return lang_rt_error(I, c, &e, "load_mesh");
     }
     return lang_mesh_value(I, m, out);
@@ -592,12 +588,12 @@ static int b_slice(interp *I, value *a, int n, value *out)
         if (a[5].k == V_NIL)
             hi = mx > lo ? mx : lo + 1;
     }
-    image *im = malloc(sizeof *im);
+    image *im = mem_alloc(I, sizeof *im);
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     rt_error e;
     if (volume_slice_axis(v, axis, (int)index, &r, lo, hi, im, &e)) {
-        free(im);
+        mem_free(I, im);
         return err_at(I, NULL, ERR_VALUE, "slice: %s", e.msg);
     }
     return lang_image_value(I, im, out);

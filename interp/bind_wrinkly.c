@@ -88,16 +88,13 @@ static void style_summary(const wrinkly_opts *o, bytebuf *out)
 
 typedef struct ist_obj {
     ist t;
-    size_t bytes; /* reserved from the memory budget for the lists */
-    interp *I;
 } ist_obj;
 
 static void ist_destroy(void *p)
 {
     ist_obj *o = p;
-    mem_release(o->I, o->bytes);
     ist_free(&o->t);
-    free(o);
+    rt_free(o);
 }
 
 static void ist_summary(const void *p, bytebuf *out)
@@ -132,13 +129,13 @@ static int ist_get(interp *I, const void *p, const char *name, value *out)
     else if (strcmp(name, "bounds") == 0)
         return num_list_value(I, t->bounds, (size_t)t->n + 1, out);
     else if (strcmp(name, "crossings") == 0) {
-        double *m = malloc(sizeof(double) * (size_t)t->n);
+        double *m = mem_alloc(I, sizeof(double) * (size_t)t->n);
         if (!m)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         for (int i = 0; i < t->n; i++)
             m[i] = t->ms[i];
         int r = num_list_value(I, m, (size_t)t->n, out);
-        free(m);
+        mem_free(I, m);
         return r;
     } else
         return 1;
@@ -198,7 +195,7 @@ static int b_ist(interp *I, value *a, int n, value *out)
         return err_at(I, NULL, ERR_VALUE, "ist: method must be \"auto\", \"lists\" or \"closed\", got \"%s\"", meth);
     int rc = -1;
     if (a[4].k != V_NIL) {
-        bounds = malloc(sizeof(double) * (size_t)(nint + 1));
+        bounds = mem_alloc(I, sizeof(double) * (size_t)(nint + 1));
         if (!bounds)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         get_vec(I, a[4], bounds, (size_t)nint + 1, "ist: bounds");
@@ -221,7 +218,7 @@ static int b_ist(interp *I, value *a, int n, value *out)
                    nint, AS_LIST(a[1])->n);
             goto done;
         }
-        ms = malloc(sizeof(int) * (size_t)nint);
+        ms = mem_alloc(I, sizeof(int) * (size_t)nint);
         if (!ms) {
             err_at(I, NULL, ERR_MEMORY, "out of memory");
             goto done;
@@ -239,14 +236,14 @@ static int b_ist(interp *I, value *a, int n, value *out)
             goto done;
         s.m = (int)m;
     }
-    ist_obj *o = calloc(1, sizeof *o);
+    ist_obj *o = mem_calloc(I, 1, sizeof *o);
     if (!o) {
         err_at(I, NULL, ERR_MEMORY, "out of memory");
         goto done;
     }
-    o->I = I;
-    /* The list evaluator is used unless the closed form applies: reserve its
-     * memory first (an upper bound: N·(2M+1)^K entries). */
+    /* The list evaluator is used unless the closed form applies: check its
+     * memory first (an upper bound: N·(2M+1)^K entries; the hook counts the
+     * lists themselves). */
     {
         int mmax = s.m, uniform = 1, equal = 1;
         if (ms)
@@ -262,26 +259,24 @@ static int b_ist(interp *I, value *a, int n, value *out)
             est = (double)IST_MAX_ENTRIES;
         int closed = uniform && equal && s.method != IST_LISTS && pow(2.0 * mmax + 1, (double)s.k) <= 4503599627370496.0;
         if (!closed) {
-            if (mem_reserve(I, est * IST_ENTRY_BYTES, "the IST lists")) {
-                free(o);
+            if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST lists")) {
+                mem_free(I, o);
                 goto done;
             }
-            o->bytes = (size_t)(est * IST_ENTRY_BYTES);
         }
     }
     rt_error e;
     rt_code c = ist_init(&o->t, &s, &e);
     if (c) {
-        mem_release(I, o->bytes);
-        free(o);
+        mem_free(I, o);
         lang_rt_error(I, c, &e, W);
         goto done;
     }
     *out = val_obj(I, &ist_class, o);
     rc = out->k == V_NIL ? -1 : 0;
 done:
-    free(bounds);
-    free(ms);
+    mem_free(I, bounds);
+    mem_free(I, ms);
     return rc;
 }
 
@@ -329,9 +324,8 @@ static int b_ist_lists(interp *I, value *a, int n, value *out)
                       t->k);
     if (t->closed && !t->x) {
         double est = ist_list_estimate(t);
-        if (mem_reserve(I, est * IST_ENTRY_BYTES, "the IST lists"))
+        if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST lists"))
             return -1;
-        o->bytes += (size_t)(est * IST_ENTRY_BYTES);
     }
     bytebuf b;
     bytebuf_init(&b);
@@ -354,7 +348,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
 {
     (void)n;
     const ist *t = &((ist_obj *)AS_OBJ(a[0])->payload)->t;
-    int *ki = malloc(sizeof(int) * (size_t)t->n);
+    int *ki = mem_alloc(I, sizeof(int) * (size_t)t->n);
     if (!ki)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     int rc = -1;
@@ -380,7 +374,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
     uint64_t seed;
     if (arg_seed(I, a[3], &seed, "ist_samples"))
         goto done;
-    pos = malloc(sizeof(double) * ((size_t)count + 1));
+    pos = mem_alloc(I, sizeof(double) * ((size_t)count + 1));
     if (!pos) {
         err_at(I, NULL, ERR_MEMORY, "out of memory for %.0f samples", count);
         goto done;
@@ -392,8 +386,8 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
     }
     rc = num_list_value(I, pos, got, out);
 done:
-    free(ki);
-    free(pos);
+    mem_free(I, ki);
+    mem_free(I, pos);
     return rc;
 }
 
@@ -518,8 +512,8 @@ typedef struct curve_obj {
 static void curve_destroy(void *p)
 {
     curve_obj *c = p;
-    free(c->pts);
-    free(c);
+    rt_free(c->pts);
+    rt_free(c);
 }
 
 static void curve_summary(const void *p, bytebuf *out)
@@ -563,12 +557,12 @@ static int b_wrinkly_curve(interp *I, value *a, int n, value *out)
     if (pl->n < 1 || pl->n > MAX_CONTROL)
         return err_at(I, NULL, ERR_VALUE, "wrinkly_curve: points must be a list of 1 to %d points [x, y], got %zu",
                       MAX_CONTROL, pl->n);
-    curve_obj *c = calloc(1, sizeof *c);
+    curve_obj *c = mem_calloc(I, 1, sizeof *c);
     if (c)
-        c->pts = calloc(pl->n, sizeof *c->pts);
+        c->pts = mem_calloc(I, pl->n, sizeof *c->pts);
     if (!c || !c->pts) {
         if (c)
-            free(c);
+            mem_free(I, c);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     c->n = (int)pl->n;
@@ -641,23 +635,22 @@ static int curve_sample(interp *I, const curve_obj *c, const lod *l, wrinkly_pol
     o.k = l->k;
     o.kmax = l->kmax;
     o.tol = l->tol;
-    int *ki = malloc(sizeof(int) * (size_t)c->n);
+    int *ki = mem_alloc(I, sizeof(int) * (size_t)c->n);
     if (!ki)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     wrinkly_curve_levels(&wc, &o, ki);
     double count = c->ax.cyclic ? 0 : 2;
     for (int i = 0; i < c->n; i++)
         count += pow(2.0 * c->ax.m + 1, ki[i]);
-    free(ki);
+    mem_free(I, ki);
     if (count > I->lim.max_points)
         return err_at(I, NULL, ERR_LIMIT,
                       "%s: the curve would have %.0f samples, more than the limit of %.0f points (raise it with --max-points, or lower iterations/kmax)",
                       what, count, I->lim.max_points);
-    if (mem_reserve(I, count * 40, "the curve samples"))
+    if (mem_precheck(I, count * 40, "the curve samples"))
         return -1;
     rt_error e;
     rt_code rc = wrinkly_curve_sample(&wc, &o, pl, &e);
-    mem_release(I, (size_t)(count * 40));
     if (rc)
         return lang_rt_error(I, rc, &e, what);
     return 0;
@@ -749,11 +742,11 @@ static int get_view(interp *I, const curve_obj *c, value bounds, int w, int h, d
 static int stroke_coloured(interp *I, image *im, const draw_view *v, const wrinkly_polyline *pl, double width)
 {
     size_t np = (size_t)im->w * (size_t)im->h;
-    float *cov = calloc(np, sizeof *cov);
-    float *col = calloc(np * 4, sizeof *col);
+    float *cov = mem_calloc(I, np, sizeof *cov);
+    float *col = mem_calloc(I, np * 4, sizeof *col);
     if (!cov || !col) {
-        free(cov);
-        free(col);
+        mem_free(I, cov);
+        mem_free(I, col);
         return err_at(I, NULL, ERR_MEMORY, "out of memory drawing a curve");
     }
     size_t nseg = pl->n < 2 ? 0 : pl->closed ? pl->n : pl->n - 1;
@@ -798,8 +791,8 @@ static int stroke_coloured(interp *I, image *im, const draw_view *v, const wrink
             p[q] = p[q] * (1 - k) + c[q] * k;
         p[3] = p[3] + (1 - p[3]) * k;
     }
-    free(cov);
-    free(col);
+    mem_free(I, cov);
+    mem_free(I, col);
     return 0;
 }
 
@@ -940,8 +933,8 @@ typedef struct surf_obj {
 static void surf_destroy(void *p)
 {
     surf_obj *s = p;
-    free(s->pts);
-    free(s);
+    rt_free(s->pts);
+    rt_free(s);
 }
 
 static void axis_summary(const wrinkly_axis *a, bytebuf *out)
@@ -1027,11 +1020,11 @@ static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
     if (nu > MAX_CONTROL || (double)nu * (double)nv > 1e7)
         return err_at(I, NULL, ERR_LIMIT, "wrinkly_surface: %zu×%zu control points are too many (at most 10000000)", nu,
                       nv);
-    surf_obj *s = calloc(1, sizeof *s);
+    surf_obj *s = mem_calloc(I, 1, sizeof *s);
     if (s)
-        s->pts = calloc(nu * nv, sizeof *s->pts);
+        s->pts = mem_calloc(I, nu * nv, sizeof *s->pts);
     if (!s || !s->pts) {
-        free(s);
+        mem_free(I, s);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     s->nu = (int)nu;
@@ -1086,10 +1079,10 @@ static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, in
     o.tol = l->tol;
     o.k = l->k;
     o.kmax = l->kmax;
-    int *ku = malloc(sizeof(int) * (size_t)so->nu), *kv = malloc(sizeof(int) * (size_t)so->nv);
+    int *ku = mem_alloc(I, sizeof(int) * (size_t)so->nu), *kv = mem_alloc(I, sizeof(int) * (size_t)so->nv);
     if (!ku || !kv) {
-        free(ku);
-        free(kv);
+        mem_free(I, ku);
+        mem_free(I, kv);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     wrinkly_surface_levels(&ws, &o, ku, kv);
@@ -1098,8 +1091,8 @@ static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, in
         cu += pow(2.0 * so->au.m + 1, ku[i]);
     for (int j = 0; j < so->nv; j++)
         cv += pow(2.0 * so->av.m + 1, kv[j]);
-    free(ku);
-    free(kv);
+    mem_free(I, ku);
+    mem_free(I, kv);
     double nvert = cu * cv;
     if (nvert > I->lim.max_points || nvert >= 4294967295.0)
         return err_at(I, NULL, ERR_LIMIT,
@@ -1108,20 +1101,18 @@ static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, in
     /* positions, normals, colours (floats), the displaced grid (doubles),
      * two triangles per vertex */
     double bytes = nvert * (12 + 12 + 16 + 24 + 24);
-    if (mem_reserve(I, bytes, "the wrinkly mesh"))
+    if (mem_precheck(I, bytes, "the wrinkly mesh"))
         return -1;
-    mesh *m = malloc(sizeof *m);
+    mesh *m = mem_alloc(I, sizeof *m);
     if (!m) {
-        mem_release(I, (size_t)bytes);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_run run = lang_run(I);
     rt_error e;
     rt_code rc = wrinkly_surface_mesh(&ws, &o, &run, m, NULL, &e);
-    mem_release(I, (size_t)bytes);
     if (rc) {
         mesh_free(m);
-        free(m);
+        mem_free(I, m);
         return lang_rt_error(I, rc, &e, what);
     }
     *out = m;
@@ -1282,7 +1273,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
                 normals = 0;
             tv += m ? (double)m->nv : 0;
         }
-        merged = malloc(sizeof *merged);
+        merged = mem_alloc(I, sizeof *merged);
         if (!merged)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         mesh_init(merged, normals, 1);
@@ -1298,7 +1289,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
             if (tv >= 4294967295.0 || tv > I->lim.max_points) {
                 if (t) {
                     mesh_free(t);
-                    free(t);
+                    mem_free(I, t);
                 }
                 err_at(I, NULL, ERR_LIMIT,
                        "rasterize: the scene has more than %.0f vertices (raise it with --max-points)",
@@ -1308,7 +1299,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
             mesh_append(merged, m, ro.colour);
             if (t) {
                 mesh_free(t);
-                free(t);
+                mem_free(I, t);
             }
             if (merged->failed) {
                 err_at(I, NULL, ERR_MEMORY, "out of memory merging the scene");
@@ -1332,7 +1323,7 @@ done:
     lang_image_discard(im);
     if (merged) {
         mesh_free(merged);
-        free(merged);
+        mem_free(I, merged);
     }
     return rc;
 }

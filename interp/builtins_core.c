@@ -648,6 +648,8 @@ static int b_format(interp *I, value *a, int n, value *out)
     bytebuf b;
     bytebuf_init(&b);
     int rc = do_format(I, AS_STR(a[0])->s, AS_STR(a[0])->len, a + 1, n - 1, &b);
+    if (rc == 0 && b.failed) /* the buffer's growth was refused by the allocation hook */
+        rc = mem_engine_error(I, "format", "out of memory");
     if (rc == 0)
         *out = val_str(I, b.data ? (char *)b.data : "", b.len);
     bytebuf_free(&b);
@@ -664,6 +666,10 @@ static int b_print(interp *I, value *a, int n, value *out)
         val_print(I, a[i], &b, 0);
     }
     bytebuf_byte(&b, '\n');
+    if (b.failed) { /* the buffer's growth was refused by the allocation hook */
+        bytebuf_free(&b);
+        return mem_engine_error(I, "print", "out of memory");
+    }
     errno = 0;
     int bad = b.data && fwrite(b.data, 1, b.len, I->out) != b.len;
     bad |= fflush(I->out) != 0 || ferror(I->out);

@@ -57,13 +57,17 @@ int lang_image_new(interp *I, int w, int h, image **out)
         return err_at(I, NULL, ERR_LIMIT,
                       "image of %d×%d pixels exceeds the limit of %.0f pixels (raise it with --max-pixels)",
                       w, h, I->lim.max_pixels);
-    image *im = malloc(sizeof *im);
+    char what[96];
+    snprintf(what, sizeof what, "image of %d×%d pixels", w, h);
+    if (mem_precheck(I, (double)w * h * 4 * sizeof(float), what))
+        return -1;
+    image *im = mem_alloc(I, sizeof *im);
     if (!im)
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        return -1;
     rt_error e;
     if (image_init(im, w, h, &e)) {
-        free(im);
-        return err_at(I, NULL, ERR_MEMORY, "%s", e.msg);
+        mem_free(I, im);
+        return mem_engine_error(I, what, e.msg);
     }
     *out = im;
     return 0;
@@ -79,7 +83,7 @@ void lang_image_discard(image *im)
 {
     if (im) {
         image_free(im);
-        free(im);
+        rt_free(im);
     }
 }
 
@@ -276,18 +280,21 @@ static int b_pixel(interp *I, value *a, int n, value *out)
 static int b_load(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    image *im = malloc(sizeof *im);
+    image *im = mem_alloc(I, sizeof *im);
     if (!im)
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        return -1;
     char path[4096];
     if (script_relative_path(I, a[0], path, sizeof path, "load")) {
-        free(im);
+        mem_free(I, im);
         return -1;
     }
     rt_error e;
-    if (image_load(im, path, &e)) {
-        free(im);
-        return lang_rt_error(I, e.code, &e, "load");
+    /* the decoder checks the declared size against --max-pixels and the
+     * memory left before it allocates (rt_check_pixels, rt_check_bytes) */
+    rt_code c = image_load(im, path, &e);
+    if (c) {
+        mem_free(I, im);
+        return lang_rt_error(I, c, &e, "load");
     }
     if ((double)im->w * im->h > I->lim.max_pixels) {
         image_destroy(im);
@@ -333,8 +340,9 @@ static int image_save_hook(interp *I, const void *p, const char *path, value opt
     if (opt_num(I, opts, "channels", &x) == 1)
         o.channels = (int)x;
     rt_error e;
-    if (image_save(p, path, &o, &e))
-        return lang_rt_error(I, e.code, &e, "save");
+    rt_code c = image_save(p, path, &o, &e);
+    if (c) /* lang_rt_error: an encoder buffer refused by the allocation hook is a memory error */
+        return lang_rt_error(I, c, &e, "save");
     return 0;
 }
 

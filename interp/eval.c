@@ -923,7 +923,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
         char *real = realpath(key, NULL);
         if (real) {
             snprintf(key, sizeof key, "%s", real);
-            free(real);
+            free(real); /* realpath() allocates with malloc: stays raw */
         }
     }
     for (int i = 0; i < I->nmods; i++) {
@@ -966,7 +966,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
             snprintf(display, sizeof display, "%s/%s", dir, name);
     }
     int src = interp_add_source(I, display, text, filelen);
-    free(filedata);
+    mem_free(I, filedata);
     if (src < 0)
         return -1;
     if (I->nmods == I->cap_mods) {

@@ -53,10 +53,12 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 rt_run lang_run(interp *I);
 /* The one map from runtime codes to error kinds (args.c): RT_ENOMEM ->
  * ERR_MEMORY (exit 70), RT_EIO -> ERR_IO (74), RT_ECANCEL -> ERR_INTERRUPT
- * (130), RT_EFORMAT and RT_EINVAL -> ERR_VALUE (65). */
+ * (130), RT_ELIMIT -> ERR_LIMIT (65), RT_EFORMAT and RT_EINVAL -> ERR_VALUE (65). */
 err_kind lang_rt_kind(rt_code c);
-/* Turn a runtime failure into a script error of kind lang_rt_kind(c). The
- * message is "WHAT: e->msg" ("WHAT: interrupted" for RT_ECANCEL). Returns -1. */
+/* Turn a runtime failure into a script error of kind lang_rt_kind(c); for
+ * RT_ENOMEM the kind says why the allocation hook refused (mem_engine_error:
+ * ERR_LIMIT for the memory limit, ERR_MEMORY otherwise). The message is
+ * "WHAT: e->msg" ("WHAT: interrupted" for RT_ECANCEL). Returns -1. */
 int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what);
 
 #endif

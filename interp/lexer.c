@@ -1,5 +1,6 @@
 /* lexer.c — the scanner. */
 #include "lexer.h"
+#include "rt_alloc.h"
 
 #include <ctype.h>
 #include <stdlib.h>
@@ -35,11 +36,14 @@ const char *lex_name(tok_type t)
     return t < T_COUNT && names[t] ? names[t] : "token";
 }
 
+/* The lexer has no interpreter state: it allocates with rt_realloc, which
+ * goes through the same allocation hook as mem_alloc (counted, and failed by
+ * --fail-alloc); lex_all's caller reports the failure. */
 static int push(token_list *tl, token t)
 {
     if (tl->n == tl->cap) {
         size_t nc = tl->cap ? tl->cap * 2 : 1024;
-        token *nt = realloc(tl->toks, nc * sizeof *nt);
+        token *nt = rt_realloc(tl->toks, nc * sizeof *nt);
         if (!nt)
             return -1;
         tl->toks = nt;
@@ -51,7 +55,7 @@ static int push(token_list *tl, token t)
 
 void lex_free(token_list *tl)
 {
-    free(tl->toks);
+    rt_free(tl->toks);
     tl->toks = NULL;
     tl->n = tl->cap = 0;
 }

@@ -66,7 +66,7 @@ static const char usage_text[] =
     "  --params              with check: list the script's params and defaults\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
-    "  --max-memory MIB      memory for values, images, volumes (default 4096)\n"
+    "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
     "  --max-depth N         function call depth (default 1000)\n"
     "  --max-pixels N        pixels per image (default 64000000)\n"
     "  --max-points N        points per chaos game or sampling (default 1e10)\n"
@@ -146,7 +146,10 @@ static void set_numflag(interp *I, int f, double d)
     case F_POINTS: I->lim.max_points = d; break;
     case F_VOXELS: I->lim.max_voxels = d; break;
     case F_LIST: I->lim.max_list = d; break;
-    case F_FAIL: I->fail_alloc_at = (long)d; break;
+    case F_FAIL: /* count from here: parsing the command line allocated */
+        I->fail_alloc_at = (long)d;
+        I->alloc_count = 0;
+        break;
     }
 }
 
@@ -332,7 +335,8 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
     rt_error e;
     if (strcmp(path, "-") == 0) {
         size_t cap = 1 << 16, n = 0;
-        unsigned char *buf = malloc(cap + 1);
+        /* rt_malloc, like fileio_read_all below: the same hook as mem_alloc */
+        unsigned char *buf = rt_malloc(cap + 1);
         if (!buf)
             return EX_SOFTWARE;
         size_t r;
@@ -340,13 +344,13 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
             n += r;
             if (n == cap) {
                 if (cap >= (64u << 20)) {
-                    free(buf);
+                    rt_free(buf);
                     fprintf(stderr, "frac: error: the script on standard input is larger than 64 MiB\n");
                     return EX_IO;
                 }
-                unsigned char *nb = realloc(buf, cap * 2 + 1);
+                unsigned char *nb = rt_realloc(buf, cap * 2 + 1);
                 if (!nb) {
-                    free(buf);
+                    rt_free(buf);
                     return EX_SOFTWARE;
                 }
                 buf = nb;
@@ -358,13 +362,14 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
         *len = n;
         return 0;
     }
-    if (fileio_read_all(path, 64u << 20, text, len, &e)) {
+    rt_code c = fileio_read_all(path, 64u << 20, text, len, &e);
+    if (c) {
         fprintf(stderr, "frac: error: %s\n", e.msg);
-        return EX_IO;
+        return c == RT_ENOMEM ? EX_SOFTWARE : EX_IO; /* the buffer goes through the allocation hook */
     }
     if (memchr(*text, 0, *len)) {
         fprintf(stderr, "frac: error: '%s' is not a text file (it contains NUL bytes)\n", path);
-        free(*text);
+        rt_free(*text);
         return EX_SCRIPT;
     }
     return 0;
@@ -541,8 +546,13 @@ static int run_frac(interp *I, opts *o)
             bytebuf b;
             bytebuf_init(&b);
             val_print(I, v, &b, 1);
-            fwrite(b.data, 1, b.len, stdout);
-            fputc('\n', stdout);
+            if (b.failed) { /* the buffer's growth was refused by the allocation hook */
+                mem_engine_error(I, "-e", "out of memory printing the value");
+                rc = session_report(I);
+            } else {
+                fwrite(b.data, 1, b.len, stdout);
+                fputc('\n', stdout);
+            }
             bytebuf_free(&b);
         }
         val_unref(I, v);
@@ -555,11 +565,11 @@ static int run_frac(interp *I, opts *o)
         return rc;
     const char *name = strcmp(o->script, "-") == 0 ? "<stdin>" : o->script;
     if (set_script_args(I, o) || (o->nov && check_overrides(I, name, (const char *)text, len))) {
-        free(text);
+        rt_free(text);
         return session_report(I);
     }
     if (!check && I->out_dir && (rc = make_out_dir(I->out_dir))) {
-        free(text);
+        rt_free(text);
         return rc;
     }
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
@@ -569,7 +579,7 @@ static int run_frac(interp *I, opts *o)
         if (check && o->list_params)
             print_params(I);
     }
-    free(text);
+    rt_free(text);
     return rc;
 }
 
@@ -580,16 +590,16 @@ int main(int argc, char **argv)
     I->threads = par_cores();
     I->progress = 1;
     opts o = {0};
-    o.args = calloc((size_t)argc, sizeof *o.args);
-    o.ov = calloc((size_t)argc, sizeof *o.ov);
+    o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
+    o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
     int rc = EX_SOFTWARE;
     if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
             rc = run_frac(I, &o);
     }
+    mem_free(I, o.args);
+    mem_free(I, o.ov);
     interp_free(I);
-    free(o.args);
-    free(o.ov);
     return finish_output(rc);
 }

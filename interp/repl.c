@@ -83,7 +83,7 @@ static char *read_line(repl *r, const char *prompt, int *cancelled)
             if (!r->tty)
                 continue;
             *cancelled = 1;
-            line = malloc(1);
+            line = rt_malloc(1); /* like lineedit's lines: freed with rt_free */
             if (line)
                 line[0] = 0;
             return line;
@@ -113,9 +113,9 @@ static int join_next(repl *r, char **text, size_t *len)
             return 0;
         if (r->nahead == r->capahead) {
             size_t nc = r->capahead ? 2 * r->capahead : 8;
-            char **na = realloc(r->ahead, nc * sizeof *na);
+            char **na = rt_realloc(r->ahead, nc * sizeof *na);
             if (!na) {
-                free(line);
+                rt_free(line);
                 return 0;
             }
             r->ahead = na;
@@ -130,10 +130,10 @@ static int join_next(repl *r, char **text, size_t *len)
         char *l = r->ahead[i];
         size_t ml = strlen(l);
         if (ml) {
-            char *nt = realloc(*text, *len + ml + 2);
+            char *nt = rt_realloc(*text, *len + ml + 2);
             if (!nt) {
                 for (; i < r->nahead; i++)
-                    free(r->ahead[i]);
+                    rt_free(r->ahead[i]);
                 r->nahead = 0;
                 return 0;
             }
@@ -143,7 +143,7 @@ static int join_next(repl *r, char **text, size_t *len)
             *len += ml + 1;
             r->line_no++;
         }
-        free(l);
+        rt_free(l);
     }
     r->nahead = 0;
     return 1;
@@ -155,7 +155,7 @@ static void snap_drop(repl *r)
 {
     for (size_t i = 0; i < r->nsnap; i++)
         val_unref(r->I, r->snap[i]);
-    free(r->snap);
+    rt_free(r->snap);
     r->snap = NULL;
     r->nsnap = 0;
 }
@@ -164,7 +164,7 @@ static void snap_take(repl *r)
 {
     snap_drop(r);
     env *g = r->I->globals;
-    if (!g->n || !(r->snap = malloc(g->n * sizeof *r->snap)))
+    if (!g->n || !(r->snap = rt_malloc(g->n * sizeof *r->snap)))
         return;
     for (size_t i = 0; i < g->n; i++) {
         r->snap[i] = g->vals[i];
@@ -184,14 +184,14 @@ static void snap_restore(repl *r)
     }
     for (size_t i = g->n; i < r->nsnap; i++)
         val_unref(r->I, r->snap[i]);
-    free(r->snap);
+    rt_free(r->snap);
     r->snap = NULL;
     r->nsnap = 0;
 }
 
 static void forget_prev(repl *r)
 {
-    free(r->prev_text);
+    rt_free(r->prev_text);
     r->prev_text = NULL;
     snap_drop(r);
 }
@@ -335,7 +335,7 @@ static int run_command(repl *r, char *line)
         } else {
             if (session_run(I, arg, (char *)text, len, 0, NULL))
                 report(r);
-            free(text);
+            mem_free(I, text);
         }
     } else if (strcmp(cmd, "time") == 0) {
         eval_entry(r, arg, r->line_no - 1, 1);
@@ -359,14 +359,14 @@ static int add_entry_source(interp *I, const char *text, size_t len)
 {
     if (len && text[len - 1] == '\\')
         return interp_add_source(I, "<repl>", text, len);
-    char *t = malloc(len + 2);
+    char *t = rt_malloc(len + 2);
     if (!t)
         return -1;
     memcpy(t, text, len);
     t[len] = '\n';
     t[len + 1] = 0;
     int src = interp_add_source(I, "<repl>", t, len + 1);
-    free(t);
+    rt_free(t);
     return src;
 }
 
@@ -408,7 +408,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         if (!line)
             break;
         if (cancelled || line[0] == 0) {
-            free(line);
+            mem_free(I, line);
             continue;
         }
         int first = r.line_no++;
@@ -416,7 +416,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             forget_prev(&r);
             lineedit_history_add(r.le, line);
             int quit = run_command(&r, line);
-            free(line);
+            mem_free(I, line);
             if (quit)
                 break;
             continue;
@@ -427,12 +427,12 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
         if (r.prev_text && continues_previous(first_token(line))) {
             /* terminal: this line goes on with the entry before it */
             size_t pl = strlen(r.prev_text);
-            char *nt = malloc(pl + len + 2);
+            char *nt = rt_malloc(pl + len + 2);
             if (nt) {
                 memcpy(nt, r.prev_text, pl);
                 nt[pl] = '\n';
                 memcpy(nt + pl + 1, line, len + 1);
-                free(line);
+                rt_free(line);
                 text = nt;
                 len += pl + 1;
                 first = r.prev_first;
@@ -458,7 +458,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             if (!more || cancelled) {
                 /* piped input that ends here is the parser's error; on a
                  * terminal Ctrl-C or Ctrl-D abandons the unfinished entry */
-                free(more);
+                rt_free(more);
                 if (r.in_tty || r.io_error)
                     dropped = 1;
                 break;
@@ -466,16 +466,16 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             err_clear(I);
             r.line_no++;
             size_t ml = strlen(more);
-            char *nt = realloc(text, len + ml + 2);
+            char *nt = mem_realloc(I, text, len + ml + 2);
             if (!nt) {
-                free(more);
+                mem_free(I, more);
                 break;
             }
             text = nt;
             text[len] = '\n';
             memcpy(text + len + 1, more, ml + 1);
             len += ml + 1;
-            free(more);
+            mem_free(I, more);
         }
         lineedit_history_add(r.le, joined ? text + strlen(r.prev_text) + 1 : text);
         if (dropped || I->err.active) {
@@ -483,7 +483,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
                 err_clear(I);
             else
                 report(&r);
-            free(text);
+            rt_free(text);
             forget_prev(&r);
             continue;
         }
@@ -493,17 +493,17 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             snap_take(&r);
         eval_entry(&r, text, first, 0);
         if (r.in_tty) {
-            free(r.prev_text);
+            rt_free(r.prev_text);
             r.prev_text = text;
             r.prev_first = first;
         } else {
-            free(text);
+            rt_free(text);
         }
     }
     stdout_failed(&r);
     for (size_t i = 0; i < r.nahead; i++)
-        free(r.ahead[i]);
-    free(r.ahead);
+        rt_free(r.ahead[i]);
+    rt_free(r.ahead);
     forget_prev(&r);
     lineedit_free(r.le);
     if (r.io_error)

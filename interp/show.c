@@ -69,7 +69,7 @@ static int preview_of(interp *I, value v, image **out, int *owned)
     *owned = 1;
     volume *vol = lang_as_volume(v);
     if (vol) {
-        image *s = malloc(sizeof *s);
+        image *s = mem_alloc(I, sizeof *s);
         if (!s)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         size_t n = (size_t)vol->nx * vol->ny * vol->nz;
@@ -81,7 +81,7 @@ static int preview_of(interp *I, value v, image **out, int *owned)
         ramp g = ramp_grey();
         rt_error e;
         if (volume_slice_axis(vol, 2, vol->nz / 2, &g, mn, mx > mn ? mx : mn + 1, s, &e)) {
-            free(s);
+            mem_free(I, s);
             return lang_rt_error(I, e.code, &e, "show");
         }
         *out = s;

@@ -3,6 +3,7 @@
 #include "state.h"
 
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,85 +31,139 @@ int err_kind_exit(err_kind k)
 
 /* ---- allocation ---------------------------------------------------------- */
 
-typedef struct memhdr {
-    size_t size;
-    size_t pad; /* keep 16-byte alignment */
-} memhdr;
+/* Why the hook last refused an allocation. */
+enum mem_fail_kind { MEM_FAIL_NONE, MEM_FAIL_LIMIT, MEM_FAIL_INJECTED, MEM_FAIL_SYSTEM };
 
-static int mem_check(interp *I, size_t n)
+static void *fail(interp *I, int kind, size_t n, long count)
 {
-    I->alloc_count++;
-    if (I->fail_alloc_at && I->alloc_count == I->fail_alloc_at) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory (allocation %ld failed, as --fail-alloc asked)",
-               I->alloc_count);
-        return -1;
+    atomic_store(&I->mem_fail_size, n);
+    atomic_store(&I->mem_fail_n, count);
+    atomic_store(&I->mem_fail, kind);
+    return NULL;
+}
+
+/* The one allocation hook (rt_alloc_hook.alloc). Runs on any thread: the
+ * budget is taken with a compare-and-swap before the block is allocated, so
+ * concurrent engine workers can never overshoot lim.max_memory together. */
+static void *mem_hook(void *ud, void *p, size_t osize, size_t nsize)
+{
+    interp *I = ud;
+    if (nsize == 0) {
+        free(p);
+        atomic_fetch_sub(&I->mem_used, osize);
+        return NULL;
     }
-    if (n > I->lim.max_memory || I->mem_used > I->lim.max_memory - n) {
-        err_at(I, NULL, ERR_LIMIT,
-               "memory limit of %.0f MiB exceeded (raise it with --max-memory MiB)",
-               (double)I->lim.max_memory / 1048576.0);
-        return -1;
+    size_t grow = nsize > osize ? nsize - osize : 0;
+    if (grow) {
+        long count = atomic_fetch_add(&I->alloc_count, 1) + 1;
+        if (I->fail_alloc_at && count == I->fail_alloc_at)
+            return fail(I, MEM_FAIL_INJECTED, nsize, count);
+        size_t max = I->lim.max_memory;
+        size_t used = atomic_load(&I->mem_used);
+        do {
+            if (grow > max || used > max - grow)
+                return fail(I, MEM_FAIL_LIMIT, nsize, count);
+        } while (!atomic_compare_exchange_weak(&I->mem_used, &used, used + grow));
     }
-    return 0;
+    void *q = realloc(p, nsize);
+    if (!q) {
+        atomic_fetch_sub(&I->mem_used, grow);
+        return fail(I, MEM_FAIL_SYSTEM, nsize, 0);
+    }
+    if (nsize < osize)
+        atomic_fetch_sub(&I->mem_used, osize - nsize);
+    return q;
+}
+
+static double mem_limit(void *ud, rt_limit k, const char **flag)
+{
+    interp *I = ud;
+    switch (k) {
+    case RT_LIMIT_MEMORY: {
+        size_t used = atomic_load(&I->mem_used);
+        *flag = "--max-memory MiB";
+        return used > I->lim.max_memory ? 0 : (double)(I->lim.max_memory - used);
+    }
+    case RT_LIMIT_PIXELS:
+        *flag = "--max-pixels";
+        return I->lim.max_pixels;
+    case RT_LIMIT_VOXELS:
+        *flag = "--max-voxels";
+        return I->lim.max_voxels;
+    }
+    return -1;
+}
+
+/* Record the error for the hook's last refusal (prefixed "WHAT: " if what)
+ * and forget the refusal. */
+static int refused(interp *I, const char *what, size_t n, const char *fallback)
+{
+    int kind = atomic_exchange(&I->mem_fail, MEM_FAIL_NONE);
+    const char *sep = what ? ": " : "";
+    what = what ? what : "";
+    switch (kind) {
+    case MEM_FAIL_LIMIT:
+        return err_at(I, NULL, ERR_LIMIT, "%s%smemory limit of %.0f MiB exceeded (raise it with --max-memory MiB)",
+                      what, sep, (double)I->lim.max_memory / 1048576.0);
+    case MEM_FAIL_INJECTED:
+        return err_at(I, NULL, ERR_MEMORY, "%s%sout of memory (allocation %ld failed, as --fail-alloc asked)",
+                      what, sep, atomic_load(&I->mem_fail_n));
+    case MEM_FAIL_SYSTEM:
+        return err_at(I, NULL, ERR_MEMORY, "%s%sout of memory (allocating %zu bytes)", what, sep,
+                      atomic_load(&I->mem_fail_size));
+    default: /* not refused by the hook: a size that overflowed, or the engine's own reason */
+        if (fallback)
+            return err_at(I, NULL, ERR_MEMORY, "%s%s%s", what, sep, fallback);
+        if (n)
+            return err_at(I, NULL, ERR_MEMORY, "%s%sout of memory (allocating %zu bytes)", what, sep, n);
+        return err_at(I, NULL, ERR_MEMORY, "%s%sout of memory (a buffer size overflows)", what, sep);
+    }
 }
 
 void *mem_alloc(interp *I, size_t n)
 {
-    if (mem_check(I, n))
-        return NULL;
-    memhdr *h = malloc(sizeof(memhdr) + n);
-    if (!h) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory (allocating %zu bytes)", n);
-        return NULL;
-    }
-    h->size = n;
-    I->mem_used += n;
-    return h + 1;
+    void *p = rt_malloc(n);
+    if (!p)
+        refused(I, NULL, n, NULL);
+    return p;
+}
+
+void *mem_calloc(interp *I, size_t count, size_t size)
+{
+    void *p = rt_calloc(count, size);
+    if (!p)
+        refused(I, NULL, 0, NULL);
+    return p;
 }
 
 void *mem_realloc(interp *I, void *p, size_t n)
 {
-    if (!p)
-        return mem_alloc(I, n);
-    memhdr *h = (memhdr *)p - 1;
-    size_t old = h->size;
-    if (n > old && mem_check(I, n - old))
-        return NULL;
-    memhdr *nh = realloc(h, sizeof(memhdr) + n);
-    if (!nh) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory (allocating %zu bytes)", n);
-        return NULL;
-    }
-    nh->size = n;
-    I->mem_used = I->mem_used - old + n;
-    return nh + 1;
+    void *q = rt_realloc(p, n);
+    if (!q)
+        refused(I, NULL, n, NULL);
+    return q;
 }
 
 void mem_free(interp *I, void *p)
 {
-    if (!p)
-        return;
-    memhdr *h = (memhdr *)p - 1;
-    I->mem_used -= h->size;
-    free(h);
+    (void)I;
+    rt_free(p);
 }
 
-int mem_reserve(interp *I, double bytes, const char *what)
+int mem_precheck(interp *I, double bytes, const char *what)
 {
-    if (bytes < 0 || bytes > (double)I->lim.max_memory ||
-        (double)I->mem_used + bytes > (double)I->lim.max_memory)
+    double used = (double)atomic_load(&I->mem_used), max = (double)I->lim.max_memory;
+    if (!(bytes >= 0 && bytes <= max && used + bytes <= max))
         return err_at(I, NULL, ERR_LIMIT,
                       "%s needs %.0f MiB, over the memory limit of %.0f MiB (%.0f MiB in use; raise "
                       "it with --max-memory MiB)",
-                      what, bytes / 1048576.0, (double)I->lim.max_memory / 1048576.0,
-                      (double)I->mem_used / 1048576.0);
-    I->mem_used += (size_t)bytes;
+                      what, bytes / 1048576.0, max / 1048576.0, used / 1048576.0);
     return 0;
 }
 
-void mem_release(interp *I, size_t bytes)
+int mem_engine_error(interp *I, const char *what, const char *msg)
 {
-    I->mem_used = bytes > I->mem_used ? 0 : I->mem_used - bytes;
+    return refused(I, what, 0, msg);
 }
 
 /* ---- arena for syntax trees --------------------------------------------- */
@@ -231,6 +286,15 @@ int interp_add_source(interp *I, const char *name, const char *text, size_t len)
 void interp_init(interp *I)
 {
     memset(I, 0, sizeof *I);
+    atomic_init(&I->mem_used, 0);
+    atomic_init(&I->alloc_count, 0);
+    atomic_init(&I->mem_fail, MEM_FAIL_NONE);
+    atomic_init(&I->mem_fail_size, 0);
+    atomic_init(&I->mem_fail_n, 0);
+    I->hook.alloc = mem_hook;
+    I->hook.limit = mem_limit;
+    I->hook.ud = I;
+    rt_alloc_set_hook(&I->hook);
     I->lim.max_memory = (size_t)4096 << 20;
     I->lim.max_depth = 1000;
     I->lim.max_pixels = 64e6;
@@ -267,6 +331,7 @@ void interp_free(interp *I)
     mem_free(I, I->params);
     mem_free(I, I->overrides);
     mem_free(I, I->builtins);
+    rt_alloc_set_hook(NULL); /* blocks freed later go to free() uncounted */
 }
 
 /* ---- errors --------------------------------------------------------------- */

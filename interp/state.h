@@ -17,6 +17,7 @@
 #include <stdio.h>
 
 #include "ast.h"
+#include "rt_alloc.h"
 #include "value.h"
 
 /* Error classes; the X-macro gives the enum, the name and the exit code
@@ -93,11 +94,15 @@ typedef struct module {
 typedef struct builtin builtin;
 
 typedef struct interp {
-    /* allocation */
-    size_t mem_used;
+    /* allocation (the hook runs on engine worker threads too: atomics) */
+    _Atomic size_t mem_used;
     limits lim;
     long fail_alloc_at; /* testing: fail the N-th allocation (0 = never) */
-    long alloc_count;
+    _Atomic long alloc_count;
+    _Atomic int mem_fail;        /* why the hook last refused (mem_fail_kind in state.c) */
+    _Atomic size_t mem_fail_size;
+    _Atomic long mem_fail_n;
+    rt_alloc_hook hook;
 
     /* sources, names, syntax trees */
     source *srcs;
@@ -142,16 +147,30 @@ typedef struct interp {
     const struct bcall *bcall;       /* the builtin call running, for positions */
 } interp;
 
-/* Allocation hook: every interpreter allocation goes through here; it
- * enforces lim.max_memory and records an ERR_MEMORY/ERR_LIMIT error on
- * failure (returning NULL). Sizes are tracked with a small header. */
+/* Allocation: every interpreter allocation goes through mem_alloc /
+ * mem_calloc / mem_realloc / mem_free, which are the runtime's allocator
+ * (rt_alloc.h) plus an error: on failure they record ERR_LIMIT ("memory limit
+ * of N MiB exceeded (raise it with --max-memory MiB)") or ERR_MEMORY (out of
+ * memory, or the allocation --fail-alloc asked to fail) and return NULL.
+ * interp_init installs the one allocation hook (mem_hook in state.c): it
+ * counts every block — interpreter values and every engine, image, volume,
+ * mesh and decoder buffer alike — against lim.max_memory, thread-safely, and
+ * fails the fail_alloc_at-th allocation. Blocks are interchangeable with the
+ * runtime's: mem_free(I, p) is rt_free(p), and code that has no interp at
+ * hand (object destructors) calls rt_free. */
 void *mem_alloc(interp *I, size_t n);
+void *mem_calloc(interp *I, size_t count, size_t size); /* zeroed, count * size checked */
 void *mem_realloc(interp *I, void *p, size_t n);
 void mem_free(interp *I, void *p);
-/* Reserve bytes for an engine allocation made with malloc by the runtime
- * (images, volumes…): checked against the same budget; release when freed. */
-int mem_reserve(interp *I, double bytes, const char *what);
-void mem_release(interp *I, size_t bytes);
+/* Before a large engine allocation: is `bytes` still free under the memory
+ * limit? Records "WHAT needs N MiB, over the memory limit of M MiB (K MiB in
+ * use; raise it with --max-memory MiB)" (ERR_LIMIT) and returns -1 if not.
+ * Counts nothing: the hook counts the engine's blocks when they are made. */
+int mem_precheck(interp *I, double bytes, const char *what);
+/* The error for an engine that returned RT_ENOMEM: why the hook refused
+ * (memory limit, --fail-alloc, or the system), "WHAT: reason"; msg (the
+ * engine's message) when the hook refused nothing. */
+int mem_engine_error(interp *I, const char *what, const char *msg);
 
 void interp_init(interp *I);
 void interp_free(interp *I);

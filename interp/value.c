@@ -131,6 +131,10 @@ value val_cstr(interp *I, const char *s) { return val_str(I, s, strlen(s)); }
 
 value val_list(interp *I, size_t cap)
 {
+    if ((double)cap > I->lim.max_list) { /* the length a caller is about to fill */
+        err_at(I, NULL, ERR_LIMIT, "list longer than %.0f items (raise it with --max-list)", I->lim.max_list);
+        return val_nil();
+    }
     vlist *l = heap_new(I, sizeof(vlist), H_LIST);
     if (!l)
         return val_nil();
@@ -150,12 +154,14 @@ value val_list(interp *I, size_t cap)
 
 int list_push(interp *I, vlist *l, value v)
 {
+    /* every push, not only when the list grows its storage: the limit is
+     * exact whatever capacity val_list reserved */
+    if ((double)l->n + 1 > I->lim.max_list) {
+        val_unref(I, v);
+        return err_at(I, NULL, ERR_LIMIT, "list longer than %.0f items (raise it with --max-list)",
+                      I->lim.max_list);
+    }
     if (l->n == l->cap) {
-        if ((double)l->n + 1 > I->lim.max_list) {
-            val_unref(I, v);
-            return err_at(I, NULL, ERR_LIMIT, "list longer than %.0f items (raise it with --max-list)",
-                          I->lim.max_list);
-        }
         size_t nc = l->cap ? l->cap * 2 : 8;
         value *ni = mem_realloc(I, l->items, nc * sizeof(value));
         if (!ni) {

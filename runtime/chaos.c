@@ -6,6 +6,7 @@
  * constants in each instantiation, maps are plain arrays of 6 (2-D) or 12
  * (3-D) doubles, and the map choice is an alias-table lookup (ifs.h). */
 #include "chaos.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -39,11 +40,11 @@ typedef struct sysdata {
 
 static void sys_free(sysdata *d)
 {
-    free(d->thr);
-    free(d->sel);
-    free(d->m);
-    free(d->mc);
-    free(d);
+    rt_free(d->thr);
+    rt_free(d->sel);
+    rt_free(d->m);
+    rt_free(d->mc);
+    rt_free(d);
 }
 
 static void fixed_point(const affine *a, double out[3])
@@ -97,7 +98,7 @@ static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, 
                 rt_fail(e, RT_EINVAL, "colour %d is %.6g (expected 0 .. 1)", k + 1, o->map_c[k]);
                 return NULL;
             }
-    sysdata *d = calloc(1, sizeof *d);
+    sysdata *d = rt_calloc(1, sizeof *d);
     if (!d) {
         rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
         return NULL;
@@ -105,10 +106,10 @@ static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, 
     d->n = n;
     d->dim = dim;
     size_t cols = (size_t)rows * (size_t)n;
-    d->thr = calloc(cols, sizeof *d->thr);
-    d->sel = calloc(cols * 2, sizeof *d->sel);
-    d->m = calloc((size_t)n * 12, sizeof *d->m);
-    d->mc = calloc((size_t)n, sizeof *d->mc);
+    d->thr = rt_calloc(cols, sizeof *d->thr);
+    d->sel = rt_calloc(cols * 2, sizeof *d->sel);
+    d->m = rt_calloc((size_t)n * 12, sizeof *d->m);
+    d->mc = rt_calloc((size_t)n, sizeof *d->mc);
     if (!d->thr || !d->sel || !d->m || !d->mc) {
         sys_free(d);
         rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
@@ -285,7 +286,7 @@ INLINE void bump(worker *w, uint32_t *cnt, size_t b, size_t nbins)
 {
     if (!++cnt[b]) { /* exact carry on 32-bit wrap-around */
         if (!w->carry)
-            w->carry = calloc(nbins + 1, sizeof *w->carry);
+            w->carry = rt_calloc(nbins + 1, sizeof *w->carry);
         if (w->carry)
             w->carry[b]++;
         else
@@ -307,7 +308,7 @@ INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t 
     cell[3] += pal[pc][2];
     if (!(++cell[0] & 0xffffu) && b < nbins) {
         if (!w->carry)
-            w->carry = calloc(4 * nbins, sizeof *w->carry);
+            w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
         if (w->carry) {
             for (int q = 0; q < 4; q++)
                 w->carry[4 * b + q] += cell[q];
@@ -533,12 +534,12 @@ static void free_workers(worker *w, int nw)
     if (!w)
         return;
     for (int i = 0; i < nw; i++) {
-        free(w[i].cnt);
-        free(w[i].carry);
-        free(w[i].zb);
-        free(w[i].tag);
+        rt_free(w[i].cnt);
+        rt_free(w[i].carry);
+        rt_free(w[i].zb);
+        rt_free(w[i].tag);
     }
-    free(w);
+    rt_free(w);
 }
 
 static void job_init(job *j, const sysdata *d, const chaos_opts *o)
@@ -574,11 +575,11 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
     job j;
     job_init(&j, d, &fo);
     size_t np = CHAOS_FIT_POINTS;
-    j.pos = malloc(sizeof *j.pos * 3 * np);
-    double *ax = malloc(sizeof *ax * np);
+    j.pos = rt_malloc(sizeof *j.pos * 3 * np);
+    double *ax = rt_malloc(sizeof *ax * np);
     if (!j.pos || !ax) {
-        free(j.pos);
-        free(ax);
+        rt_free(j.pos);
+        rt_free(ax);
         sys_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory fitting a window");
     }
@@ -620,8 +621,8 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
             lo[1] = c - 0.5 * ex / want, hi[1] = c + 0.5 * ex / want;
         }
     }
-    free(j.pos);
-    free(ax);
+    rt_free(j.pos);
+    rt_free(ax);
     sys_free(d);
     return RT_OK;
 }
@@ -631,15 +632,15 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
 static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int colour, int zbuf,
                              rt_error *e)
 {
-    worker *w = calloc((size_t)nw, sizeof *w);
+    worker *w = rt_calloc((size_t)nw, sizeof *w);
     int bad = !w;
     for (int i = 0; !bad && i < nw; i++) {
         /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
-        if (counts && !(w[i].cnt = calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+        if (counts && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
             bad = 1;
         if (zbuf) {
-            w[i].zb = malloc(sizeof *w[i].zb * nbins);
-            w[i].tag = malloc(sizeof *w[i].tag * nbins);
+            w[i].zb = rt_malloc(sizeof *w[i].zb * nbins);
+            w[i].tag = rt_malloc(sizeof *w[i].tag * nbins);
             if (!w[i].zb || !w[i].tag)
                 bad = 1;
             else
@@ -782,13 +783,13 @@ rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_
     job j;
     job_init(&j, d, o);
     size_t np = (size_t)o->points;
-    j.pos = malloc(sizeof *j.pos * rt_mul_size(np ? np : 1, 3));
+    j.pos = rt_malloc(sizeof *j.pos * rt_mul_size(np ? np : 1, 3));
     int want_col = m->col && o->colour != CHAOS_COLOUR_NONE;
     if (want_col)
-        j.col = malloc(sizeof *j.col * rt_mul_size(np ? np : 1, 4));
+        j.col = rt_malloc(sizeof *j.col * rt_mul_size(np ? np : 1, 4));
     if (!j.pos || (want_col && !j.col)) {
-        free(j.pos);
-        free(j.col);
+        rt_free(j.pos);
+        rt_free(j.col);
         sys_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
     }
@@ -797,8 +798,8 @@ rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_
     for (size_t i = 0; !rc && i < np; i++)
         if (mesh_add_vertex(m, j.pos + 3 * i, NULL, j.col ? j.col + 4 * i : NULL) == UINT32_MAX)
             rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
-    free(j.pos);
-    free(j.col);
+    rt_free(j.pos);
+    rt_free(j.col);
     sys_free(d);
     return rc;
 }

@@ -11,6 +11,7 @@
  * zlib's level 6; the code itself is ours.
  */
 #include "deflate.h"
+#include "rt_alloc.h"
 
 #include <pthread.h>
 #include <stdlib.h>
@@ -85,7 +86,7 @@ static int bw_reserve(bitw *w, size_t extra)
         }
         ncap *= 2;
     }
-    unsigned char *nb = realloc(w->buf, ncap);
+    unsigned char *nb = rt_realloc(w->buf, ncap);
     if (!nb) {
         w->failed = 1;
         return 0;
@@ -713,7 +714,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
 {
     if (level < 0 || level > 9)
         return rt_fail(e, RT_EINVAL, "deflate level %d is out of range (expected 0..9)", level);
-    deflater *d = calloc(1, sizeof *d);
+    deflater *d = rt_calloc(1, sizeof *d);
     if (!d)
         return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
     d->in = in;
@@ -721,14 +722,14 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     d->cfg = level_cfgs[level];
     d->w = *w;
     if (level > 0) {
-        d->head = malloc(HSIZE * sizeof *d->head);
-        d->prev = malloc(WSIZE * sizeof *d->prev);
-        d->sym_ll = malloc(BLOCK_SYMS * sizeof *d->sym_ll);
-        d->sym_d = malloc(BLOCK_SYMS * sizeof *d->sym_d);
+        d->head = rt_malloc(HSIZE * sizeof *d->head);
+        d->prev = rt_malloc(WSIZE * sizeof *d->prev);
+        d->sym_ll = rt_malloc(BLOCK_SYMS * sizeof *d->sym_ll);
+        d->sym_d = rt_malloc(BLOCK_SYMS * sizeof *d->sym_d);
         if (!d->head || !d->prev || !d->sym_ll || !d->sym_d) {
-            free(d->head), free(d->prev), free(d->sym_ll), free(d->sym_d);
+            rt_free(d->head), rt_free(d->prev), rt_free(d->sym_ll), rt_free(d->sym_d);
             *w = d->w;
-            free(d);
+            rt_free(d);
             return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
         }
         for (int i = 0; i < HSIZE; i++)
@@ -746,8 +747,8 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     }
     bw_align(&d->w);
     *w = d->w;
-    free(d->head), free(d->prev), free(d->sym_ll), free(d->sym_d);
-    free(d);
+    rt_free(d->head), rt_free(d->prev), rt_free(d->sym_ll), rt_free(d->sym_d);
+    rt_free(d);
     if (w->failed)
         return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
     return RT_OK;
@@ -756,7 +757,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
 static rt_code append_out(bitw *w, bytebuf *out, rt_error *e)
 {
     bytebuf_append(out, w->buf, w->len);
-    free(w->buf);
+    rt_free(w->buf);
     if (out->failed)
         return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
     return RT_OK;
@@ -767,7 +768,7 @@ rt_code deflate_raw(const unsigned char *in, size_t n, int level, bytebuf *out, 
     bitw w = {0};
     rt_code c = deflate_to(in, n, level, &w, e);
     if (c) {
-        free(w.buf);
+        rt_free(w.buf);
         return c;
     }
     return append_out(&w, out, e);
@@ -785,7 +786,7 @@ rt_code deflate_zlib(const unsigned char *in, size_t n, int level, bytebuf *out,
     bw_bytes(&w, hdr, 2);
     rt_code c = deflate_to(in, n, level, &w, e);
     if (c) {
-        free(w.buf);
+        rt_free(w.buf);
         return c;
     }
     uint32_t a = deflate_adler32(1, in, n);
@@ -793,7 +794,7 @@ rt_code deflate_zlib(const unsigned char *in, size_t n, int level, bytebuf *out,
                            (unsigned char)a};
     bw_bytes(&w, tr, 4);
     if (w.failed) {
-        free(w.buf);
+        rt_free(w.buf);
         return rt_fail(e, RT_ENOMEM, "out of memory for deflate output");
     }
     return append_out(&w, out, e);

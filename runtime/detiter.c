@@ -2,6 +2,7 @@
  * (seed 003 thm 2.1: W(B) = ∪ ω_n(B); §3-2: a function set applies W_σ(k)
  * at step k). */
 #include "detiter.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -24,9 +25,9 @@ rt_code detiter_shape_make(detiter_shape *s, int dim, size_t n, const double *v,
     if (kind == DETITER_POLYLINE && n < 2)
         return rt_fail(e, RT_EINVAL, "polyline has %zu vertex (expected at least 2)", n);
     size_t np = kind == DETITER_POINTS ? n : 1;
-    s->v = malloc(rt_mul_size(n, (size_t)dim) * sizeof *s->v);
-    s->start = malloc((np + 1) * sizeof *s->start);
-    s->closed = malloc(np);
+    s->v = rt_malloc(rt_mul_size(n, (size_t)dim) * sizeof *s->v);
+    s->start = rt_malloc((np + 1) * sizeof *s->start);
+    s->closed = rt_malloc(np);
     if (!s->v || !s->start || !s->closed) {
         detiter_shape_free(s);
         return rt_fail(e, RT_ENOMEM, "out of memory for a shape of %zu vertices", n);
@@ -45,9 +46,9 @@ rt_code detiter_shape_make(detiter_shape *s, int dim, size_t n, const double *v,
 
 void detiter_shape_free(detiter_shape *s)
 {
-    free(s->v);
-    free(s->start);
-    free(s->closed);
+    rt_free(s->v);
+    rt_free(s->start);
+    rt_free(s->closed);
     memset(s, 0, sizeof *s);
 }
 
@@ -129,11 +130,11 @@ rt_code detiter_run(const fset *fs, const fset_order *o, size_t steps, const det
     if ((code = detiter_shape_make(&cur, k0->dim, k0->nverts, k0->v, DETITER_POINTS, e)))
         return code;
     /* Replace the point structure by k0's polylines. */
-    free(cur.start);
-    free(cur.closed);
+    rt_free(cur.start);
+    rt_free(cur.closed);
     cur.npoly = k0->npoly;
-    cur.start = malloc((k0->npoly + 1) * sizeof *cur.start);
-    cur.closed = malloc(k0->npoly);
+    cur.start = rt_malloc((k0->npoly + 1) * sizeof *cur.start);
+    cur.closed = rt_malloc(k0->npoly);
     if (!cur.start || !cur.closed) {
         detiter_shape_free(&cur);
         return rt_fail(e, RT_ENOMEM, "out of memory for the initial set");
@@ -145,9 +146,9 @@ rt_code detiter_run(const fset *fs, const fset_order *o, size_t steps, const det
         const fset_ifs *w = &fs->sets[fset_order_at(o, fs->n, k)];
         size_t M = (size_t)w->n;
         detiter_shape nx = {cur.dim, cur.nverts * M, NULL, cur.npoly * M, NULL, NULL};
-        nx.v = malloc(nx.nverts * (size_t)nx.dim * sizeof *nx.v);
-        nx.start = malloc((nx.npoly + 1) * sizeof *nx.start);
-        nx.closed = malloc(nx.npoly);
+        nx.v = rt_malloc(nx.nverts * (size_t)nx.dim * sizeof *nx.v);
+        nx.start = rt_malloc((nx.npoly + 1) * sizeof *nx.start);
+        nx.closed = rt_malloc(nx.npoly);
         if (!nx.v || !nx.start || !nx.closed) {
             detiter_shape_free(&nx);
             detiter_shape_free(&cur);

@@ -1,6 +1,7 @@
 /* draw.c — coverage-based antialiased strokes, discs and even–odd fills,
  * and byte-stable SVG (seed 003 Fig. 1, 3: drawing K_n). */
 #include "draw.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -98,13 +99,13 @@ static int fill_polygon(float *cov, int w, int h, const double *px, size_t n, xs
     int bx0 = xlo < 0 ? 0 : (int)xlo, bx1 = xhi >= w ? w - 1 : (int)xhi;
     int by0 = ylo < 0 ? 0 : (int)ylo, by1 = yhi >= h ? h - 1 : (int)yhi;
     int bw = bx1 - bx0 + 1;
-    double *row = malloc((size_t)bw * sizeof *row);
+    double *row = rt_malloc((size_t)bw * sizeof *row);
     if (!row)
         return -1;
     if (xs->cap < n) {
-        double *nx = realloc(xs->x, n * sizeof *nx);
+        double *nx = rt_realloc(xs->x, n * sizeof *nx);
         if (!nx) {
-            free(row);
+            rt_free(row);
             return -1;
         }
         xs->x = nx;
@@ -139,7 +140,7 @@ static int fill_polygon(float *cov, int w, int h, const double *px, size_t n, xs
             if (row[i] > 0)
                 cov_max(cov, w, bx0 + i, y, row[i] > 1 ? 1 : row[i]);
     }
-    free(row);
+    rt_free(row);
     return 0;
 }
 
@@ -153,7 +154,7 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
         return rt_fail(e, RT_EINVAL, "line width %g and point radius %g must be >= 0", st->width,
                        st->radius);
     int w = im->w, h = im->h, d = s->dim;
-    float *cov = calloc((size_t)w * (size_t)h, sizeof *cov);
+    float *cov = rt_calloc((size_t)w * (size_t)h, sizeof *cov);
     xsort xs = {NULL, 0, 0};
     double *poly = NULL;
     size_t polycap = 0;
@@ -165,7 +166,7 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
         if (n == 0)
             continue;
         if (polycap < n) {
-            double *np = realloc(poly, 2 * n * sizeof *np);
+            double *np = rt_realloc(poly, 2 * n * sizeof *np);
             if (!np) {
                 code = rt_fail(e, RT_ENOMEM, "out of memory drawing a polyline of %zu vertices", n);
                 goto done;
@@ -204,9 +205,9 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
         px[3] = px[3] + (1 - px[3]) * al;
     }
 done:
-    free(cov);
-    free(xs.x);
-    free(poly);
+    rt_free(cov);
+    rt_free(xs.x);
+    rt_free(poly);
     return code;
 }
 

@@ -1,6 +1,7 @@
 /* field.c — field graph nodes, printing, and the compiler to block
  * programs. See field.h; evaluation is in field_eval.c. */
 #include "field.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -113,8 +114,8 @@ void field_unref(field *f)
         }
         if (n->release)
             n->release(n->ctx);
-        free(n->perm);
-        free(n);
+        rt_free(n->perm);
+        rt_free(n);
     }
 }
 
@@ -126,7 +127,7 @@ static field *node_new(int kind, int op, int nkids, field *k0, field *k1, field 
     int bad = 0;
     for (int i = 0; i < nkids; i++)
         bad |= kids[i] == NULL;
-    field *f = bad ? NULL : calloc(1, sizeof *f);
+    field *f = bad ? NULL : rt_calloc(1, sizeof *f);
     if (!f) {
         for (int i = 0; i < nkids; i++)
             field_unref(kids[i]);
@@ -207,9 +208,9 @@ static field *noise_node(int kind, uint64_t seed, int octaves, double lac, doubl
     field *f = node_new(kind, 0, 0, NULL, NULL, NULL, NULL);
     if (!f)
         return NULL;
-    f->perm = malloc(sizeof *f->perm);
+    f->perm = rt_malloc(sizeof *f->perm);
     if (!f->perm) {
-        free(f);
+        rt_free(f);
         return NULL;
     }
     noise_perm_init(f->perm, seed);
@@ -453,7 +454,7 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     size_t nc = *cap ? *cap * 2 : 64;
     while (nc < need)
         nc *= 2;
-    void *q = realloc(*p, rt_mul_size(nc, elem));
+    void *q = rt_realloc(*p, rt_mul_size(nc, elem));
     if (!q)
         return 0;
     *p = q;
@@ -491,7 +492,7 @@ static int tab_put(comp *c, uint64_t a, uint64_t b, int v)
 {
     if ((c->tabn + 1) * 2 > c->tabcap) {
         size_t nc = c->tabcap ? c->tabcap * 2 : 256;
-        slot *t = malloc(rt_mul_size(nc, sizeof *t));
+        slot *t = rt_malloc(rt_mul_size(nc, sizeof *t));
         if (!t)
             return 0;
         for (size_t i = 0; i < nc; i++)
@@ -504,7 +505,7 @@ static int tab_put(comp *c, uint64_t a, uint64_t b, int v)
                 i = (i + 1) & (nc - 1);
             t[i] = c->tab[j];
         }
-        free(c->tab);
+        rt_free(c->tab);
         c->tab = t;
         c->tabcap = nc;
     }
@@ -680,23 +681,23 @@ void field_prog_free(field_prog *p)
     if (!p)
         return;
     field_unref(p->root);
-    free(p->code);
-    free(p->consts);
-    free(p);
+    rt_free(p->code);
+    rt_free(p->consts);
+    rt_free(p);
 }
 
 /* Pass 2: dead code, constants, register reuse. */
 static field_prog *allocate(comp *c, int result)
 {
     size_t nv = c->nval;
-    int *phys = malloc(rt_mul_size(nv, sizeof *phys));
-    int *last = malloc(rt_mul_size(nv, sizeof *last));
-    char *live = calloc(nv ? nv : 1, 1);
-    field_prog *p = calloc(1, sizeof *p);
-    int *freel = malloc(rt_mul_size(c->ncode + 1, sizeof *freel));
-    double *consts = malloc(rt_mul_size(nv, sizeof *consts));
+    int *phys = rt_malloc(rt_mul_size(nv, sizeof *phys));
+    int *last = rt_malloc(rt_mul_size(nv, sizeof *last));
+    char *live = rt_calloc(nv ? nv : 1, 1);
+    field_prog *p = rt_calloc(1, sizeof *p);
+    int *freel = rt_malloc(rt_mul_size(c->ncode + 1, sizeof *freel));
+    double *consts = rt_malloc(rt_mul_size(nv, sizeof *consts));
     if (!phys || !last || !live || !p || !freel || !consts) {
-        free(phys), free(last), free(live), free(p), free(freel), free(consts);
+        rt_free(phys), rt_free(last), rt_free(live), rt_free(p), rt_free(freel), rt_free(consts);
         oom(c);
         return NULL;
     }
@@ -756,7 +757,7 @@ static field_prog *allocate(comp *c, int result)
     p->ntemp = ntemp;
     p->consts = consts;
     p->result = phys[result];
-    free(phys), free(last), free(live), free(freel);
+    rt_free(phys), rt_free(last), rt_free(live), rt_free(freel);
     return p;
 }
 
@@ -780,10 +781,10 @@ field_prog *field_compile(const field *root, rt_error *e)
         p->root = field_ref((field *)root);
     else if (!c.err)
         oom(&c);
-    free(c.code);
-    free(c.val);
-    free(c.tab);
-    free(c.frame);
+    rt_free(c.code);
+    rt_free(c.val);
+    rt_free(c.tab);
+    rt_free(c.frame);
     return p;
 }
 

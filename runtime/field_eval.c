@@ -1,6 +1,7 @@
 /* field_eval.c — running compiled field programs over blocks of points,
  * and filling volumes from fields. See field.h. */
 #include "field.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -127,7 +128,7 @@ static void run_blocks(const field_prog *p, double *scratch, size_t blk, size_t 
 {
     size_t nr = 3 + p->nconst + p->ntemp;
     double *regbuf[3 + 256];
-    double **reg = nr <= 3 + 256 ? regbuf : malloc(nr * sizeof *reg);
+    double **reg = nr <= 3 + 256 ? regbuf : rt_malloc(nr * sizeof *reg);
     if (!reg) {
         for (size_t i = 0; i < n; i++)
             out[i] = NAN;
@@ -147,7 +148,7 @@ static void run_blocks(const field_prog *p, double *scratch, size_t blk, size_t 
         memcpy(out + s, reg[p->result], m * sizeof *out);
     }
     if (reg != regbuf)
-        free(reg);
+        rt_free(reg);
 }
 
 void field_prog_eval_scratch(const field_prog *p, double *scratch, size_t n, const double *x,
@@ -168,14 +169,14 @@ void field_prog_eval(const field_prog *p, size_t n, const double *x, const doubl
         run_blocks(p, stack, blk, n, x, y, z, out);
         return;
     }
-    double *heap = malloc(rt_mul_size(nr, RT_BLOCK) * sizeof *heap);
+    double *heap = rt_malloc(rt_mul_size(nr, RT_BLOCK) * sizeof *heap);
     if (!heap) {
         for (size_t i = 0; i < n; i++)
             out[i] = NAN;
         return;
     }
     run_blocks(p, heap, RT_BLOCK, n, x, y, z, out);
-    free(heap);
+    rt_free(heap);
 }
 
 void field_prog_fn(const void *prog, size_t n, const double *x, const double *y, const double *z,

@@ -1,6 +1,7 @@
 /* fileio.c — whole-file reads, atomic writes, byte buffers. */
 #define _POSIX_C_SOURCE 200809L
 #include "fileio.h"
+#include "rt_alloc.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -293,7 +294,7 @@ rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data
     if (!f)
         return rt_fail(e, RT_EIO, "cannot open '%s': %s", path, strerror(errno));
     size_t cap = 1 << 16, len = 0;
-    unsigned char *buf = malloc(cap + 1);
+    unsigned char *buf = rt_malloc(cap + 1);
     if (!buf) {
         fclose(f);
         return rt_fail(e, RT_ENOMEM, "out of memory");
@@ -301,14 +302,14 @@ rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data
     for (;;) {
         if (len == cap) {
             if (cap >= max_bytes) {
-                free(buf);
+                rt_free(buf);
                 fclose(f);
                 return rt_fail(e, RT_EIO, "'%s' is larger than %zu bytes", path, max_bytes);
             }
             size_t ncap = cap * 2 > max_bytes ? max_bytes : cap * 2;
-            unsigned char *nb = realloc(buf, ncap + 1);
+            unsigned char *nb = rt_realloc(buf, ncap + 1);
             if (!nb) {
-                free(buf);
+                rt_free(buf);
                 fclose(f);
                 return rt_fail(e, RT_ENOMEM, "out of memory reading '%s'", path);
             }
@@ -320,7 +321,7 @@ rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data
         if (r == 0) {
             if (ferror(f)) {
                 int err = errno;
-                free(buf);
+                rt_free(buf);
                 fclose(f);
                 return rt_fail(e, RT_EIO, "cannot read '%s': %s", path, strerror(err));
             }
@@ -343,7 +344,7 @@ void bytebuf_init(bytebuf *b)
 
 void bytebuf_free(bytebuf *b)
 {
-    free(b->data);
+    rt_free(b->data);
     bytebuf_init(b);
 }
 
@@ -360,7 +361,7 @@ void bytebuf_append(bytebuf *b, const void *p, size_t n)
             }
             ncap *= 2;
         }
-        unsigned char *nd = realloc(b->data, ncap);
+        unsigned char *nd = rt_realloc(b->data, ncap);
         if (!nd) {
             b->failed = 1;
             return;
@@ -387,7 +388,7 @@ void bytebuf_printf(bytebuf *b, const char *fmt, ...)
         bytebuf_append(b, small, (size_t)k);
         return;
     }
-    char *big = malloc((size_t)k + 1);
+    char *big = rt_malloc((size_t)k + 1);
     if (!big) {
         b->failed = 1;
         return;
@@ -396,7 +397,7 @@ void bytebuf_printf(bytebuf *b, const char *fmt, ...)
     vsnprintf(big, (size_t)k + 1, fmt, ap);
     va_end(ap);
     bytebuf_append(b, big, (size_t)k);
-    free(big);
+    rt_free(big);
 }
 
 void bytebuf_u16be(bytebuf *b, unsigned v)

@@ -1,5 +1,6 @@
 /* fractint.c — parser for Fractint .ifs files (format in fractint.h). */
 #include "fractint.h"
+#include "rt_alloc.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -42,10 +43,10 @@ static int is_tok_end(char c)
 void fractint_free(fractint_list *l)
 {
     for (int i = 0; i < l->n; i++) {
-        free(l->e[i].maps);
-        free(l->e[i].p);
+        rt_free(l->e[i].maps);
+        rt_free(l->e[i].p);
     }
-    free(l->e);
+    rt_free(l->e);
     l->e = NULL;
     l->n = 0;
 }
@@ -88,7 +89,7 @@ static rt_code parse_entry(scan *sc, fractint_entry *en, rt_error *e)
     for (;;) {
         skip_blank(sc);
         if (sc->pos >= sc->len) {
-            free(num);
+            rt_free(num);
             return rt_fail(e, RT_EFORMAT, "line %d: entry '%s' opened at line %d is not closed with '}'",
                            sc->line, en->name, open_line);
         }
@@ -109,15 +110,15 @@ static rt_code parse_entry(scan *sc, fractint_entry *en, rt_error *e)
         char *endp;
         double v = strtod(tok, &endp);
         if (tl >= sizeof tok || endp == tok || *endp || !isfinite(v)) {
-            free(num);
+            rt_free(num);
             return rt_fail(e, RT_EFORMAT, "line %d: expected a number or '}', found '%s'", sc->line,
                            tok);
         }
         if (nnum == cap) {
             cap = cap ? 2 * cap : 64;
-            double *nn = realloc(num, cap * sizeof *num);
+            double *nn = rt_realloc(num, cap * sizeof *num);
             if (!nn) {
-                free(num);
+                rt_free(num);
                 return rt_fail(e, RT_ENOMEM, "out of memory reading an .ifs file");
             }
             num = nn;
@@ -126,19 +127,19 @@ static rt_code parse_entry(scan *sc, fractint_entry *en, rt_error *e)
     }
     size_t row = en->dim == 2 ? 7 : 13;
     if (nnum == 0) {
-        free(num);
+        rt_free(num);
         return rt_fail(e, RT_EFORMAT, "line %d: entry '%s' has no maps", sc->line, en->name);
     }
     if (nnum % row) {
-        free(num);
+        rt_free(num);
         return rt_fail(e, RT_EFORMAT, "line %d: entry '%s' has %zu numbers, not a whole number of %zu-number rows",
                        sc->line, en->name, nnum, row);
     }
     en->n = (int)(nnum / row);
-    en->maps = malloc(sizeof *en->maps * (size_t)en->n);
-    en->p = malloc(sizeof *en->p * (size_t)en->n);
+    en->maps = rt_malloc(sizeof *en->maps * (size_t)en->n);
+    en->p = rt_malloc(sizeof *en->p * (size_t)en->n);
     if (!en->maps || !en->p) {
-        free(num);
+        rt_free(num);
         return rt_fail(e, RT_ENOMEM, "out of memory reading an .ifs file");
     }
     for (int i = 0; i < en->n; i++) {
@@ -151,7 +152,7 @@ static rt_code parse_entry(scan *sc, fractint_entry *en, rt_error *e)
             en->p[i] = r[12];
         }
     }
-    free(num);
+    rt_free(num);
     return RT_OK;
 }
 
@@ -167,7 +168,7 @@ rt_code fractint_parse(const char *text, size_t len, fractint_list *out, rt_erro
             return RT_OK;
         if (out->n == cap) {
             cap = cap ? 2 * cap : 8;
-            fractint_entry *ne = realloc(out->e, sizeof *ne * (size_t)cap);
+            fractint_entry *ne = rt_realloc(out->e, sizeof *ne * (size_t)cap);
             if (!ne) {
                 fractint_free(out);
                 return rt_fail(e, RT_ENOMEM, "out of memory reading an .ifs file");
@@ -195,7 +196,7 @@ rt_code fractint_load(const char *path, fractint_list *out, rt_error *e)
     if (rc)
         return rc;
     rc = fractint_parse((const char *)data, n, out, e);
-    free(data);
+    rt_free(data);
     return rc;
 }
 

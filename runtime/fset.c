@@ -1,6 +1,7 @@
 /* fset.c — iterated function sets (seed 003 def. 3.1, 3.2), their orders,
  * the composition-notation parser and the chaos game with an order. */
 #include "fset.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -250,7 +251,7 @@ rt_code fset_order_parse(const char *text, int nsets, int **seq, int *len, size_
         }
         if (n == cap) {
             cap = cap ? 2 * cap : 16;
-            int *nv = realloc(v, cap * sizeof *nv);
+            int *nv = rt_realloc(v, cap * sizeof *nv);
             if (!nv) {
                 code = rt_fail(e, RT_ENOMEM, "out of memory parsing an order");
                 goto fail;
@@ -292,7 +293,7 @@ rt_code fset_order_parse(const char *text, int nsets, int **seq, int *len, size_
     *len = (int)n;
     return RT_OK;
 fail:
-    free(v);
+    rt_free(v);
     if (err_offset)
         *err_offset = char_offset(&sc, bad);
     return code;
@@ -367,7 +368,7 @@ static void chaos_walk(void *p, size_t chunk, int worker)
     uint64_t *cnt = c->count[worker];
     uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
     size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
-    double *pt = malloc(n * 2 * sizeof *pt);
+    double *pt = rt_malloc(n * 2 * sizeof *pt);
     if (!pt) {
         c->failed = 1;
         return;
@@ -392,7 +393,7 @@ static void chaos_walk(void *p, size_t chunk, int worker)
         if (b >= 0)
             cnt[b]++;
     }
-    free(pt);
+    rt_free(pt);
 }
 
 rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, hist2 *hs,
@@ -422,8 +423,8 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
     size_t nchunks = (size_t)((opts->points + per - 1) / per);
     int nw = par_workers(run, nchunks);
     size_t nbins = (size_t)hs->w * (size_t)hs->h;
-    c.cum = malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
-    c.count = calloc((size_t)nw, sizeof *c.count);
+    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.count = rt_calloc((size_t)nw, sizeof *c.count);
     if (!c.cum || !c.count) {
         code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
         goto done;
@@ -431,7 +432,7 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
     for (int s = 0; s < fs->n; s++)
         fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
     for (int i = 0; i < nw; i++) {
-        c.count[i] = calloc(nbins, sizeof **c.count);
+        c.count[i] = rt_calloc(nbins, sizeof **c.count);
         if (!c.count[i]) {
             code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread histograms", nw);
             goto done;
@@ -452,8 +453,8 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
 done:
     if (c.count)
         for (int i = 0; i < nw; i++)
-            free(c.count[i]);
-    free(c.count);
-    free(c.cum);
+            rt_free(c.count[i]);
+    rt_free(c.count);
+    rt_free(c.cum);
     return code;
 }

@@ -2,6 +2,7 @@
  * IFS: seed 003 §2; RIFS conditions (i) rows sum to 1, (ii) irreducible:
  * seed 001 §2. Alias method: Walker (1977), Vose (1991). */
 #include "ifs.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,15 +21,15 @@ rt_code ifs_alias_build(ifs_alias *a, const double *w, int n, rt_error *e)
         sum += w[i];
     if (n < 1 || !(sum > 0))
         return rt_fail(e, RT_EINVAL, "probabilities are all 0");
-    double *q = malloc(sizeof *q * (size_t)n);
-    int *small = malloc(sizeof *small * (size_t)n);
-    int *large = malloc(sizeof *large * (size_t)n);
-    a->thresh = malloc(sizeof *a->thresh * (size_t)n);
-    a->sel = malloc(sizeof *a->sel * 2 * (size_t)n);
+    double *q = rt_malloc(sizeof *q * (size_t)n);
+    int *small = rt_malloc(sizeof *small * (size_t)n);
+    int *large = rt_malloc(sizeof *large * (size_t)n);
+    a->thresh = rt_malloc(sizeof *a->thresh * (size_t)n);
+    a->sel = rt_malloc(sizeof *a->sel * 2 * (size_t)n);
     if (!q || !small || !large || !a->thresh || !a->sel) {
-        free(q);
-        free(small);
-        free(large);
+        rt_free(q);
+        rt_free(small);
+        rt_free(large);
         ifs_alias_free(a);
         return rt_fail(e, RT_ENOMEM, "out of memory for an alias table");
     }
@@ -69,16 +70,16 @@ rt_code ifs_alias_build(ifs_alias *a, const double *w, int n, rt_error *e)
         a->sel[2 * s] = a->sel[2 * s + 1] = (uint32_t)s;
     }
     a->n = n;
-    free(q);
-    free(small);
-    free(large);
+    rt_free(q);
+    rt_free(small);
+    rt_free(large);
     return RT_OK;
 }
 
 void ifs_alias_free(ifs_alias *a)
 {
-    free(a->thresh);
-    free(a->sel);
+    rt_free(a->thresh);
+    rt_free(a->sel);
     a->thresh = NULL;
     a->sel = NULL;
     a->n = 0;
@@ -151,7 +152,7 @@ rt_code ifs_check_maps(const affine *maps, int n, int allow_expanding, int *dim,
 
 static affine *copy_maps(const affine *maps, int n)
 {
-    affine *m = malloc(sizeof *m * (size_t)n);
+    affine *m = rt_malloc(sizeof *m * (size_t)n);
     if (m)
         memcpy(m, maps, sizeof *m * (size_t)n);
     return m;
@@ -170,25 +171,25 @@ rt_code ifs_build(ifs *out, const affine *maps, int n, const double *p, int flag
      * probability typo is reported before a norm). */
     if ((rc = ifs_check_maps(maps, n, 1, &dim, &maxc, &worst, warn, e)))
         return rc;
-    double *q = malloc(sizeof *q * (size_t)n);
+    double *q = rt_malloc(sizeof *q * (size_t)n);
     if (!q)
         return rt_fail(e, RT_ENOMEM, "out of memory for an IFS");
     if (p) {
         double sum = 0;
         for (int i = 0; i < n; i++) {
             if (!(p[i] >= 0) || !isfinite(p[i])) {
-                free(q);
+                rt_free(q);
                 return rt_fail(e, RT_EINVAL, "probability %d is %.6g (expected >= 0)", i + 1, p[i]);
             }
             sum += p[i];
         }
         if (!(fabs(sum - 1) <= IFS_SUM_TOL) && !(flags & IFS_NORMALISE)) {
-            free(q);
+            rt_free(q);
             return rt_fail(e, RT_EINVAL,
                            "probabilities sum to %.10g, not 1 (use normalize: true to rescale them)", sum);
         }
         if (!(sum > 0)) {
-            free(q);
+            rt_free(q);
             return rt_fail(e, RT_EINVAL, "probabilities are all 0");
         }
         for (int i = 0; i < n; i++)
@@ -213,17 +214,17 @@ rt_code ifs_build(ifs *out, const affine *maps, int n, const double *p, int flag
             q[i] /= sum;
     }
     if (!(maxc < 1) && !(flags & IFS_ALLOW_EXPANDING)) {
-        free(q);
+        rt_free(q);
         return rt_fail(e, RT_EINVAL, "%s", warn);
     }
     out->maps = copy_maps(maps, n);
     if (!out->maps) {
-        free(q);
+        rt_free(q);
         return rt_fail(e, RT_ENOMEM, "out of memory for an IFS");
     }
     if ((rc = ifs_alias_build(&out->alias, q, n, e))) {
-        free(q);
-        free(out->maps);
+        rt_free(q);
+        rt_free(out->maps);
         out->maps = NULL;
         return rc;
     }
@@ -238,8 +239,8 @@ rt_code ifs_build(ifs *out, const affine *maps, int n, const double *p, int flag
 
 void ifs_free(ifs *f)
 {
-    free(f->maps);
-    free(f->p);
+    rt_free(f->maps);
+    rt_free(f->p);
     ifs_alias_free(&f->alias);
     memset(f, 0, sizeof *f);
 }
@@ -294,10 +295,10 @@ static int graph_succ(const graph *g, int v, int k)
 static int tarjan(const graph *g, int *comp)
 {
     int V = g->V;
-    int *idx = malloc(sizeof *idx * (size_t)V), *low = malloc(sizeof *low * (size_t)V);
-    int *stk = malloc(sizeof *stk * (size_t)V), *cs = malloc(sizeof *cs * (size_t)V);
-    int *ck = malloc(sizeof *ck * (size_t)V);
-    unsigned char *on = calloc((size_t)V, 1);
+    int *idx = rt_malloc(sizeof *idx * (size_t)V), *low = rt_malloc(sizeof *low * (size_t)V);
+    int *stk = rt_malloc(sizeof *stk * (size_t)V), *cs = rt_malloc(sizeof *cs * (size_t)V);
+    int *ck = rt_malloc(sizeof *ck * (size_t)V);
+    unsigned char *on = rt_calloc((size_t)V, 1);
     int ncomp = -1;
     if (!idx || !low || !stk || !cs || !ck || !on)
         goto done;
@@ -350,12 +351,12 @@ static int tarjan(const graph *g, int *comp)
         }
     }
 done:
-    free(idx);
-    free(low);
-    free(stk);
-    free(cs);
-    free(ck);
-    free(on);
+    rt_free(idx);
+    rt_free(low);
+    rt_free(stk);
+    rt_free(cs);
+    rt_free(ck);
+    rt_free(on);
     return ncomp;
 }
 
@@ -364,9 +365,9 @@ void rifs_free(rifs *r)
     if (r->row)
         for (int i = 0; i < r->rows; i++)
             ifs_alias_free(&r->row[i]);
-    free(r->row);
-    free(r->maps);
-    free(r->P);
+    rt_free(r->row);
+    rt_free(r->maps);
+    rt_free(r->P);
     memset(r, 0, sizeof *r);
 }
 
@@ -374,11 +375,11 @@ void rifs_free(rifs *r)
 static rt_code check_irreducible1(const rifs *r, rt_error *e)
 {
     int n = r->n;
-    int *queue = malloc(sizeof *queue * (size_t)n);
-    unsigned char *seen = malloc((size_t)n);
+    int *queue = rt_malloc(sizeof *queue * (size_t)n);
+    unsigned char *seen = rt_malloc((size_t)n);
     if (!queue || !seen) {
-        free(queue);
-        free(seen);
+        rt_free(queue);
+        rt_free(seen);
         return rt_fail(e, RT_ENOMEM, "out of memory checking a RIFS");
     }
     rt_code rc = RT_OK;
@@ -404,8 +405,8 @@ static rt_code check_irreducible1(const rifs *r, rt_error *e)
                 break;
             }
     }
-    free(queue);
-    free(seen);
+    rt_free(queue);
+    rt_free(seen);
     return rc;
 }
 
@@ -424,19 +425,19 @@ static rt_code check_irreducible2(rifs *r, const unsigned char *used, rt_error *
                                v / n + 1, v % n + 1, k + 1, w / n + 1, w % n + 1);
         }
     }
-    int *comp = malloc(sizeof *comp * (size_t)V);
+    int *comp = rt_malloc(sizeof *comp * (size_t)V);
     if (!comp)
         return rt_fail(e, RT_ENOMEM, "out of memory checking a RIFS");
     graph g = {V, n, 2, r->P, used};
     int nc = tarjan(&g, comp);
     if (nc < 0) {
-        free(comp);
+        rt_free(comp);
         return rt_fail(e, RT_ENOMEM, "out of memory checking a RIFS");
     }
     /* closed components: no edge leaves them */
-    unsigned char *open = calloc((size_t)nc + 1, 1);
+    unsigned char *open = rt_calloc((size_t)nc + 1, 1);
     if (!open) {
-        free(comp);
+        rt_free(comp);
         return rt_fail(e, RT_ENOMEM, "out of memory checking a RIFS");
     }
     for (int v = 0; v < V; v++) {
@@ -464,7 +465,7 @@ static rt_code check_irreducible2(rifs *r, const unsigned char *used, rt_error *
         rc = rt_fail(e, RT_EINVAL, "matrix is not irreducible: pair (%d, %d) cannot reach pair (%d, %d)",
                      first / n + 1, first % n + 1, second / n + 1, second % n + 1);
     } else {
-        unsigned char *occurs = calloc((size_t)n, 1);
+        unsigned char *occurs = rt_calloc((size_t)n, 1);
         if (!occurs) {
             rc = rt_fail(e, RT_ENOMEM, "out of memory checking a RIFS");
         } else {
@@ -476,12 +477,12 @@ static rt_code check_irreducible2(rifs *r, const unsigned char *used, rt_error *
                     rc = rt_fail(e, RT_EINVAL, "map %d never occurs in the recurrent pairs", k + 1);
                     break;
                 }
-            free(occurs);
+            rt_free(occurs);
         }
         r->start = first;
     }
-    free(open);
-    free(comp);
+    rt_free(open);
+    rt_free(comp);
     return rc;
 }
 
@@ -510,10 +511,10 @@ rt_code rifs_build(rifs *out, const affine *maps, int n, int order, const double
             return rt_fail(e, RT_EINVAL, "matrix entry row %s, column %d is %.6g (expected >= 0)",
                            name, (int)(c % (size_t)n) + 1, P[c]);
         }
-    out->P = malloc(sizeof *out->P * cells);
-    unsigned char *used = malloc((size_t)rows);
+    out->P = rt_malloc(sizeof *out->P * cells);
+    unsigned char *used = rt_malloc((size_t)rows);
     if (!out->P || !used) {
-        free(used);
+        rt_free(used);
         rifs_free(out);
         return rt_fail(e, RT_ENOMEM, "out of memory for a RIFS");
     }
@@ -527,7 +528,7 @@ rt_code rifs_build(rifs *out, const affine *maps, int n, int order, const double
         used[r] = sum > 0;
         if (!(sum > 0)) {
             if (order == 1) {
-                free(used);
+                rt_free(used);
                 rifs_free(out);
                 return rt_fail(e, RT_EINVAL, "row %d is all zero (the chain cannot leave state %d)",
                                r + 1, r + 1);
@@ -547,7 +548,7 @@ rt_code rifs_build(rifs *out, const affine *maps, int n, int order, const double
             out->P[(size_t)r * n + k] = P[(size_t)r * n + k] / sum;
     }
     if (nbad) {
-        free(used);
+        rt_free(used);
         rifs_free(out);
         return rt_fail(e, RT_EINVAL, "%s (each row must sum to 1%s)", bad,
                        order == 2 ? ", or be all zero for an unused pair" : "");
@@ -560,14 +561,14 @@ rt_code rifs_build(rifs *out, const affine *maps, int n, int order, const double
         rc = rt_fail(e, RT_EINVAL, "%s", warn);
     if (!rc) {
         out->maps = copy_maps(maps, n);
-        out->row = calloc((size_t)rows, sizeof *out->row);
+        out->row = rt_calloc((size_t)rows, sizeof *out->row);
         if (!out->maps || !out->row)
             rc = rt_fail(e, RT_ENOMEM, "out of memory for a RIFS");
     }
     for (int r = 0; !rc && r < rows; r++)
         if (used[r])
             rc = ifs_alias_build(&out->row[r], out->P + (size_t)r * n, n, e);
-    free(used);
+    rt_free(used);
     if (rc) {
         rifs_free(out);
         return rc;
@@ -582,10 +583,10 @@ rt_code rifs_build(rifs *out, const affine *maps, int n, int order, const double
 rt_code rifs_stationary(const rifs *r, double *pi, rt_error *e)
 {
     int n = r->n, S = r->rows;
-    double *a = malloc(sizeof *a * (size_t)S), *b = malloc(sizeof *b * (size_t)S);
+    double *a = rt_malloc(sizeof *a * (size_t)S), *b = rt_malloc(sizeof *b * (size_t)S);
     if (!a || !b) {
-        free(a);
-        free(b);
+        rt_free(a);
+        rt_free(b);
         return rt_fail(e, RT_ENOMEM, "out of memory for a stationary distribution");
     }
     for (int s = 0; s < S; s++)
@@ -616,7 +617,7 @@ rt_code rifs_stationary(const rifs *r, double *pi, rt_error *e)
         pi[k] = 0;
     for (int s = 0; s < S; s++)
         pi[s % n] += a[s];
-    free(a);
-    free(b);
+    rt_free(a);
+    rt_free(b);
     return RT_OK;
 }

@@ -1,6 +1,7 @@
 /* image.c — allocation of the float RGBA image. Codecs live in png.c, pnm.c;
  * image_save/image_load dispatch by extension in image_io.c. */
 #include "image.h"
+#include "rt_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -14,7 +15,7 @@ rt_code image_init(image *im, int w, int h, rt_error *e)
     size_t n = rt_mul_size(rt_mul_size((size_t)w, (size_t)h), 4 * sizeof(float));
     if (n == 0)
         return rt_fail(e, RT_ENOMEM, "image size %d×%d is too large", w, h);
-    im->px = calloc(1, n);
+    im->px = rt_calloc(1, n);
     if (!im->px)
         return rt_fail(e, RT_ENOMEM, "out of memory for a %d×%d image", w, h);
     im->w = w;
@@ -24,7 +25,7 @@ rt_code image_init(image *im, int w, int h, rt_error *e)
 
 void image_free(image *im)
 {
-    free(im->px);
+    rt_free(im->px);
     im->px = NULL;
     im->w = im->h = 0;
 }

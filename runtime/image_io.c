@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "image.h"
+#include "rt_alloc.h"
 #include "fileio.h"
 #include "png.h"
 #include "pnm.h"
@@ -73,6 +74,6 @@ rt_code image_load(image *im, const char *path, rt_error *e)
         memcpy(m, e->msg, sizeof m);
         rt_fail(e, c, "'%s': %s", path, m);
     }
-    free(d);
+    rt_free(d);
     return c;
 }

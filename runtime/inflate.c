@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "deflate.h"
+#include "rt_alloc.h"
 
 #define FAST 10
 #define MAXBITS 15
@@ -167,7 +168,7 @@ static rt_code room(inf *s, size_t k)
         ncap = ncap > SIZE_MAX / 2 ? want : ncap * 2;
     if (ncap - s->base > s->max) /* do not reserve beyond the cap */
         ncap = s->base + s->max;
-    unsigned char *nd = realloc(o->data, ncap);
+    unsigned char *nd = rt_realloc(o->data, ncap);
     if (!nd)
         return rt_fail(s->e, RT_ENOMEM, "out of memory for decompressed data");
     o->data = nd;
@@ -265,7 +266,7 @@ static rt_code codes(inf *s, const huff *lh, const huff *dh)
 static rt_code fixed_block(inf *s)
 {
     uint8_t len[288];
-    huff *t = malloc(2 * sizeof *t);
+    huff *t = rt_malloc(2 * sizeof *t);
     if (!t)
         return rt_fail(s->e, RT_ENOMEM, "out of memory");
     for (int i = 0; i < 288; i++)
@@ -277,7 +278,7 @@ static rt_code fixed_block(inf *s)
         c = huff_build(s, &t[1], len, 32, "distance", 1);
     if (!c)
         c = codes(s, &t[0], &t[1]);
-    free(t);
+    rt_free(t);
     return c;
 }
 
@@ -296,7 +297,7 @@ static rt_code dynamic_block(inf *s)
         return rt_fail(s->e, RT_EFORMAT, "too many literal/length codes (%u, at most 286)", hlit);
     if (hdist > 30)
         return rt_fail(s->e, RT_EFORMAT, "too many distance codes (%u, at most 30)", hdist);
-    huff *t = malloc(2 * sizeof *t);
+    huff *t = rt_malloc(2 * sizeof *t);
     if (!t)
         return rt_fail(s->e, RT_ENOMEM, "out of memory");
     uint8_t len[286 + 30];
@@ -357,7 +358,7 @@ static rt_code dynamic_block(inf *s)
         goto done;
     c = codes(s, &t[0], &t[1]);
 done:
-    free(t);
+    rt_free(t);
     return c;
 }
 

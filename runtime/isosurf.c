@@ -20,6 +20,7 @@
  * both agree without communicating.
  */
 #include "isosurf.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -316,11 +317,11 @@ static void pass_count(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     int z0, z1;
     chunk_range(j, c, &z0, &z1);
-    unsigned char *in0 = malloc(j->lsz), *in1 = malloc(j->lsz);
+    unsigned char *in0 = rt_malloc(j->lsz), *in1 = rt_malloc(j->lsz);
     if (!in0 || !in1) {
         j->failed[c] = 1;
-        free(in0);
-        free(in1);
+        rt_free(in0);
+        rt_free(in1);
         return;
     }
     size_t cnt = 0;
@@ -340,8 +341,8 @@ static void pass_count(void *ctx, size_t c, int worker)
         in1 = t;
     }
     j->counts[c] = cnt;
-    free(in0);
-    free(in1);
+    rt_free(in0);
+    rt_free(in1);
 }
 
 static void push_tri(tri_list *L, uint32_t a, uint32_t b, uint32_t c)
@@ -350,7 +351,7 @@ static void push_tri(tri_list *L, uint32_t a, uint32_t b, uint32_t c)
         return;
     if (L->n == L->cap) {
         size_t nc = L->cap ? L->cap * 2 : 1024;
-        uint32_t *nt = realloc(L->t, nc * 3 * sizeof(uint32_t));
+        uint32_t *nt = rt_realloc(L->t, nc * 3 * sizeof(uint32_t));
         if (!nt) {
             L->failed = 1;
             return;
@@ -373,11 +374,11 @@ static void pass_build(void *ctx, size_t c, int worker)
     size_t lsz = j->lsz, w = (size_t)j->NXp;
     unsigned char *ins[3];
     uint32_t *ids[2];
-    ins[0] = malloc(lsz);
-    ins[1] = malloc(lsz);
-    ins[2] = malloc(lsz);
-    ids[0] = malloc(lsz * 7 * sizeof(uint32_t));
-    ids[1] = malloc(lsz * 7 * sizeof(uint32_t));
+    ins[0] = rt_malloc(lsz);
+    ins[1] = rt_malloc(lsz);
+    ins[2] = rt_malloc(lsz);
+    ids[0] = rt_malloc(lsz * 7 * sizeof(uint32_t));
+    ids[1] = rt_malloc(lsz * 7 * sizeof(uint32_t));
     tri_list *L = &j->lists[c];
     if (!ins[0] || !ins[1] || !ins[2] || !ids[0] || !ids[1]) {
         j->failed[c] = 1;
@@ -422,11 +423,11 @@ static void pass_build(void *ctx, size_t c, int worker)
         ids[1] = ti2;
     }
 done:
-    free(ins[0]);
-    free(ins[1]);
-    free(ins[2]);
-    free(ids[0]);
-    free(ids[1]);
+    rt_free(ins[0]);
+    rt_free(ins[1]);
+    rt_free(ins[2]);
+    rt_free(ids[0]);
+    rt_free(ids[1]);
 }
 
 /* Concatenate the chunks' triangle lists (in chunk order, at fixed offsets). */
@@ -436,7 +437,7 @@ static void pass_concat(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     if (j->lists[c].n)
         memcpy(j->tri_out + 3 * j->tri_at[c], j->lists[c].t, j->lists[c].n * 3 * sizeof(uint32_t));
-    free(j->lists[c].t);
+    rt_free(j->lists[c].t);
     j->lists[c].t = NULL;
 }
 
@@ -554,7 +555,7 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
             return rt_fail(e, RT_EINVAL, "isosurface bounds along %c: lo %g is not below hi %g",
                            axn[a], vol->lo[a], vol->hi[a]);
     }
-    iso_job *j = calloc(1, sizeof *j);
+    iso_job *j = rt_calloc(1, sizeof *j);
     if (!j)
         return rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
     j->vol = vol;
@@ -571,9 +572,9 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         j->doff[d] = (size_t)(d & 1) + (size_t)(d >> 1 & 1) * (size_t)j->NXp;
     build_table(&j->tb);
     j->nchunks = (size_t)(vol->nz + 1 + SLAB - 1) / SLAB;
-    j->counts = calloc(j->nchunks + 1, sizeof(size_t));
-    j->lists = calloc(j->nchunks, sizeof(tri_list));
-    j->failed = calloc(j->nchunks, sizeof(int));
+    j->counts = rt_calloc(j->nchunks + 1, sizeof(size_t));
+    j->lists = rt_calloc(j->nchunks, sizeof(tri_list));
+    j->failed = rt_calloc(j->nchunks, sizeof(int));
     size_t nv = 0, nt = 0;
     if (!j->counts || !j->lists || !j->failed) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
@@ -595,10 +596,10 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         rc = rt_fail(e, RT_EINVAL, "isosurface has %zu vertices, more than a mesh can index", nv);
         goto done;
     }
-    j->pos = malloc((nv ? nv : 1) * 3 * sizeof(float));
-    j->cap = malloc(nv ? nv : 1);
+    j->pos = rt_malloc((nv ? nv : 1) * 3 * sizeof(float));
+    j->cap = rt_malloc(nv ? nv : 1);
     if (j->want_normals)
-        j->nrm = malloc((nv ? nv : 1) * 3 * sizeof(float));
+        j->nrm = rt_malloc((nv ? nv : 1) * 3 * sizeof(float));
     if (!j->pos || !j->cap || (j->want_normals && !j->nrm)) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface vertices", nv);
         goto done;
@@ -614,8 +615,8 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         nt += j->lists[c].n;
     }
     /* Hand the arrays to the mesh. */
-    free(out->pos);
-    free(out->nrm);
+    rt_free(out->pos);
+    rt_free(out->nrm);
     out->pos = j->pos;
     j->pos = NULL;
     if (j->want_normals) {
@@ -626,21 +627,21 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     }
     out->nv = out->cap_v = nv;
     if (colours) {
-        free(out->col);
-        out->col = malloc((nv ? nv : 1) * 4 * sizeof(float));
+        rt_free(out->col);
+        out->col = rt_malloc((nv ? nv : 1) * 4 * sizeof(float));
         if (!out->col) {
             rc = rt_fail(e, RT_ENOMEM, "out of memory for isosurface colours");
             goto done;
         }
     }
-    out->tri = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
+    out->tri = rt_malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
     if (!out->tri) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface triangles", nt);
         goto done;
     }
     out->nt = out->cap_t = nt;
     j->tri_out = out->tri;
-    j->tri_at = calloc(j->nchunks, sizeof(size_t));
+    j->tri_at = rt_calloc(j->nchunks, sizeof(size_t));
     if (!j->tri_at) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
         goto done;
@@ -672,15 +673,15 @@ fail_par:
 done:
     if (j->lists)
         for (size_t c = 0; c < j->nchunks; c++)
-            free(j->lists[c].t);
-    free(j->lists);
-    free(j->tri_at);
-    free(j->counts);
-    free(j->failed);
-    free(j->pos);
-    free(j->nrm);
-    free(j->cap);
-    free(j);
+            rt_free(j->lists[c].t);
+    rt_free(j->lists);
+    rt_free(j->tri_at);
+    rt_free(j->counts);
+    rt_free(j->failed);
+    rt_free(j->pos);
+    rt_free(j->nrm);
+    rt_free(j->cap);
+    rt_free(j);
     return rc;
 }
 

@@ -2,6 +2,7 @@
  * §4.1 and its O(K) closed form for equal lengths and one M (SEEDS.md 002).
  * The readings where the paper is silent are documented in ist.h. */
 #include "ist.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -66,18 +67,18 @@ static void fast_init(ist *t);
 
 void ist_free(ist *t)
 {
-    free(t->bounds);
-    free(t->ms);
-    free(t->start);
-    free(t->x);
-    free(t->len);
-    free(t->cum);
-    free(t->total);
-    free(t->label);
-    free(t->slot);
-    free(t->owner);
-    free(t->by_x);
-    free(t->ftab);
+    rt_free(t->bounds);
+    rt_free(t->ms);
+    rt_free(t->start);
+    rt_free(t->x);
+    rt_free(t->len);
+    rt_free(t->cum);
+    rt_free(t->total);
+    rt_free(t->label);
+    rt_free(t->slot);
+    rt_free(t->owner);
+    rt_free(t->by_x);
+    rt_free(t->ftab);
     ist_zero(t);
 }
 
@@ -90,8 +91,8 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
     t->n = s->n;
     t->k = s->k;
     t->axis = s->axis;
-    t->bounds = malloc(sizeof(double) * (size_t)(s->n + 1));
-    t->ms = malloc(sizeof(int) * (size_t)s->n);
+    t->bounds = rt_malloc(sizeof(double) * (size_t)(s->n + 1));
+    t->ms = rt_malloc(sizeof(int) * (size_t)s->n);
     if (!t->bounds || !t->ms) {
         ist_free(t);
         return rt_fail(e, RT_ENOMEM, "out of memory for an IST of %d intervals", s->n);
@@ -191,13 +192,13 @@ rt_code ist_build_lists(ist *t, rt_error *e)
     size_t nslot = 0;
     for (int j = 0; j < n; j++)
         nslot += (size_t)(2 * t->ms[j] + 1);
-    slotdef *sl = malloc(sizeof *sl * nslot);
-    size_t *sstart = malloc(sizeof(size_t) * (size_t)(n + 1));
-    size_t *cnt = calloc((size_t)n, sizeof(size_t)), *cnt2 = calloc((size_t)n, sizeof(size_t));
+    slotdef *sl = rt_malloc(sizeof *sl * nslot);
+    size_t *sstart = rt_malloc(sizeof(size_t) * (size_t)(n + 1));
+    size_t *cnt = rt_calloc((size_t)n, sizeof(size_t)), *cnt2 = rt_calloc((size_t)n, sizeof(size_t));
     double *x0 = NULL, *l0 = NULL, *x1 = NULL, *l1 = NULL;
     uint64_t *b0 = NULL, *b1 = NULL;
     uint32_t *s1 = NULL, *o1 = NULL;
-    size_t *st0 = malloc(sizeof(size_t) * (size_t)(n + 1)), *st1 = malloc(sizeof(size_t) * (size_t)(n + 1));
+    size_t *st0 = rt_malloc(sizeof(size_t) * (size_t)(n + 1)), *st1 = rt_malloc(sizeof(size_t) * (size_t)(n + 1));
     rt_code rc = RT_OK;
     if (!sl || !sstart || !cnt || !cnt2 || !st0 || !st1) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory building IST lists");
@@ -256,14 +257,14 @@ rt_code ist_build_lists(ist *t, rt_error *e)
     for (int i = 0; i < n; i++)
         if (t->ms[i] > 31)
             want_label = 0;
-    x0 = malloc(sizeof(double) * ne);
-    l0 = malloc(sizeof(double) * ne);
-    x1 = malloc(sizeof(double) * ne);
-    l1 = malloc(sizeof(double) * ne);
-    b0 = calloc(ne, sizeof(uint64_t));
-    b1 = calloc(ne, sizeof(uint64_t));
-    s1 = calloc(ne, sizeof(uint32_t));
-    o1 = calloc(ne, sizeof(uint32_t));
+    x0 = rt_malloc(sizeof(double) * ne);
+    l0 = rt_malloc(sizeof(double) * ne);
+    x1 = rt_malloc(sizeof(double) * ne);
+    l1 = rt_malloc(sizeof(double) * ne);
+    b0 = rt_calloc(ne, sizeof(uint64_t));
+    b1 = rt_calloc(ne, sizeof(uint64_t));
+    s1 = rt_calloc(ne, sizeof(uint32_t));
+    o1 = rt_calloc(ne, sizeof(uint32_t));
     if (!x0 || !l0 || !x1 || !l1 || !b0 || !b1 || !s1 || !o1) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu IST list entries", ne);
         goto done;
@@ -312,12 +313,12 @@ rt_code ist_build_lists(ist *t, rt_error *e)
     t->owner = o1;
     s1 = NULL;
     o1 = NULL;
-    t->cum = malloc(sizeof(double) * (t->ne ? t->ne : 1));
-    t->total = malloc(sizeof(double) * (size_t)n);
-    t->by_x = malloc(sizeof(size_t) * (t->ne ? t->ne : 1));
-    xi *tmp = malloc(sizeof(xi) * (t->ne ? t->ne : 1));
+    t->cum = rt_malloc(sizeof(double) * (t->ne ? t->ne : 1));
+    t->total = rt_malloc(sizeof(double) * (size_t)n);
+    t->by_x = rt_malloc(sizeof(size_t) * (t->ne ? t->ne : 1));
+    xi *tmp = rt_malloc(sizeof(xi) * (t->ne ? t->ne : 1));
     if (!t->cum || !t->total || !t->by_x || !tmp) {
-        free(tmp);
+        rt_free(tmp);
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu IST list entries", t->ne);
         goto done;
     }
@@ -337,25 +338,25 @@ rt_code ist_build_lists(ist *t, rt_error *e)
     qsort(tmp, t->ne, sizeof *tmp, xi_cmp);
     for (size_t r = 0; r < t->ne; r++)
         t->by_x[r] = tmp[r].i;
-    free(tmp);
+    rt_free(tmp);
 done:
-    free(sl);
-    free(sstart);
-    free(cnt);
-    free(cnt2);
-    free(x0);
-    free(l0);
-    free(x1);
-    free(l1);
-    free(b0);
-    free(b1);
-    free(s1);
-    free(o1);
-    free(st0);
-    free(st1);
+    rt_free(sl);
+    rt_free(sstart);
+    rt_free(cnt);
+    rt_free(cnt2);
+    rt_free(x0);
+    rt_free(l0);
+    rt_free(x1);
+    rt_free(l1);
+    rt_free(b0);
+    rt_free(b1);
+    rt_free(s1);
+    rt_free(o1);
+    rt_free(st0);
+    rt_free(st1);
     if (rc && t->x) { /* undo a partial final level, keep the spec */
-        free(t->start); free(t->x); free(t->len); free(t->cum); free(t->total);
-        free(t->label); free(t->slot); free(t->owner); free(t->by_x);
+        rt_free(t->start); rt_free(t->x); rt_free(t->len); rt_free(t->cum); rt_free(t->total);
+        rt_free(t->label); rt_free(t->slot); rt_free(t->owner); rt_free(t->by_x);
         t->start = NULL; t->x = t->len = t->cum = t->total = NULL;
         t->label = NULL; t->slot = t->owner = NULL; t->by_x = NULL; t->ne = 0;
     }
@@ -603,7 +604,7 @@ static void fast_init(ist *t)
         btop *= b;
     int dig = t->axis == IST_TRANSLATION && b <= 15;
     size_t ne = (size_t)bg + (r ? btop : 0) + (dig ? 2 * (size_t)bg + (r ? btop : 0) : 0);
-    uint32_t *tab = malloc(sizeof(uint32_t) * ne);
+    uint32_t *tab = rt_malloc(sizeof(uint32_t) * ne);
     if (!tab)
         return;
     fill_groups(tab, b, g);

@@ -9,6 +9,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "lineedit.h"
+#include "rt_alloc.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -285,7 +286,7 @@ static int buf_reserve(lineedit *le, size_t extra)
     size_t cap = le->cap ? le->cap : 128;
     while (cap < le->len + extra + 1)
         cap *= 2;
-    char *nb = realloc(le->buf, cap);
+    char *nb = rt_realloc(le->buf, cap);
     if (!nb) {
         snprintf(le->err, sizeof le->err, "out of memory");
         return -1;
@@ -495,13 +496,13 @@ static int hist_push(lineedit *le, const char *s, size_t n)
         if (strlen(last) == n && memcmp(last, s, n) == 0)
             return 0;
     }
-    char *copy = malloc(n + 1);
+    char *copy = rt_malloc(n + 1);
     if (!copy)
         return 0;
     memcpy(copy, s, n);
     copy[n] = 0;
     if (le->hist_len == le->hist_max) {
-        free(le->hist[0]);
+        rt_free(le->hist[0]);
         memmove(le->hist, le->hist + 1, (size_t)(le->hist_len - 1) * sizeof *le->hist);
         le->hist_len--;
     }
@@ -566,7 +567,7 @@ rt_code lineedit_history_save(lineedit *le, rt_error *e)
 
 lineedit *lineedit_new(int in_fd, int out_fd, const char *history_path, int history_max)
 {
-    lineedit *le = calloc(1, sizeof *le);
+    lineedit *le = rt_calloc(1, sizeof *le);
     if (!le)
         return NULL;
     le->in_fd = in_fd;
@@ -579,24 +580,24 @@ lineedit *lineedit_new(int in_fd, int out_fd, const char *history_path, int hist
         le->mode = LE_PIPE;
     }
     if (le->hist_max > 0) {
-        le->hist = calloc((size_t)le->hist_max, sizeof *le->hist);
+        le->hist = rt_calloc((size_t)le->hist_max, sizeof *le->hist);
         if (!le->hist) {
-            free(le);
+            rt_free(le);
             return NULL;
         }
     }
     if (history_path) {
-        le->hist_path = strdup(history_path);
+        le->hist_path = rt_strdup(history_path);
         if (!le->hist_path) {
-            free(le->hist);
-            free(le);
+            rt_free(le->hist);
+            rt_free(le);
             return NULL;
         }
         unsigned char *data;
         size_t n;
         if (le->hist_max > 0 && fileio_read_all(history_path, (size_t)64 << 20, &data, &n, NULL) == RT_OK) {
             hist_add_text(le, (const char *)data, n);
-            free(data);
+            rt_free(data);
         }
     }
     return le;
@@ -611,11 +612,11 @@ void lineedit_free(lineedit *le)
     if (le->hist_dirty)
         lineedit_history_save(le, NULL);
     for (int i = 0; i < le->hist_len; i++)
-        free(le->hist[i]);
-    free(le->hist);
-    free(le->hist_path);
-    free(le->buf);
-    free(le);
+        rt_free(le->hist[i]);
+    rt_free(le->hist);
+    rt_free(le->hist_path);
+    rt_free(le->buf);
+    rt_free(le);
 }
 
 int lineedit_is_raw(const lineedit *le) { return le && le->mode == LE_RAW; }
@@ -627,7 +628,7 @@ const char *lineedit_errmsg(const lineedit *le) { return le ? le->err : ""; }
 /* Hand the buffer to the caller as a malloc'd string. */
 static lineedit_result take_line(lineedit *le, char **line)
 {
-    char *s = malloc(le->len + 1);
+    char *s = rt_malloc(le->len + 1);
     if (!s) {
         snprintf(le->err, sizeof le->err, "out of memory");
         return LINEEDIT_ERROR;
@@ -674,12 +675,12 @@ static int browse_move(lineedit *le, browse *h, int to)
 {
     if (to < 0 || to > le->hist_len || to == h->at)
         return 0;
-    char *keep = strdup(le->buf ? le->buf : "");
+    char *keep = rt_strdup(le->buf ? le->buf : "");
     if (!keep) {
         snprintf(le->err, sizeof le->err, "out of memory");
         return -1;
     }
-    free(h->edits[h->at]);
+    rt_free(h->edits[h->at]);
     h->edits[h->at] = keep;
     h->at = to;
     const char *src = h->edits[to] ? h->edits[to] : to == 0 ? "" : le->hist[le->hist_len - to];
@@ -691,14 +692,14 @@ static int is_word_space(char c) { return c == ' ' || c == '\t'; }
 static lineedit_result read_raw(lineedit *le, char **line)
 {
     browse h = {NULL, le->hist_len + 1, 0};
-    h.edits = calloc((size_t)h.n, sizeof *h.edits);
+    h.edits = rt_calloc((size_t)h.n, sizeof *h.edits);
     if (!h.edits) {
         snprintf(le->err, sizeof le->err, "out of memory");
         return LINEEDIT_ERROR;
     }
     if (raw_on(le) != 0) {
         set_err(le, "cannot set the terminal to raw mode", errno);
-        free(h.edits);
+        rt_free(h.edits);
         return LINEEDIT_ERROR;
     }
     lineedit_result res = LINEEDIT_ERROR;
@@ -852,8 +853,8 @@ static lineedit_result read_raw(lineedit *le, char **line)
 done:
     raw_off();
     for (int i = 0; i < h.n; i++)
-        free(h.edits[i]);
-    free(h.edits);
+        rt_free(h.edits[i]);
+    rt_free(h.edits);
     return res;
 }
 

@@ -1,5 +1,6 @@
 /* mesh.c — growable triangle mesh and its topology statistics. */
 #include "mesh.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,18 +11,18 @@ void mesh_init(mesh *m, int with_normals, int with_colours)
     memset(m, 0, sizeof *m);
     /* A non-NULL sentinel marks the attribute as present until the first
      * vertex allocates the real array. */
-    m->nrm = with_normals ? malloc(3 * sizeof(float)) : NULL;
-    m->col = with_colours ? malloc(4 * sizeof(float)) : NULL;
+    m->nrm = with_normals ? rt_malloc(3 * sizeof(float)) : NULL;
+    m->col = with_colours ? rt_malloc(4 * sizeof(float)) : NULL;
     if ((with_normals && !m->nrm) || (with_colours && !m->col))
         m->failed = 1;
 }
 
 void mesh_free(mesh *m)
 {
-    free(m->pos);
-    free(m->nrm);
-    free(m->col);
-    free(m->tri);
+    rt_free(m->pos);
+    rt_free(m->nrm);
+    rt_free(m->col);
+    rt_free(m->tri);
     memset(m, 0, sizeof *m);
 }
 
@@ -32,7 +33,7 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     size_t nc = *cap ? *cap : 64;
     while (nc < need)
         nc *= 2;
-    void *np = realloc(*p, rt_mul_size(nc, elem));
+    void *np = rt_realloc(*p, rt_mul_size(nc, elem));
     if (!np)
         return -1;
     *p = np;
@@ -99,11 +100,11 @@ rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e)
     size_t cap = 16;
     while (cap < m->nt * 6 + 16)
         cap *= 2;
-    edge_slot *tab = calloc(cap, sizeof *tab);
-    unsigned char *used = calloc(m->nv ? m->nv : 1, 1);
+    edge_slot *tab = rt_calloc(cap, sizeof *tab);
+    unsigned char *used = rt_calloc(m->nv ? m->nv : 1, 1);
     if (!tab || !used) {
-        free(tab);
-        free(used);
+        rt_free(tab);
+        rt_free(used);
         return rt_fail(e, RT_ENOMEM, "out of memory computing mesh statistics");
     }
     for (size_t t = 0; t < m->nt; t++) {
@@ -144,7 +145,7 @@ rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e)
     for (size_t i = 0; i < m->nv; i++)
         st->vertices += used[i];
     st->euler = (long)st->vertices - (long)st->edges + (long)st->triangles;
-    free(tab);
-    free(used);
+    rt_free(tab);
+    rt_free(used);
     return RT_OK;
 }

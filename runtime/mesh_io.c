@@ -1,5 +1,6 @@
 /* mesh_io.c — PLY, OBJ and binary STL writers and readers (see mesh_io.h). */
 #include "mesh_io.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -356,6 +357,16 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                 have_c |= strcmp(el[i].prop[k].name, "red") == 0;
             }
         }
+    /* the declared vertices and faces (one triangle each at least), before
+     * any is read */
+    double nfaces = 0;
+    for (int i = 0; i < nel; i++)
+        if (strcmp(el[i].name, "face") == 0)
+            nfaces = (double)el[i].count;
+    rt_code lc = rt_check_bytes((double)nverts * (12 + (have_n ? 12 : 0) + (have_c ? 16 : 0)) + nfaces * 12,
+                                "reading the PLY vertices and faces", e);
+    if (lc)
+        return lc;
     mesh_free(m);
     mesh_init(m, have_n, have_c);
     ply_in in = {d, n, pos, fmt, 0};
@@ -458,7 +469,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     k++;
                 }
                 if (k < 3) {
-                    free(vn);
+                    rt_free(vn);
                     if (pass == 1)
                         mesh_free(m);
                     return rt_fail(e, RT_EFORMAT, "OBJ line %d: vertex needs 3 coordinates", lineno);
@@ -480,16 +491,16 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                 for (int k = 0; k < 3; k++) {
                     c[k] = strtod(p, &q);
                     if (q == p) {
-                        free(vn);
+                        rt_free(vn);
                         return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal needs 3 components", lineno);
                     }
                     p = q;
                 }
                 if (nvn == cap_vn) {
                     cap_vn = cap_vn ? 2 * cap_vn : 64;
-                    float *nb = realloc(vn, cap_vn * 3 * sizeof(float));
+                    float *nb = rt_realloc(vn, cap_vn * 3 * sizeof(float));
                     if (!nb) {
-                        free(vn);
+                        rt_free(vn);
                         return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
                     }
                     vn = nb;
@@ -509,7 +520,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     char *q;
                     long vi = obj_index(p, &q, nv), ni = 0;
                     if (!vi || k == 256) {
-                        free(vn);
+                        rt_free(vn);
                         mesh_free(m);
                         return rt_fail(e, RT_EFORMAT, "OBJ line %d: face index out of 1..%zu", lineno, nv);
                     }
@@ -522,7 +533,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                             p++;
                             ni = obj_index(p, &q, nvn);
                             if (!ni) {
-                                free(vn);
+                                rt_free(vn);
                                 mesh_free(m);
                                 return rt_fail(e, RT_EFORMAT, "OBJ line %d: normal index out of 1..%zu", lineno, nvn);
                             }
@@ -534,7 +545,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     idx[k++] = (double)(vi - 1);
                 }
                 if (k < 3) {
-                    free(vn);
+                    rt_free(vn);
                     mesh_free(m);
                     return rt_fail(e, RT_EFORMAT, "OBJ line %d: face has fewer than 3 vertices", lineno);
                 }
@@ -542,7 +553,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
             }
         }
     }
-    free(vn);
+    rt_free(vn);
     return reader_oom(m, e);
 }
 
@@ -565,7 +576,12 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     size_t cap = 16;
     while (cap < (size_t)nt * 6 + 16)
         cap *= 2;
-    weld_slot *tab = malloc(cap * sizeof *tab);
+    /* the weld table and up to 3 vertices and one triangle per facet */
+    rt_code lc = rt_check_bytes((double)cap * sizeof(weld_slot) + (double)nt * (3 * 12 + 12),
+                                "reading the STL triangles", e);
+    if (lc)
+        return lc;
+    weld_slot *tab = rt_malloc(cap * sizeof *tab);
     if (!tab)
         return rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
     for (size_t i = 0; i < cap; i++)
@@ -594,7 +610,7 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
         }
         mesh_add_tri(m, v[0], v[1], v[2]);
     }
-    free(tab);
+    rt_free(tab);
     return reader_oom(m, e);
 }
 
@@ -614,6 +630,6 @@ rt_code mio_load(const char *path, mesh *m, rt_error *e)
     mesh_free(m);
     rc = kind == 0 ? mio_ply_from_mem(d, n, m, e) : kind == 1 ? mio_obj_from_mem(d, n, m, e)
                                                            : mio_stl_from_mem(d, n, m, e);
-    free(d);
+    rt_free(d);
     return rc;
 }

@@ -1,6 +1,7 @@
 /* mpd.c — 3-D random fractal by midpoint displacement, Types I–IV (seed 000).
  * See mpd.h for the lattice, the node keys and the four strategies. */
 #include "mpd.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -393,7 +394,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
 
     if (type == MPD_TYPE1 || type == MPD_TYPE4) {
         size_t bytes = lattice_bytes(R2);
-        m->arr = bytes ? malloc(bytes) : NULL;
+        m->arr = bytes ? rt_malloc(bytes) : NULL;
         if (!m->arr)
             return rt_fail(e, RT_ENOMEM, "out of memory for the Type %s array (%zu bytes)",
                            type == MPD_TYPE1 ? "I" : "IV", bytes);
@@ -414,7 +415,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
 
 void mpd_free(mpd *m)
 {
-    free(m->arr);
+    rt_free(m->arr);
     m->arr = NULL;
     m->arr_bytes = 0;
 }
@@ -542,11 +543,11 @@ typedef struct memo {
 
 static int memo_alloc(memo *mm, size_t cap)
 {
-    uint64_t *k = malloc(cap * sizeof *k);
-    float *v = malloc(cap * sizeof *v);
+    uint64_t *k = rt_malloc(cap * sizeof *k);
+    float *v = rt_malloc(cap * sizeof *v);
     if (!k || !v) {
-        free(k);
-        free(v);
+        rt_free(k);
+        rt_free(v);
         return -1;
     }
     memset(k, 0xff, cap * sizeof *k);
@@ -562,8 +563,8 @@ static int memo_alloc(memo *mm, size_t cap)
 
 static void memo_free(memo *mm)
 {
-    free(mm->keys);
-    free(mm->vals);
+    rt_free(mm->keys);
+    rt_free(mm->vals);
     mm->keys = NULL;
     mm->vals = NULL;
     mm->cap = mm->used = 0;
@@ -600,8 +601,8 @@ static void memo_insert(memo *mm, uint64_t key, float val)
                 *memo_find(mm, old.keys[i], &f) = old.vals[i];
                 mm->used++;
             }
-        free(old.keys);
-        free(old.vals);
+        rt_free(old.keys);
+        rt_free(old.vals);
     }
     int f;
     float *slot = memo_find(mm, key, &f);
@@ -826,15 +827,15 @@ rt_code mpd_eval_points(const mpd *m, const rt_run *run, size_t n, const double 
     size_t nchunks = (n + MPD_CHUNK - 1) / MPD_CHUNK;
     int nw = par_workers(run, nchunks);
     pjob j = {m, n, x, y, z, out, NULL, NULL, NULL, NULL};
-    j.ev = calloc((size_t)nw, sizeof *j.ev);
-    j.sc = calloc((size_t)nw, sizeof *j.sc);
-    j.work = calloc((size_t)nw, sizeof *j.work);
-    void *buf = malloc((size_t)nw * MPD_CHUNK * 2 * (sizeof(uint64_t) + sizeof(uint32_t)));
+    j.ev = rt_calloc((size_t)nw, sizeof *j.ev);
+    j.sc = rt_calloc((size_t)nw, sizeof *j.sc);
+    j.work = rt_calloc((size_t)nw, sizeof *j.work);
+    void *buf = rt_malloc((size_t)nw * MPD_CHUNK * 2 * (sizeof(uint64_t) + sizeof(uint32_t)));
     if (!j.ev || !j.sc || !j.work || !buf) {
-        free(j.ev);
-        free(j.sc);
-        free(j.work);
-        free(buf);
+        rt_free(j.ev);
+        rt_free(j.sc);
+        rt_free(j.work);
+        rt_free(buf);
         return rt_fail(e, RT_ENOMEM, "out of memory evaluating %zu points", n);
     }
     uint64_t *kb = buf;
@@ -858,10 +859,10 @@ rt_code mpd_eval_points(const mpd *m, const rt_run *run, size_t n, const double 
     }
     for (int w = 0; w < nw; w++)
         memo_free(&j.ev[w].mm);
-    free(j.ev);
-    free(j.sc);
-    free(j.work);
-    free(buf);
+    rt_free(j.ev);
+    rt_free(j.sc);
+    rt_free(j.work);
+    rt_free(buf);
     if (rc)
         return rt_fail(e, rc, "interrupted");
     return RT_OK;
@@ -978,10 +979,10 @@ static void grid_tile(void *ctx, size_t chunk, int worker)
 
 static int axis_setup(axis_map *am, int n, double lo, double hi, int R, int s, int nt)
 {
-    am->cell = malloc((size_t)n * sizeof *am->cell);
-    am->t = malloc((size_t)n * sizeof *am->t);
-    am->order = malloc((size_t)n * sizeof *am->order);
-    am->start = calloc((size_t)nt + 1, sizeof *am->start);
+    am->cell = rt_malloc((size_t)n * sizeof *am->cell);
+    am->t = rt_malloc((size_t)n * sizeof *am->t);
+    am->order = rt_malloc((size_t)n * sizeof *am->order);
+    am->start = rt_calloc((size_t)nt + 1, sizeof *am->start);
     if (!am->cell || !am->t || !am->order || !am->start)
         return -1;
     for (int i = 0; i < n; i++) {
@@ -991,22 +992,22 @@ static int axis_setup(axis_map *am, int n, double lo, double hi, int R, int s, i
     }
     for (int k = 0; k < nt; k++)
         am->start[k + 1] += am->start[k];
-    uint32_t *pos = malloc((size_t)nt * sizeof *pos);
+    uint32_t *pos = rt_malloc((size_t)nt * sizeof *pos);
     if (!pos)
         return -1;
     memcpy(pos, am->start, (size_t)nt * sizeof *pos);
     for (int i = 0; i < n; i++)
         am->order[pos[am->cell[i] >> s]++] = (uint32_t)i;
-    free(pos);
+    rt_free(pos);
     return 0;
 }
 
 static void axis_free(axis_map *am)
 {
-    free(am->cell);
-    free(am->t);
-    free(am->order);
-    free(am->start);
+    rt_free(am->cell);
+    rt_free(am->t);
+    rt_free(am->order);
+    rt_free(am->start);
 }
 
 rt_code mpd_eval_grid(const mpd *m, const rt_run *run, const double lo[3], const double hi[3], int nx,
@@ -1027,9 +1028,9 @@ rt_code mpd_eval_grid(const mpd *m, const rt_run *run, const double lo[3], const
     j.out = out;
     int nw = par_workers(run, (size_t)j.nt * j.nt * j.nt);
     rt_code rc = RT_OK;
-    j.tile = calloc((size_t)nw, sizeof *j.tile);
-    j.ev = calloc((size_t)nw, sizeof *j.ev);
-    j.nodes = calloc((size_t)nw, sizeof *j.nodes);
+    j.tile = rt_calloc((size_t)nw, sizeof *j.tile);
+    j.ev = rt_calloc((size_t)nw, sizeof *j.ev);
+    j.nodes = rt_calloc((size_t)nw, sizeof *j.nodes);
     int ok = j.tile && j.ev && j.nodes;
     for (int a = 0; a < 3 && ok; a++)
         ok = axis_setup(&j.ax[a], j.n[a], lo[a], hi[a], m->R, j.ts_log, j.nt) == 0;
@@ -1037,7 +1038,7 @@ rt_code mpd_eval_grid(const mpd *m, const rt_run *run, const double lo[3], const
     size_t tile_bytes = S1 * S1 * S1 * sizeof(float);
     if (ok && (m->type == MPD_TYPE3 || m->type == MPD_TYPE4))
         for (int w = 0; w < nw && ok; w++)
-            ok = (j.tile[w] = malloc(tile_bytes)) != NULL;
+            ok = (j.tile[w] = rt_malloc(tile_bytes)) != NULL;
     if (!ok)
         rc = rt_fail(e, RT_ENOMEM, "out of memory evaluating a %d x %d x %d grid", nx, ny, nz);
     else {
@@ -1060,14 +1061,14 @@ rt_code mpd_eval_grid(const mpd *m, const rt_run *run, const double lo[3], const
     }
     if (j.tile)
         for (int w = 0; w < nw; w++)
-            free(j.tile[w]);
+            rt_free(j.tile[w]);
     if (j.ev)
         for (int w = 0; w < nw; w++)
             memo_free(&j.ev[w].mm);
     for (int a = 0; a < 3; a++)
         axis_free(&j.ax[a]);
-    free(j.tile);
-    free(j.ev);
-    free(j.nodes);
+    rt_free(j.tile);
+    rt_free(j.ev);
+    rt_free(j.nodes);
     return rc;
 }

@@ -2,6 +2,7 @@
  * the PNG specification (W3C, 2nd edition); section numbers below refer to
  * it. Compression is our deflate.c / inflate.c. */
 #include "png.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -136,9 +137,9 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
     size_t total = rt_mul_size((size_t)h, rb + 1);
     if (rb == 0 || total == 0)
         return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is too large", w, h);
-    unsigned char *f = malloc(total), *tmp = malloc(5 * rb), *zero = calloc(1, rb);
+    unsigned char *f = rt_malloc(total), *tmp = rt_malloc(5 * rb), *zero = rt_calloc(1, rb);
     if (!f || !tmp || !zero) {
-        free(f), free(tmp), free(zero);
+        rt_free(f), rt_free(tmp), rt_free(zero);
         return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", w, h);
     }
     /* adaptive filtering, §12.8: minimum sum of absolute differences */
@@ -159,15 +160,15 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
         dst[0] = (unsigned char)bestft;
         memcpy(dst + 1, tmp + (size_t)bestft * rb, rb);
     }
-    free(zero);
-    free(tmp);
+    rt_free(zero);
+    rt_free(tmp);
     if (filtered)
         bytebuf_append(filtered, f, total);
 
     bytebuf z;
     bytebuf_init(&z);
     c = deflate_zlib(f, total, level, &z, e);
-    free(f);
+    rt_free(f);
     if (c) {
         bytebuf_free(&z);
         return c;
@@ -202,7 +203,7 @@ rt_code png_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
     size_t n = rt_mul_size(np, (size_t)channels * bps);
     if (n == 0)
         return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is too large", im->w, im->h);
-    unsigned char *s = malloc(n);
+    unsigned char *s = rt_malloc(n);
     if (!s)
         return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", im->w, im->h);
     unsigned maxval = bits == 16 ? 65535 : 255;
@@ -225,7 +226,7 @@ rt_code png_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
         }
     }
     c = png_encode_samples(s, im->w, im->h, channels, bits, PNG_DEFAULT_LEVEL, out, NULL, e);
-    free(s);
+    rt_free(s);
     return c;
 }
 
@@ -511,7 +512,7 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
     rt_code c = check_sig(data, n, e);
     if (c)
         return c;
-    dec *D = calloc(1, sizeof *D);
+    dec *D = rt_calloc(1, sizeof *D);
     if (!D)
         return rt_fail(e, RT_ENOMEM, "out of memory");
     bytebuf idat, raw;
@@ -534,7 +535,8 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
                 c = rt_fail(e, RT_EFORMAT, "first PNG chunk is '%s', expected IHDR", type);
                 goto fail;
             }
-            if ((c = parse_ihdr(p, len, &D->info, e)))
+            if ((c = parse_ihdr(p, len, &D->info, e)) ||
+                (c = rt_check_pixels(D->info.w, D->info.h, e))) /* before any buffer of that size */
                 goto fail;
         } else if (!strcmp(type, "IHDR")) {
             c = rt_fail(e, RT_EFORMAT, "PNG has a second IHDR chunk");
@@ -620,6 +622,10 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
             total += k;
         }
     }
+    /* the inflated rows and the float image, before either is allocated */
+    if ((c = rt_check_bytes((double)total + (double)D->info.w * D->info.h * 4 * sizeof(float),
+                            "decoding the PNG image", e)))
+        goto fail;
     c = inflate_zlib(idat.data, idat.len, total, &raw, e);
     if (c) {
         if (c == RT_EFORMAT) {
@@ -650,7 +656,7 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
 fail:
     bytebuf_free(&idat);
     bytebuf_free(&raw);
-    free(D);
+    rt_free(D);
     return c;
 }
 
@@ -664,6 +670,6 @@ rt_code png_load(const char *path, image *im, png_info *info, rt_error *e)
     if (c)
         return c;
     c = png_decode(d, n, im, info, e);
-    free(d);
+    rt_free(d);
     return c;
 }

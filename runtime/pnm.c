@@ -1,6 +1,7 @@
 /* pnm.c — P5/P6 (netpbm) and PF/Pf (Portable Float Map) reading and writing.
  * Not from the seed papers; formats as described in pnm.h. */
 #include "pnm.h"
+#include "rt_alloc.h"
 
 #include <limits.h>
 #include <math.h>
@@ -96,7 +97,7 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
     unsigned maxval = bits == 16 ? 65535 : 255;
     bytebuf_printf(out, "P%c\n%d %d\n%u\n", channels == 1 ? '5' : '6', im->w, im->h, maxval);
     size_t rb = (size_t)im->w * (size_t)channels * (size_t)(bits / 8);
-    unsigned char *row = malloc(rb ? rb : 1);
+    unsigned char *row = rt_malloc(rb ? rb : 1);
     if (!row)
         return rt_fail(e, RT_ENOMEM, "out of memory writing a %d×%d image", im->w, im->h);
     for (int y = 0; y < im->h; y++) {
@@ -115,7 +116,7 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
         }
         bytebuf_append(out, row, rb);
     }
-    free(row);
+    rt_free(row);
     if (out->failed)
         return rt_fail(e, RT_ENOMEM, "out of memory writing a %d×%d image", im->w, im->h);
     return RT_OK;
@@ -137,7 +138,7 @@ rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     size_t bps = maxval < 256 ? 1 : 2, need;
     if ((c = check_size(h.what, (int)w, (int)ht, ch, bps, n - h.pos, &need, e)))
         return c;
-    if ((c = image_init(im, (int)w, (int)ht, e)))
+    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
         return c;
     const unsigned char *s = d + h.pos;
     size_t np = (size_t)w * (size_t)ht;
@@ -222,7 +223,7 @@ rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     size_t need;
     if ((c = check_size("PFM", (int)w, (int)ht, ch, 4, n - h.pos, &need, e)))
         return c;
-    if ((c = image_init(im, (int)w, (int)ht, e)))
+    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
         return c;
     int le = scale < 0;
     const unsigned char *s = d + h.pos;

@@ -1,5 +1,6 @@
 /* raster.c — tiled, deterministic Z-buffer rasteriser (see raster.h). */
 #include "raster.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -147,7 +148,7 @@ static rtri *extra_slot(chunk_extra *X)
 {
     if (X->n == X->cap) {
         size_t cap = X->cap ? 2 * X->cap : 64;
-        rtri *nt = realloc(X->t, sizeof *nt * cap);
+        rtri *nt = rt_realloc(X->t, sizeof *nt * cap);
         if (!nt) {
             X->oom = 1;
             return NULL;
@@ -441,14 +442,14 @@ static void tile_fn(void *ctx, size_t tile, int worker)
     int x1 = x0 + ts - 1 < J->im->w - 1 ? x0 + ts - 1 : J->im->w - 1;
     int y1 = y0 + ts - 1 < J->im->h - 1 ? y0 + ts - 1 : J->im->h - 1;
     size_t np = (size_t)ts * (size_t)ts;
-    double *zb = malloc(sizeof(double) * np);
-    float *cb = malloc(sizeof(float) * 4 * np);
+    double *zb = rt_malloc(sizeof(double) * np);
+    float *cb = rt_malloc(sizeof(float) * 4 * np);
     size_t n = J->start[tile + 1] - J->start[tile];
-    zsort *zs = malloc(sizeof(zsort) * (n ? n : 1));
+    zsort *zs = rt_malloc(sizeof(zsort) * (n ? n : 1));
     if (!zb || !cb || !zs) { /* cannot report from here; leave the tile as background */
-        free(zb);
-        free(cb);
-        free(zs);
+        rt_free(zb);
+        rt_free(cb);
+        rt_free(zs);
         return;
     }
     const float *bg = J->o->background;
@@ -478,9 +479,9 @@ static void tile_fn(void *ctx, size_t tile, int worker)
                 o[d] = a > 0 ? (a == 1 ? c[d] : c[d] / a) : 0;
             o[3] = a;
         }
-    free(zb);
-    free(cb);
-    free(zs);
+    rt_free(zb);
+    rt_free(cb);
+    rt_free(zs);
 }
 
 rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, const rt_run *run,
@@ -493,8 +494,8 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         ts = 1024;
     int tiles_x = (im->w + ts - 1) / ts, tiles_y = (im->h + ts - 1) / ts;
     size_t ntiles = (size_t)tiles_x * (size_t)tiles_y;
-    rtri *t = malloc(sizeof *t * (m->nt ? m->nt : 1));
-    size_t *start = calloc(ntiles + 1, sizeof(size_t));
+    rtri *t = rt_malloc(sizeof *t * (m->nt ? m->nt : 1));
+    size_t *start = rt_calloc(ntiles + 1, sizeof(size_t));
     uint32_t *list = NULL;
     size_t *bins = NULL;
     chunk_extra *ex = NULL;
@@ -519,8 +520,8 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
     nch = (m->nt + csz - 1) / csz;
     setup_job S = {m, cam, o, im->w, im->h, {0, 0, 0}, t, csz, NULL, NULL, ntiles, ts, tiles_x, NULL,
                    o->near > NEAR_MIN ? o->near : NEAR_MIN};
-    bins = S.bins = calloc(nch * ntiles + 1, sizeof(size_t));
-    ex = S.ex = calloc(nch ? nch : 1, sizeof *ex);
+    bins = S.bins = rt_calloc(nch * ntiles + 1, sizeof(size_t));
+    ex = S.ex = rt_calloc(nch ? nch : 1, sizeof *ex);
     if (!bins || !ex) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory binning %zu triangles", m->nt);
         goto done;
@@ -554,7 +555,7 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         nex += ex[c].n;
     }
     if (nex) {
-        rtri *t2 = nex < UINT32_MAX - m->nt ? realloc(t, sizeof *t * (m->nt + nex)) : NULL;
+        rtri *t2 = nex < UINT32_MAX - m->nt ? rt_realloc(t, sizeof *t * (m->nt + nex)) : NULL;
         if (!t2) {
             rc = rt_fail(e, RT_ENOMEM, "out of memory clipping %zu triangles", m->nt);
             goto done;
@@ -576,7 +577,7 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         }
     }
     start[ntiles] = tot;
-    list = malloc(sizeof(uint32_t) * (tot ? tot : 1));
+    list = rt_malloc(sizeof(uint32_t) * (tot ? tot : 1));
     if (!list) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory binning %zu triangles", m->nt);
         goto done;
@@ -594,11 +595,11 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
     (void)tiles_y;
 done:
     for (size_t c = 0; ex && c < nch; c++)
-        free(ex[c].t);
-    free(ex);
-    free(bins);
-    free(t);
-    free(start);
-    free(list);
+        rt_free(ex[c].t);
+    rt_free(ex);
+    rt_free(bins);
+    rt_free(t);
+    rt_free(start);
+    rt_free(list);
     return rc;
 }

@@ -5,10 +5,20 @@
  * rt_error (a code and a one-line message without position: the interpreter
  * adds file:line:col). Engines never print and never exit.
  *
- * Memory: engines allocate with malloc/free. The interpreter checks every
- * user-controlled size against its limits *before* calling an engine, so an
- * engine only has to handle malloc returning NULL (RT_ENOMEM), never to
- * decide how much is too much.
+ * Memory: engines allocate only through rt_alloc.h (rt_malloc, rt_calloc,
+ * rt_realloc, rt_free, with overflow-checked sizes), never with malloc. The
+ * interpreter installs one process-wide hook there at start, so every engine
+ * and codec buffer is counted against --max-memory and can be failed by the
+ * fail-the-N-th-allocation test. The hook is process-wide, not a parameter,
+ * because most runtime calls (codecs, images, meshes) take no context object
+ * and a process runs one interpreter at a time; it is set before any worker
+ * thread starts, and the interpreter's hook counts with C11 atomics because
+ * engines allocate on their worker threads (details in rt_alloc.h). Without
+ * a hook (C tests) it is plain malloc.
+ * The interpreter checks user-controlled sizes before calling an engine for
+ * a clear message; an engine handles a NULL from rt_malloc (RT_ENOMEM).
+ * Decoders check the sizes a file declares with rt_check_pixels/_voxels/
+ * _bytes before allocating (RT_ELIMIT).
  */
 #ifndef RT_H
 #define RT_H
@@ -24,6 +34,7 @@ typedef enum rt_code {
     RT_EFORMAT,  /* a file is not in the expected format, or is corrupt */
     RT_EINVAL,   /* invalid parameters (validation failed) */
     RT_ECANCEL,  /* interrupted by the user (Ctrl-C) */
+    RT_ELIMIT,   /* a size exceeds a limit set through the allocation hook (rt_alloc.h) */
 } rt_code;
 
 typedef struct rt_error {

@@ -1,5 +1,6 @@
 /* superifs.c — V-variable super IFS with point-set buffers (seed 004 eq. (14)). */
 #include "superifs.h"
+#include "rt_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -66,9 +67,9 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
     size_t n = rt_mul_size(rt_mul_size(V, S), 2);
     if (!n)
         return rt_fail(e, RT_EINVAL, "super IFS of %zu buffers of %zu points is too large", V, S);
-    double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
-    double *cum = malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *cum);
-    int *nv = malloc(V * sizeof *nv), *input = malloc(V * FSET_MAX_MAPS * sizeof *input);
+    double *a = rt_malloc(n * sizeof *a), *b = rt_malloc(n * sizeof *b);
+    double *cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *cum);
+    int *nv = rt_malloc(V * sizeof *nv), *input = rt_malloc(V * FSET_MAX_MAPS * sizeof *input);
     if (!a || !b || !cum || !nv || !input) {
         code = rt_fail(e, RT_ENOMEM, "out of memory for %zu buffers of %zu points", V, S);
         goto done;
@@ -106,11 +107,11 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
     a = NULL;
     nv = NULL;
 done:
-    free(a);
-    free(b);
-    free(cum);
-    free(nv);
-    free(input);
+    rt_free(a);
+    rt_free(b);
+    rt_free(cum);
+    rt_free(nv);
+    rt_free(input);
     return code;
 }
 
@@ -132,7 +133,7 @@ rt_code superifs_render(const superifs_state *s, int v, hist2 *hs, rt_error *e)
 
 void superifs_free(superifs_state *s)
 {
-    free(s->pts);
-    free(s->ifs_of);
+    rt_free(s->pts);
+    rt_free(s->ifs_of);
     memset(s, 0, sizeof *s);
 }

@@ -7,6 +7,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "termview.h"
+#include "rt_alloc.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -132,10 +133,10 @@ rt_code termview_render(const image *im, const termview_opts *o, bytebuf *out, r
         int64_t a = (int64_t)c * im->w, b = a + im->w;
         xw += (size_t)((b + cols - 1) / cols - a / cols);
     }
-    span *xs = malloc((size_t)cols * sizeof *xs);
-    int64_t *xwt = malloc(xw * sizeof *xwt);
-    int64_t *ywt = malloc((size_t)(2 * ((int64_t)im->h / prow + 2)) * sizeof *ywt);
-    double *up = malloc((size_t)cols * 3 * sizeof *up), *lo = malloc((size_t)cols * 3 * sizeof *lo);
+    span *xs = rt_malloc((size_t)cols * sizeof *xs);
+    int64_t *xwt = rt_malloc(xw * sizeof *xwt);
+    int64_t *ywt = rt_malloc((size_t)(2 * ((int64_t)im->h / prow + 2)) * sizeof *ywt);
+    double *up = rt_malloc((size_t)cols * 3 * sizeof *up), *lo = rt_malloc((size_t)cols * 3 * sizeof *lo);
     rt_code rc = RT_OK;
     if (!xs || !xwt || !ywt || !up || !lo) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the preview");
@@ -186,11 +187,11 @@ rt_code termview_render(const image *im, const termview_opts *o, bytebuf *out, r
     if (out->failed)
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the preview");
 done:
-    free(xs);
-    free(xwt);
-    free(ywt);
-    free(up);
-    free(lo);
+    rt_free(xs);
+    rt_free(xwt);
+    rt_free(ywt);
+    rt_free(up);
+    rt_free(lo);
     return rc;
 }
 

@@ -1,6 +1,7 @@
 /* texobj.c — textured objects cut out of a solid texture (seed 000 §3, §7),
  * field volumes and slices. */
 #include "texobj.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -307,13 +308,13 @@ rt_code texobj_render(const texobj_shape *s, const camera *cam, const texobj_sou
     unit3(o->light, j.light);
     size_t nbands = ((size_t)im->h + TEXOBJ_BAND - 1) / TEXOBJ_BAND;
     int nw = par_workers(run, nbands);
-    j.acc = malloc((size_t)nw * (size_t)im->w * TEXOBJ_BAND * 4 * sizeof *j.acc);
-    j.rays = calloc((size_t)nw, sizeof *j.rays);
-    j.hits = calloc((size_t)nw, sizeof *j.hits);
+    j.acc = rt_malloc((size_t)nw * (size_t)im->w * TEXOBJ_BAND * 4 * sizeof *j.acc);
+    j.rays = rt_calloc((size_t)nw, sizeof *j.rays);
+    j.hits = rt_calloc((size_t)nw, sizeof *j.hits);
     if (!j.acc || !j.rays || !j.hits) {
-        free(j.acc);
-        free(j.rays);
-        free(j.hits);
+        rt_free(j.acc);
+        rt_free(j.rays);
+        rt_free(j.hits);
         return rt_fail(e, RT_ENOMEM, "out of memory rendering a %d x %d textured object", im->w, im->h);
     }
     rc = par_for(run, "textured object", nbands, render_band, &j);
@@ -324,9 +325,9 @@ rt_code texobj_render(const texobj_shape *s, const camera *cam, const texobj_sou
             st->hits += j.hits[w];
         }
     }
-    free(j.acc);
-    free(j.rays);
-    free(j.hits);
+    rt_free(j.acc);
+    rt_free(j.rays);
+    rt_free(j.hits);
     if (rc)
         return rt_fail(e, rc, "interrupted");
     return RT_OK;

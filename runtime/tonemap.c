@@ -1,6 +1,7 @@
 /* tonemap.c — histogram to image (log density as in flam3's renderer; the
  * formulas are in tonemap.h). */
 #include "tonemap.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -19,11 +20,11 @@ rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_erro
         return rt_fail(e, RT_EINVAL, "brightness is %g (expected > 0)", bright);
     int k = hs->w / im->w;
     size_t np = (size_t)im->w * (size_t)im->h;
-    uint64_t *cnt = malloc(sizeof *cnt * np);
-    double *cs = hs->csum ? malloc(sizeof *cs * 3 * np) : NULL;
+    uint64_t *cnt = rt_malloc(sizeof *cnt * np);
+    double *cs = hs->csum ? rt_malloc(sizeof *cs * 3 * np) : NULL;
     if (!cnt || (hs->csum && !cs)) {
-        free(cnt);
-        free(cs);
+        rt_free(cnt);
+        rt_free(cs);
         return rt_fail(e, RT_ENOMEM, "out of memory for tone mapping");
     }
     uint64_t mx = 0;
@@ -74,7 +75,7 @@ rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_erro
             px[3] = (float)(o->bg[3] + (1 - o->bg[3]) * v);
         }
     }
-    free(cnt);
-    free(cs);
+    rt_free(cnt);
+    rt_free(cs);
     return RT_OK;
 }

@@ -1,6 +1,7 @@
 /* tops.c — fractal tops (seed 004 eqs. (4)–(9)), colour stealing (§4) and
  * the fractal filter (§6). */
 #include "tops.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -139,7 +140,7 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
     out->src_w = g ? src_w : 0;
     out->src_h = g ? src_h : 0;
     size_t npx = (size_t)screen->w * (size_t)screen->h;
-    out->cell = calloc(npx, sizeof *out->cell);
+    out->cell = rt_calloc(npx, sizeof *out->cell);
     if (!out->cell)
         return rt_fail(e, RT_ENOMEM, "out of memory for a %d×%d fractal top", screen->w,
                        screen->h);
@@ -160,14 +161,14 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
         fixed_point(&g->maps[0], c.fb);
     size_t nchunks = (size_t)((opts->points + TOPS_CHUNK - 1) / TOPS_CHUNK);
     int nw = par_workers(run, nchunks);
-    c.cells = calloc((size_t)nw, sizeof *c.cells);
+    c.cells = rt_calloc((size_t)nw, sizeof *c.cells);
     if (!c.cells) {
         tops_free(out);
         return rt_fail(e, RT_ENOMEM, "out of memory for the fractal top");
     }
     c.cells[0] = out->cell;
     for (int i = 1; i < nw; i++)
-        if (!(c.cells[i] = calloc(npx, sizeof **c.cells))) {
+        if (!(c.cells[i] = rt_calloc(npx, sizeof **c.cells))) {
             code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread fractal tops", nw);
             goto done;
         }
@@ -186,8 +187,8 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
         }
 done:
     for (int i = 1; i < nw; i++)
-        free(c.cells[i]);
-    free(c.cells);
+        rt_free(c.cells[i]);
+    rt_free(c.cells);
     if (code)
         tops_free(out);
     return code;
@@ -201,7 +202,7 @@ rt_code tops_run(const fset_ifs *f, const draw_view *view, const tops_opts *opts
 
 void tops_free(tops_buf *t)
 {
-    free(t->cell);
+    rt_free(t->cell);
     t->cell = NULL;
 }
 

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt_alloc.h"
+
 #define VDB_MAGIC 0x56444220u   /* version.h.in OPENVDB_MAGIC, "VDB " */
 #define VDB_VERSION 224u        /* OPENVDB_FILE_VERSION of OpenVDB 10 */
 #define VDB_VERSION_MIN 222u    /* OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION */
@@ -178,7 +180,7 @@ static rt_code put_grid(bytebuf *b, const vdb_grid *g, int flags, rt_error *e)
     int comps = g->channels, mask_compress = !(flags & VDB_UNCOMPRESSED);
     int lx = (v->nx + 7) / 8, ly = (v->ny + 7) / 8, lz = (v->nz + 7) / 8;
     size_t cap = rt_mul_size(rt_mul_size((size_t)lx, (size_t)ly), (size_t)lz);
-    wleaf *leaves = cap ? malloc(rt_mul_size(cap, sizeof *leaves)) : NULL;
+    wleaf *leaves = cap ? rt_malloc(rt_mul_size(cap, sizeof *leaves)) : NULL;
     if (!leaves)
         return rt_fail(e, RT_ENOMEM, "out of memory for the leaves of grid '%s'", g->name);
     size_t nl = 0;
@@ -279,9 +281,9 @@ static rt_code put_grid(bytebuf *b, const vdb_grid *g, int flags, rt_error *e)
         bytebuf_f32le(b, 0.0f); /* background */
     bytebuf_u32le(b, 0);        /* tiles */
     bytebuf_u32le(b, (uint32_t)nupper);
-    uint64_t *cm = calloc(UPPER_N / 64, sizeof *cm);
+    uint64_t *cm = rt_calloc(UPPER_N / 64, sizeof *cm);
     if (!cm) {
-        free(leaves);
+        rt_free(leaves);
         return rt_fail(e, RT_ENOMEM, "out of memory writing grid '%s'", g->name);
     }
     static const uint64_t zeros[UPPER_N / 64];
@@ -326,7 +328,7 @@ static rt_code put_grid(bytebuf *b, const vdb_grid *g, int flags, rt_error *e)
         }
         i = j;
     }
-    free(cm);
+    rt_free(cm);
     size_t block_pos = b->len;
 
     /* buffers: each leaf's mask again, the metadata byte, the values */
@@ -342,7 +344,7 @@ static rt_code put_grid(bytebuf *b, const vdb_grid *g, int flags, rt_error *e)
                 bytebuf_f32le(b, grid_value(g, c, x, y, z));
         }
     }
-    free(leaves);
+    rt_free(leaves);
     size_t end_pos = b->len;
     if (b->failed)
         return rt_fail(e, RT_ENOMEM, "out of memory writing grid '%s'", g->name);
@@ -574,7 +576,7 @@ static int rd_internal(rgrid *g, int log2, const int32_t o[3])
     rd *r = g->r;
     int n = 1 << (3 * log2), child_total = log2 == UPPER_LOG2 ? LOWER_TOTAL : LEAF_TOTAL;
     size_t words = (size_t)n / 64;
-    uint64_t *cm = malloc(2 * words * sizeof *cm);
+    uint64_t *cm = rt_malloc(2 * words * sizeof *cm);
     if (!cm) {
         r->failed = 1;
         rt_fail(r->e, RT_ENOMEM, "out of memory reading a .vdb file");
@@ -584,19 +586,19 @@ static int rd_internal(rgrid *g, int log2, const int32_t o[3])
     rd_mask(r, cm, words);
     rd_mask(r, vm, words);
     if (r->failed || rd_values(r, n, g->comps, vm, g->mask_compress, g->bg, g->sel, g->scratch)) {
-        free(cm);
+        rt_free(cm);
         return -1;
     }
     for (int i = 0; i < n; i++) {
         if (bit(cm, i))
             continue;
         if (bit(vm, i)) {
-            free(cm);
+            rt_free(cm);
             return rd_fail(r, "the .vdb grid has active tiles (constant regions); frac reads voxels in leaves only");
         }
         for (int c = 0; c < g->comps; c++)
             if (g->scratch[i * g->comps + c] != g->bg[c] && !(isnan(g->scratch[i * g->comps + c]) && isnan(g->bg[c]))) {
-                free(cm);
+                rt_free(cm);
                 return rd_fail(r, "the .vdb grid has tiles whose value is not the background; frac reads "
                                   "voxels in leaves only");
             }
@@ -613,7 +615,7 @@ static int rd_internal(rgrid *g, int log2, const int32_t o[3])
         }
         if (g->nl == g->cap) {
             size_t nc = g->cap ? 2 * g->cap : 64;
-            rleaf *nv = realloc(g->leaves, nc * sizeof *nv);
+            rleaf *nv = rt_realloc(g->leaves, nc * sizeof *nv);
             if (!nv) {
                 r->failed = 1;
                 rt_fail(r->e, RT_ENOMEM, "out of memory reading a .vdb file");
@@ -626,7 +628,7 @@ static int rd_internal(rgrid *g, int log2, const int32_t o[3])
         memcpy(L->o, co, sizeof co);
         rd_mask(r, L->mask, LEAF_N / 64);
     }
-    free(cm);
+    rt_free(cm);
     return r->failed ? -1 : 0;
 }
 
@@ -760,7 +762,7 @@ static rt_code rd_grid(rd *r, size_t grid_pos, int comps, const char *gname, dou
             return rt_fail(r->e, RT_EFORMAT, "grid '%s' has tiles (constant regions); frac reads voxels in leaves only",
                            gname);
     }
-    g.scratch = malloc((size_t)UPPER_N * (size_t)comps * sizeof *g.scratch);
+    g.scratch = rt_malloc((size_t)UPPER_N * (size_t)comps * sizeof *g.scratch);
     if (!g.scratch)
         return rt_fail(r->e, RT_ENOMEM, "out of memory reading grid '%s'", gname);
     int32_t prev[3] = {0, 0, 0};
@@ -871,8 +873,8 @@ static rt_code rd_grid(rd *r, size_t grid_pos, int comps, const char *gname, dou
             volume_free(&out[c]);
     }
 done:
-    free(g.scratch);
-    free(g.leaves);
+    rt_free(g.scratch);
+    rt_free(g.leaves);
     return code;
 }
 
@@ -974,6 +976,6 @@ rt_code vdb_load(const char *path, const char *name, double max_voxels, volume o
     if (c)
         return c;
     c = vdb_from_mem(d, n, name, max_voxels, out, channels, e);
-    free(d);
+    rt_free(d);
     return c;
 }

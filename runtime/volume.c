@@ -1,5 +1,6 @@
 /* volume.c — voxel grid allocation and trilinear sampling. */
 #include "volume.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -14,7 +15,7 @@ rt_code volume_init(volume *vol, int nx, int ny, int nz, const double lo[3], con
     size_t n = rt_mul_size(rt_mul_size(rt_mul_size((size_t)nx, (size_t)ny), (size_t)nz), sizeof(float));
     if (n == 0)
         return rt_fail(e, RT_ENOMEM, "volume size %d×%d×%d is too large", nx, ny, nz);
-    vol->v = calloc(1, n);
+    vol->v = rt_calloc(1, n);
     if (!vol->v)
         return rt_fail(e, RT_ENOMEM, "out of memory for a %d×%d×%d volume", nx, ny, nz);
     vol->nx = nx;
@@ -29,7 +30,7 @@ rt_code volume_init(volume *vol, int nx, int ny, int nz, const double lo[3], con
 
 void volume_free(volume *vol)
 {
-    free(vol->v);
+    rt_free(vol->v);
     vol->v = NULL;
 }
 

@@ -5,6 +5,7 @@
  * quantisation conventions are in volume_io.h.
  */
 #include "volume_io.h"
+#include "rt_alloc.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -449,6 +450,9 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     size_t need = rt_mul_size(count, tsize(type));
     if (!need)
         return rt_fail(e, RT_EFORMAT, "NRRD sizes are too large");
+    rt_code lc = rt_check_voxels((double)sizes[0], (double)sizes[1], (double)sizes[2], e);
+    if (lc) /* before reading a detached data file or allocating the volume */
+        return lc;
 
     const unsigned char *data = d;
     size_t dn = n;
@@ -457,7 +461,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         if (!dir)
             return rt_fail(e, RT_EFORMAT, "NRRD detached data file '%s' cannot be located", datafile);
         size_t pl = strlen(dir) + strlen(datafile) + 2;
-        char *path = malloc(pl);
+        char *path = rt_malloc(pl);
         if (!path)
             return rt_fail(e, RT_ENOMEM, "out of memory");
         if (datafile[0] == '/' || !dir[0])
@@ -466,7 +470,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
             snprintf(path, pl, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", datafile);
         rt_code rc = fileio_read_all(path, need + (byte_skip > 0 ? (size_t)byte_skip : 0) + (1u << 20) + need,
                                      &file, &dn, e);
-        free(path);
+        rt_free(path);
         if (rc)
             return rc;
         data = file;
@@ -486,7 +490,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     else
         at += (size_t)byte_skip;
     if (at > dn || dn - at < need) {
-        free(file);
+        rt_free(file);
         return rt_fail(e, RT_EFORMAT, "NRRD data is %zu bytes, expected %zu (%ld×%ld×%ld samples of %zu byte(s))",
                        at > dn ? 0 : dn - at, need, sizes[0], sizes[1], sizes[2], tsize(type));
     }
@@ -505,13 +509,13 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     }
     rt_code rc = volume_init(v, (int)sizes[0], (int)sizes[1], (int)sizes[2], lo, hi, e);
     if (rc) {
-        free(file);
+        rt_free(file);
         return rc;
     }
     size_t ts = tsize(type);
     for (size_t i = 0; i < count; i++)
         v->v[i] = decode(data + at + i * ts, type, endian == 1);
-    free(file);
+    rt_free(file);
     return RT_OK;
 }
 
@@ -524,16 +528,16 @@ rt_code vio_load_nrrd(const char *path, volume *v, rt_error *e)
     if (rc)
         return rc;
     size_t dl = dir_len(path);
-    char *dir = malloc(dl + 1);
+    char *dir = rt_malloc(dl + 1);
     if (!dir) {
-        free(d);
+        rt_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory");
     }
     memcpy(dir, path, dl);
     dir[dl] = 0;
     rc = vio_nrrd_from_mem(d, n, dir, v, e);
-    free(dir);
-    free(d);
+    rt_free(dir);
+    rt_free(d);
     return rc;
 }
 
@@ -608,6 +612,9 @@ rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *
     size_t count = rt_mul_size(rt_mul_size((size_t)dims[0], (size_t)dims[1]), (size_t)dims[2]);
     if (!count || !rt_mul_size(count, 4))
         return rt_fail(e, RT_EFORMAT, "VTK dimensions are too large");
+    rt_code lc = rt_check_voxels((double)dims[0], (double)dims[1], (double)dims[2], e);
+    if (lc)
+        return lc;
     if (n - pos < count * 4)
         return rt_fail(e, RT_EFORMAT, "VTK data is %zu bytes, expected %zu", n - pos, count * 4);
     double lo[3], hi[3];
@@ -632,7 +639,7 @@ rt_code vio_load_vtk(const char *path, volume *v, rt_error *e)
     if (rc)
         return rc;
     rc = vio_vtk_from_mem(d, n, v, e);
-    free(d);
+    rt_free(d);
     return rc;
 }
 

@@ -1,6 +1,7 @@
 /* wrinkly.c — wrinkly curves and surfaces, seed 002 §5.1 eq. (7)-(11), with
  * the adaptive sampling of §5.2 and a crack remedy of our own (wrinkly.h). */
 #include "wrinkly.h"
+#include "rt_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -150,9 +151,9 @@ double wrinkly_curve_attr(const wrinkly_curve *c, double tension, int which, dou
 
 void wrinkly_polyline_free(wrinkly_polyline *p)
 {
-    free(p->xy);
-    free(p->u);
-    free(p->rgba);
+    rt_free(p->xy);
+    rt_free(p->u);
+    rt_free(p->rgba);
     memset(p, 0, sizeof *p);
 }
 
@@ -193,9 +194,9 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
         return rc;
     size_t ns = ist_sample_positions(&samp, ki, o->jitter, o->seed ^ (stream * 0x9e3779b97f4a7c15ull), NULL, 0);
     size_t tot = ns + (ax->cyclic ? 0 : 2);
-    double *pos = malloc(sizeof(double) * (tot ? tot : 1));
+    double *pos = rt_malloc(sizeof(double) * (tot ? tot : 1));
     if (!pos || ns == (size_t)-1) {
-        free(pos);
+        rt_free(pos);
         ist_free(&samp);
         return rt_fail(e, RT_ENOMEM, "out of memory for wrinkly samples");
     }
@@ -218,7 +219,7 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
     }
     rc = ist_init(map, &sp, e);
     if (rc) {
-        free(pos);
+        rt_free(pos);
         return rc;
     }
     *out = pos;
@@ -256,7 +257,7 @@ rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrin
         return rc;
     double lam = lam_of(o->tension);
     int n = c->n;
-    int *ki = malloc(sizeof(int) * (size_t)n);
+    int *ki = rt_malloc(sizeof(int) * (size_t)n);
     if (!ki)
         return rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly curve");
     wrinkly_curve_levels(c, o, ki);
@@ -264,13 +265,13 @@ rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrin
     double *pos;
     size_t np;
     rc = axis_samples(n, &c->ax, ki, o, 0, &pos, &np, &map, &out->k, e);
-    free(ki);
+    rt_free(ki);
     if (rc)
         return rc;
-    out->xy = malloc(sizeof(double) * 2 * np);
-    out->rgba = malloc(sizeof(float) * 4 * np);
+    out->xy = rt_malloc(sizeof(double) * 2 * np);
+    out->rgba = rt_malloc(sizeof(float) * 4 * np);
     if (!out->xy || !out->rgba) {
-        free(pos);
+        rt_free(pos);
         ist_free(&map);
         wrinkly_polyline_free(out);
         return rt_fail(e, RT_ENOMEM, "out of memory for %zu curve samples", np);
@@ -553,9 +554,9 @@ static rt_code make_axis(int n, const wrinkly_axis *ax, const int *ki, const wri
     rt_code rc = axis_samples(n, ax, ki, o, stream, &pos, &np, &map, k, e);
     if (rc)
         return rc;
-    axsamp *a = malloc(sizeof *a * np);
+    axsamp *a = rt_malloc(sizeof *a * np);
     if (!a) {
-        free(pos);
+        rt_free(pos);
         ist_free(&map);
         return rt_fail(e, RT_ENOMEM, "out of memory for %zu wrinkly samples", np);
     }
@@ -566,7 +567,7 @@ static rt_code make_axis(int n, const wrinkly_axis *ax, const int *ki, const wri
         axis_weights(n, ax->cyclic, lam, 0, ax->ist ? ist_inv(&map, u) : u, &a[q].shuf);
         a[q].crack = ax->ist ? crack_weight(n, ax->cyclic, o->crack_band, u) : 1;
     }
-    free(pos);
+    rt_free(pos);
     ist_free(&map);
     *out = a;
     *count = np;
@@ -585,7 +586,7 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
     if (rc)
         return rc;
     double lam = lam_of(o->tension);
-    int *ku = malloc(sizeof(int) * (size_t)s->nu), *kv = malloc(sizeof(int) * (size_t)s->nv);
+    int *ku = rt_malloc(sizeof(int) * (size_t)s->nu), *kv = rt_malloc(sizeof(int) * (size_t)s->nv);
     axsamp *su = NULL, *sv = NULL;
     double *r = NULL;
     size_t nu = 0, nv = 0;
@@ -612,13 +613,13 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         rc = rt_fail(e, RT_EINVAL, "wrinkly surface would have %zu × %zu vertices; lower kmax", nu, nv);
         goto done;
     }
-    r = malloc(rt_mul_size(nvert, 3 * sizeof(double)));
-    free(out->nrm);
-    free(out->col);
-    out->pos = malloc(rt_mul_size(nvert, 3 * sizeof(float)));
-    out->nrm = malloc(rt_mul_size(nvert, 3 * sizeof(float)));
-    out->col = malloc(rt_mul_size(nvert, 4 * sizeof(float)));
-    out->tri = malloc(rt_mul_size(ntri ? ntri : 1, 3 * sizeof(uint32_t)));
+    r = rt_malloc(rt_mul_size(nvert, 3 * sizeof(double)));
+    rt_free(out->nrm);
+    rt_free(out->col);
+    out->pos = rt_malloc(rt_mul_size(nvert, 3 * sizeof(float)));
+    out->nrm = rt_malloc(rt_mul_size(nvert, 3 * sizeof(float)));
+    out->col = rt_malloc(rt_mul_size(nvert, 4 * sizeof(float)));
+    out->tri = rt_malloc(rt_mul_size(ntri ? ntri : 1, 3 * sizeof(uint32_t)));
     if (!r || !out->pos || !out->nrm || !out->col || !out->tri) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for a %zu-vertex wrinkly mesh", nvert);
         goto done;
@@ -655,11 +656,11 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         info->triangles = ntri;
     }
 done:
-    free(ku);
-    free(kv);
-    free(su);
-    free(sv);
-    free(r);
+    rt_free(ku);
+    rt_free(kv);
+    rt_free(su);
+    rt_free(sv);
+    rt_free(r);
     if (rc) {
         mesh_free(out);
         mesh_init(out, 1, 1);

@@ -8,12 +8,13 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "deflate.h"
 #include "fileio.h"
 
 static unsigned char *lcg_bytes(size_t n, uint32_t seed)
 {
-    unsigned char *p = malloc(n ? n : 1);
+    unsigned char *p = rt_malloc(n ? n : 1);
     uint32_t x = seed;
     for (size_t i = 0; i < n; i++) {
         x = (x * 1103515245u + 12345u) & 0x7FFFFFFFu;
@@ -65,11 +66,11 @@ static void test_checksums(void)
     CHECK(deflate_adler32(1, "", 0) == 1, "adler32 of empty");
     /* by hand: a = 1 + 255*n mod 65521, b = sum_{k=1..n} (1 + 255 k) mod 65521 */
     size_t n = 100000;
-    unsigned char *ff = malloc(n);
+    unsigned char *ff = rt_malloc(n);
     memset(ff, 0xFF, n);
     uint64_t a = (1 + 255ull * n) % 65521, b = (n + 255ull * n * (n + 1) / 2) % 65521;
     CHECK(deflate_adler32(1, ff, n) == (uint32_t)(b << 16 | a), "adler32 of 100000 x 0xFF");
-    free(ff);
+    rt_free(ff);
 }
 
 static void test_roundtrips(void)
@@ -89,14 +90,14 @@ static void test_roundtrips(void)
     roundtrip(r, n, 9, "random");
 
     /* long runs (> 258): 100000 equal bytes need matches of length 258 */
-    unsigned char *run = malloc(n);
+    unsigned char *run = rt_malloc(n);
     memset(run, 'a', n);
     size_t zrun = roundtrip(run, n, 6, "run");
     CHECK(zrun < 400, "a run of %zu bytes compressed to %zu bytes", n, zrun);
     roundtrip(run, n, 1, "run");
 
     /* repetitive with distances up to 32768: a random block repeated at 32768 */
-    unsigned char *far = malloc(70000);
+    unsigned char *far = rt_malloc(70000);
     unsigned char *blk = lcg_bytes(32768, 3);
     memcpy(far, blk, 32768);
     memcpy(far + 32768, blk, 32768);
@@ -106,11 +107,11 @@ static void test_roundtrips(void)
     CHECK(zfar < 32768 + 2000, "period-32768 data compressed to %zu bytes", zfar);
     roundtrip(far, 70000, 6, "distance 32768");
     /* a period one beyond the window cannot be matched */
-    unsigned char *far2 = malloc(65538);
+    unsigned char *far2 = rt_malloc(65538);
     memcpy(far2, blk, 32768);
     far2[32768] = 0;
     memcpy(far2 + 32769, blk, 32768);
-    free(blk);
+    rt_free(blk);
     roundtrip(far2, 65537, 9, "distance 32769");
 
     /* text, and the size zlib level 6 reaches on it (1544 bytes, CPython zlib) */
@@ -150,10 +151,10 @@ static void test_roundtrips(void)
     roundtrip(fib.data, fib.len, 6, "fibonacci");
     roundtrip(fib.data, fib.len, 1, "fibonacci");
     bytebuf_free(&fib);
-    free(r);
-    free(run);
-    free(far);
-    free(far2);
+    rt_free(r);
+    rt_free(run);
+    rt_free(far);
+    rt_free(far2);
 }
 
 /* Streams from another implementation (CPython zlib). */
@@ -163,7 +164,7 @@ static void test_known_streams(void)
     bytebuf_init(&text);
     gen_text(&text);
     unsigned char *stored = lcg_bytes(300, 1);
-    unsigned char *far = malloc(34000), *r = lcg_bytes(2000, 2);
+    unsigned char *far = rt_malloc(34000), *r = lcg_bytes(2000, 2);
     memcpy(far, r, 2000);
     memset(far + 2000, 0, 30000);
     memcpy(far + 32000, r, 2000);
@@ -203,12 +204,12 @@ static void test_known_streams(void)
                   cases[i].file, e.msg);
         }
         bytebuf_free(&o);
-        free(z);
+        rt_free(z);
     }
     bytebuf_free(&text);
-    free(stored);
-    free(far);
-    free(r);
+    rt_free(stored);
+    rt_free(far);
+    rt_free(r);
 }
 
 static void test_corrupt(void)
@@ -313,7 +314,7 @@ static void test_corrupt(void)
 
     /* decompression bomb: 10 MB of zeros, refused at 1 MB */
     size_t big = 10u << 20;
-    unsigned char *zero = calloc(1, big);
+    unsigned char *zero = rt_calloc(1, big);
     bytebuf zz;
     bytebuf_init(&zz);
     deflate_zlib(zero, big, 6, &zz, &e);
@@ -324,7 +325,7 @@ static void test_corrupt(void)
     CHECK(o.cap <= (1u << 20), "bomb: reserved %zu bytes", o.cap);
     bytebuf_free(&o);
     bytebuf_free(&zz);
-    free(zero);
+    rt_free(zero);
     bytebuf_free(&t);
     bytebuf_free(&z);
 }

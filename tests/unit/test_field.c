@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "density.h"
 #include "field.h"
 #include "noise.h"
@@ -243,7 +244,7 @@ static double d_wide(double x, double y, double z)
 }
 static field *g_wide(int width)
 {
-    field **t = malloc(sizeof *t * (size_t)width);
+    field **t = rt_malloc(sizeof *t * (size_t)width);
     for (int i = 0; i < width; i++)
         t[i] = B(FIELD_ADD, X_(), K(i));
     field *s1 = field_ref(t[0]), *s2 = field_ref(t[0]);
@@ -253,7 +254,7 @@ static field *g_wide(int width)
         s2 = B(FIELD_ADD, s2, field_ref(t[i]));
     for (int i = 0; i < width; i++)
         field_unref(t[i]);
-    free(t);
+    rt_free(t);
     return B(FIELD_MUL, s1, s2);
 }
 enum { MID = 100 };

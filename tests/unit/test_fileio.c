@@ -39,7 +39,7 @@ static int same_text(const char *path, const char *text)
     if (fileio_read_all(path, 1 << 20, &d, &n, NULL))
         return 0;
     int ok = n == strlen(text) && memcmp(d, text, n) == 0;
-    free(d);
+    rt_free(d);
     return ok;
 }
 

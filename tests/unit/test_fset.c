@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "fset.h"
 
 static const double R3 = 1.7320508075688772;
@@ -18,7 +19,7 @@ static int parse_is(const char *text, int nsets, const int *want, int n)
         return 0;
     }
     int ok = len == n && memcmp(seq, want, (size_t)n * sizeof *want) == 0;
-    free(seq);
+    rt_free(seq);
     return ok;
 }
 
@@ -185,7 +186,7 @@ int main(void)
                 }
             CHECK(outside == 0, "no hits outside the invariant disc (%d bins)", outside);
             if (t == 1) {
-                ref[mode] = malloc(1600 * sizeof *ref[mode]);
+                ref[mode] = rt_malloc(1600 * sizeof *ref[mode]);
                 memcpy(ref[mode], h.count, 1600 * sizeof *ref[mode]);
             } else {
                 CHECK(memcmp(ref[mode], h.count, 1600 * sizeof *ref[mode]) == 0,
@@ -194,7 +195,7 @@ int main(void)
             hist2_free(&h);
         }
     }
-    free(ref[0]);
-    free(ref[1]);
+    rt_free(ref[0]);
+    rt_free(ref[1]);
     return check_done("test_fset");
 }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "fileio.h"
 #include "ist.h"
 #include "rng.h"
@@ -60,7 +61,7 @@ static void test_bijective(void)
                 CHECK(ist_init(&t, &s, &e) == RT_OK, "init: %s", e.msg);
                 uint64_t S = ipow(2 * m + 1, k);
                 size_t tot = (size_t)n * S;
-                unsigned char *seen = calloc(tot, 1);
+                unsigned char *seen = rt_calloc(tot, 1);
                 size_t distinct = 0;
                 for (int i = 0; i < n; i++)
                     for (uint64_t q = 0; q < S; q++) {
@@ -75,7 +76,7 @@ static void test_bijective(void)
                     }
                 CHECK(distinct == tot, "axis %d M %d K %d: %zu distinct of %zu", axis, m, k, distinct,
                       tot);
-                free(seen);
+                rt_free(seen);
                 for (int i = 0; i < n; i++) {
                     CHECK_NEAR(ist_inv(&t, i + 0.5), i + 0.5, 1e-12, "centre fixed");
                     CHECK_NEAR(ist_fwd(&t, i + 0.5), i + 0.5, 1e-12, "centre fixed (F)");
@@ -300,7 +301,7 @@ static int same_bits(double a, double b)
 static void test_fast_bits(void)
 {
     static const double a0s[5] = {0, -2.5, 0.1, 3, -1}, hs[5] = {1, 0.25, 0.37, 1.5, 2};
-    double *u = malloc(sizeof(double) * 40000), *got = malloc(sizeof(double) * 40000);
+    double *u = rt_malloc(sizeof(double) * 40000), *got = rt_malloc(sizeof(double) * 40000);
     CHECK(u && got, "memory");
     long tested = 0, fast = 0;
     for (int axis = 0; axis < 2; axis++)
@@ -363,8 +364,8 @@ static void test_fast_bits(void)
                 }
     CHECK(fast > 100, "the fast path is used (%ld configurations)", fast);
     CHECK(tested > 1000000, "%ld evaluations compared", tested);
-    free(u);
-    free(got);
+    rt_free(u);
+    rt_free(got);
 }
 
 int main(void)

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "lineedit.h"
 
 #define WAIT_MS 3000
@@ -72,7 +73,7 @@ static void child_run(int slave, int res, const char *hist, int hist_max, const 
             break;
         if (r == LINEEDIT_LINE) {
             lineedit_history_add(le, line);
-            free(line);
+            rt_free(line);
         }
         if (r == LINEEDIT_EOF || r == LINEEDIT_ERROR)
             break;
@@ -437,7 +438,7 @@ static void test_pipe(void)
         lineedit_result r = lineedit_read(le, "> ", &line);
         CHECK(r == LINEEDIT_LINE && line && strcmp(line, want[i]) == 0, "pipe line %d: r=%d '%s'", i,
               (int)r, line ? line : "(null)");
-        free(line);
+        rt_free(line);
     }
     char *line = (char *)1;
     CHECK(lineedit_read(le, "> ", &line) == LINEEDIT_EOF && line == NULL, "pipe EOF");

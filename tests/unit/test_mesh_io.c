@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "mesh_io.h"
 
 #define DATA "tests/data/formats/"
@@ -42,7 +43,7 @@ static int same_as_file(const bytebuf *b, const char *path)
     int ok = n == b->len && memcmp(d, b->data, n) == 0;
     if (!ok)
         fprintf(stderr, "%s: %zu bytes, writer gave %zu\n", path, n, b->len);
-    free(d);
+    rt_free(d);
     return ok;
 }
 
@@ -235,11 +236,38 @@ static void test_errors(void)
     CHECK(strcmp(e.msg, "mesh file '/tmp/x.off' does not end in .ply, .obj or .stl") == 0, "msg: %s", e.msg);
 }
 
+/* Declared element counts are checked against the memory left before any
+ * is read. */
+static void test_declared_size(void)
+{
+    mesh m;
+    rt_error e = {0};
+    const char *ply = "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n";
+    size_t nt = 100000, n = 84 + 50 * nt;
+    unsigned char *stl = rt_calloc(n, 1);
+    check_limits(-1, -1, 1 << 20);
+    rt_code c = mio_ply_from_mem((const unsigned char *)ply, strlen(ply), &m, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "reading the PLY vertices and faces needs 1144 MiB, more than the 1 MiB "
+                                          "left under the memory limit (raise it with --max-memory MiB)") == 0,
+          "%d %s", c, e.msg);
+    mesh_free(&m);
+    stl[80] = (unsigned char)(nt & 255), stl[81] = (unsigned char)(nt >> 8 & 255), stl[82] = (unsigned char)(nt >> 16);
+    c = mio_stl_from_mem(stl, n, &m, &e);
+    CHECK(c == RT_ELIMIT && strstr(e.msg, "reading the STL triangles needs ") &&
+          strstr(e.msg, "more than the 1 MiB left under the memory limit"), "%d %s", c, e.msg);
+    CHECK(check_hs.peak < 4096, "largest block before the refusals: %zu", check_hs.peak);
+    mesh_free(&m);
+    check_limits_off();
+    rt_free(stl);
+}
+
 int main(void)
 {
     test_writers();
     test_readers();
     test_roundtrip();
     test_errors();
+    test_declared_size();
     return check_done("test_mesh_io");
 }

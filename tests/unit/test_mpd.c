@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "mpd.h"
 #include "rng.h"
 
@@ -89,8 +90,8 @@ static void random_points(size_t n, double *x, double *y, double *z, uint64_t se
 static void test_types_identical(void)
 {
     enum { NP = 3000 };
-    double *x = malloc(NP * sizeof *x), *y = malloc(NP * sizeof *y), *z = malloc(NP * sizeof *z);
-    double *ref = malloc(NP * sizeof *ref), *o = malloc(NP * sizeof *o);
+    double *x = rt_malloc(NP * sizeof *x), *y = rt_malloc(NP * sizeof *y), *z = rt_malloc(NP * sizeof *z);
+    double *ref = rt_malloc(NP * sizeof *ref), *o = rt_malloc(NP * sizeof *o);
     random_points(NP, x, y, z, 7);
     for (int R = 3; R <= 7; R++) {
         mpd m1 = make(R, MPD_TYPE1, 0, 99, 0.6, 1);
@@ -110,7 +111,7 @@ static void test_types_identical(void)
             /* every lattice node: grid at the lattice = mpd_node of Type I */
             int N = (1 << R) + 1;
             double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-            double *g = malloc((size_t)N * N * N * sizeof *g);
+            double *g = rt_malloc((size_t)N * N * N * sizeof *g);
             CHECK(mpd_eval_grid(&mk, &run, lo, hi, N, N, N, g, NULL, NULL) == RT_OK, "grid");
             int bad = 0;
             for (int k = 0; k < N; k++)
@@ -123,7 +124,7 @@ static void test_types_identical(void)
                         bad += g[i + N * (j + (size_t)N * k)] != v1;
                     }
             CHECK(bad == 0, "R=%d type %d R2=%d: %d lattice nodes differ", R, cases[c][0], cases[c][1], bad);
-            free(g);
+            rt_free(g);
             /* a grid off the lattice against point evaluation */
             double lo2[3] = {0.1, -0.05, 0.3}, hi2[3] = {0.9, 0.77, 1.2};
             double gx[7 * 5 * 6], px[7 * 5 * 6], py[7 * 5 * 6], pz[7 * 5 * 6], pv[7 * 5 * 6];
@@ -141,7 +142,7 @@ static void test_types_identical(void)
         }
         mpd_free(&m1);
     }
-    free(x), free(y), free(z), free(ref), free(o);
+    rt_free(x), rt_free(y), rt_free(z), rt_free(ref), rt_free(o);
 }
 
 /* The corners keep their values; trilinear interpolation between nodes:
@@ -340,7 +341,7 @@ static void test_validation(void)
 static void test_threads(void)
 {
     enum { NP = 9000 };
-    double *x = malloc(NP * sizeof *x), *y = malloc(NP * sizeof *y), *z = malloc(NP * sizeof *z);
+    double *x = rt_malloc(NP * sizeof *x), *y = rt_malloc(NP * sizeof *y), *z = rt_malloc(NP * sizeof *z);
     double *o[3];
     random_points(NP, x, y, z, 3);
     int types[4] = {MPD_TYPE1, MPD_TYPE2, MPD_TYPE3, MPD_TYPE4};
@@ -349,8 +350,8 @@ static void test_threads(void)
         for (int q = 0; q < 3; q++) {
             mpd m = make(7, types[t], 4, 77, 0.5, 1 << q);
             rt_run run = {1 << q, NULL, 0};
-            o[q] = malloc(NP * sizeof *o[q]);
-            gr[q] = malloc(20 * 20 * 20 * sizeof *gr[q]);
+            o[q] = rt_malloc(NP * sizeof *o[q]);
+            gr[q] = rt_malloc(20 * 20 * 20 * sizeof *gr[q]);
             mpd_eval_points(&m, &run, NP, x, y, z, o[q], NULL, NULL);
             double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.25};
             mpd_eval_grid(&m, &run, lo, hi, 20, 20, 20, gr[q], NULL, NULL);
@@ -361,9 +362,9 @@ static void test_threads(void)
             CHECK(memcmp(gr[0], gr[q], 8000 * sizeof *gr[0]) == 0, "type %d grid: threads 1 vs %d", types[t], 1 << q);
         }
         for (int q = 0; q < 3; q++)
-            free(o[q]), free(gr[q]);
+            rt_free(o[q]), rt_free(gr[q]);
     }
-    free(x), free(y), free(z);
+    rt_free(x), rt_free(y), rt_free(z);
 }
 
 int main(void)

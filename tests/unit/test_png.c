@@ -579,6 +579,44 @@ static void test_paeth_ties(void)
     free(want);
 }
 
+/* A small file that declares a huge image: refused by the pixel limit at
+ * IHDR, before anything of that size is allocated; the memory check comes
+ * before the rows are inflated. */
+static void test_declared_size(void)
+{
+    rt_error e = {0};
+    image im;
+    bytebuf b;
+    size_t rb = 1 + 9000 / 8, nraw = rb * 9000; /* 1-bit grey, filter 0, all zero */
+    unsigned char *raw = rt_calloc(nraw, 1);
+    build(&b, 9000, 9000, 1, 0, 0, NULL, 0, NULL, 0, raw, nraw);
+    rt_free(raw);
+    CHECK(b.len < 64 * 1024, "the 9000×9000 file is small: %zu bytes", b.len);
+    check_limits(1e6, -1, -1);
+    rt_code c = dec(&b, &im, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "image of 9000×9000 pixels exceeds the limit of 1000000 pixels "
+                                          "(raise it with --max-pixels)") == 0, "%d %s", c, e.msg);
+    CHECK(check_hs.peak < 64 * 1024, "largest block before the refusal: %zu bytes", check_hs.peak);
+    check_limits(1e8, -1, 1 << 20); /* pixels allowed, 1 MiB of memory left */
+    c = dec(&b, &im, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "decoding the PNG image needs 1246 MiB, more than the 1 MiB left under "
+                                          "the memory limit (raise it with --max-memory MiB)") == 0, "%d %s", c, e.msg);
+    CHECK(check_hs.peak < 64 * 1024, "largest block before the refusal: %zu bytes", check_hs.peak);
+    check_limits_off();
+    bytebuf_free(&b);
+    /* at the limit exactly: decodes */
+    raw = rt_calloc(1 + 1000 / 8, 1000);
+    build(&b, 1000, 1000, 1, 0, 0, NULL, 0, NULL, 0, raw, (1 + 1000 / 8) * 1000);
+    rt_free(raw);
+    check_limits(1e6, -1, -1);
+    c = dec(&b, &im, &e);
+    check_limits_off();
+    CHECK(c == RT_OK && im.w == 1000 && im.h == 1000, "%d %s", c, e.msg);
+    if (c == RT_OK)
+        image_free(&im);
+    bytebuf_free(&b);
+}
+
 int main(void)
 {
     test_encoder();
@@ -587,5 +625,6 @@ int main(void)
     test_corrupt_suite();
     test_handmade();
     test_paeth_ties();
+    test_declared_size();
     return check_done("test_png");
 }

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "fileio.h"
 #include "image.h"
 #include "png.h"
@@ -290,11 +291,37 @@ static void test_dispatch(void)
     image_free(&im);
 }
 
+/* The pixel limit is checked after the header and before the image is
+ * allocated (the samples must be in the file, so the memory check is the
+ * hook's own). */
+static void test_declared_size(void)
+{
+    size_t n = 20 + 2000 * 1000;
+    unsigned char *d = rt_calloc(n, 1);
+    int k = snprintf((char *)d, 20, "P5 2000 1000 255\n");
+    image im;
+    rt_error e = {0};
+    check_limits(1e6, -1, -1);
+    rt_code c = pnm_decode(d, (size_t)k + 2000 * 1000, &im, NULL, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "image of 2000×1000 pixels exceeds the limit of 1000000 pixels "
+                                          "(raise it with --max-pixels)") == 0, "%d %s", c, e.msg);
+    CHECK(check_hs.peak < 4096, "largest block before the refusal: %zu", check_hs.peak);
+    k = snprintf((char *)d, 20, "PF 400 400 -1.0\n");
+    memset(d + k, 0, n - (size_t)k);
+    check_limits(1e5, -1, -1);
+    c = pfm_decode(d, (size_t)k + 400 * 400 * 12, &im, NULL, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "image of 400×400 pixels exceeds the limit of 100000 pixels "
+                                          "(raise it with --max-pixels)") == 0, "%d %s", c, e.msg);
+    check_limits_off();
+    rt_free(d);
+}
+
 int main(void)
 {
     test_handwritten();
     test_roundtrips();
     test_malformed();
     test_dispatch();
+    test_declared_size();
     return check_done("test_pnm");
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "raster.h"
 #include "wrinkly.h"
 
@@ -131,7 +132,7 @@ static void test_depth(void)
 static void test_threads(void)
 {
     int nu = 6, nv = 5;
-    wrinkly_point *p = calloc((size_t)nu * nv, sizeof *p);
+    wrinkly_point *p = rt_calloc((size_t)nu * nv, sizeof *p);
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
             wrinkly_point *q = &p[j * nu + i];
@@ -195,7 +196,7 @@ static void test_threads(void)
     }
     image_free(&ref);
     mesh_free(&m);
-    free(p);
+    rt_free(p);
 }
 
 
@@ -206,7 +207,7 @@ static void test_threads(void)
 static void test_binning(void)
 {
     int nu = 6, nv = 5;
-    wrinkly_point *p = calloc((size_t)nu * nv, sizeof *p);
+    wrinkly_point *p = rt_calloc((size_t)nu * nv, sizeof *p);
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
             wrinkly_point *q = &p[j * nu + i];
@@ -274,7 +275,7 @@ static void test_binning(void)
     CHECK(greenish == 0, "transparent ties: %zu nearly green pixels", greenish);
     /* and with the copy first it is green: the test sees the list order */
     size_t half = 3 * (m.nt / 2);
-    uint32_t *sw = malloc(sizeof(uint32_t) * 2 * half);
+    uint32_t *sw = rt_malloc(sizeof(uint32_t) * 2 * half);
     memcpy(sw, m.tri + half, sizeof(uint32_t) * half);
     memcpy(sw + half, m.tri, sizeof(uint32_t) * half);
     uint32_t *keep = m.tri;
@@ -291,7 +292,7 @@ static void test_binning(void)
     CHECK(green > 1000, "copy first: %zu green pixels", green);
     image_free(&gi);
     m.tri = keep;
-    free(sw);
+    rt_free(sw);
     for (int tile = 8; tile <= 16; tile *= 2)
         for (int th = 1; th <= 4; th++) {
             rt_run run = {th, NULL, 0};
@@ -304,7 +305,7 @@ static void test_binning(void)
         }
     image_free(&ref);
     mesh_free(&m);
-    free(p);
+    rt_free(p);
 }
 
 /* Near-plane clipping. Camera at (0, 1, 0) looking along -z, 90° on

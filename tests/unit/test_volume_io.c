@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "volume_io.h"
 
 #define DATA "tests/data/formats/"
@@ -39,7 +40,7 @@ static int same_as_file(const bytebuf *b, const char *path)
     int ok = n == b->len && memcmp(d, b->data, n) == 0;
     if (!ok)
         fprintf(stderr, "%s: %zu bytes, writer gave %zu\n", path, n, b->len);
-    free(d);
+    rt_free(d);
     return ok;
 }
 
@@ -262,6 +263,28 @@ static void test_slice(void)
     volume_free(&v);
 }
 
+/* Declared sizes are checked against the voxel limit before the data are
+ * looked for or the volume is allocated. */
+static void test_declared_size(void)
+{
+    const char *nrrd = "NRRD0004\ntype: float\ndimension: 3\nsizes: 1000 1000 1000\nendian: little\n"
+                       "encoding: raw\n\n";
+    const char *vtk = "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\n"
+                      "DIMENSIONS 1000 1000 1000\nORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 1000000000\n"
+                      "SCALARS v float 1\nLOOKUP_TABLE default\n";
+    volume v;
+    rt_error e = {0};
+    check_limits(-1, 1e6, -1);
+    rt_code c = vio_nrrd_from_mem((const unsigned char *)nrrd, strlen(nrrd), NULL, &v, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "volume of 1000×1000×1000 voxels exceeds the limit of 1000000 voxels "
+                                          "(raise it with --max-voxels)") == 0, "%d %s", c, e.msg);
+    c = vio_vtk_from_mem((const unsigned char *)vtk, strlen(vtk), &v, &e);
+    CHECK(c == RT_ELIMIT && strcmp(e.msg, "volume of 1000×1000×1000 voxels exceeds the limit of 1000000 voxels "
+                                          "(raise it with --max-voxels)") == 0, "%d %s", c, e.msg);
+    CHECK(check_hs.peak < 4096, "largest block before the refusals: %zu", check_hs.peak);
+    check_limits_off();
+}
+
 int main(void)
 {
     test_writers_match_references();
@@ -269,5 +292,6 @@ int main(void)
     test_roundtrip();
     test_malformed();
     test_slice();
+    test_declared_size();
     return check_done("test_volume_io");
 }

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "rt_alloc.h"
 #include "mesh.h"
 #include "rng.h"
 #include "wrinkly.h"
@@ -108,7 +109,7 @@ static void test_curve(void)
 /* Torus-like control mesh: major radius 3, minor 1. */
 static wrinkly_point *torus(int nu, int nv, uint64_t seed)
 {
-    wrinkly_point *p = calloc((size_t)nu * nv, sizeof *p);
+    wrinkly_point *p = rt_calloc((size_t)nu * nv, sizeof *p);
     rng r;
     rng_init(&r, seed, 0);
     for (int j = 0; j < nv; j++)
@@ -224,7 +225,7 @@ static void test_surface(void)
     CHECK(wrinkly_surface_mesh(&bad, &o, NULL, &m, NULL, &e) == RT_EINVAL, "nu = 0 refused");
     CHECK(strcmp(e.msg, "wrinkly surface (u axis) needs at least 1 control point, got 0") == 0, "msg: %s", e.msg);
     mesh_free(&m);
-    free(p);
+    rt_free(p);
 }
 
 
@@ -249,7 +250,7 @@ static void test_orientation(void)
 {
     int nu = 8, nv = 6;
     wrinkly_point *p = torus(nu, nv, 5);
-    wrinkly_point *q = calloc((size_t)nu * nv, sizeof *q); /* transposed: u runs around the tube */
+    wrinkly_point *q = rt_calloc((size_t)nu * nv, sizeof *q); /* transposed: u runs around the tube */
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++)
             q[i * nv + j] = p[j * nu + i];
@@ -314,8 +315,8 @@ static void test_orientation(void)
     CHECK(wrinkly_surface_side(&sh, &o, &e) == 0 &&
               strcmp(e.msg, "the surface encloses no volume, so no side of it is outward (use normal \"uv\")") == 0,
           "flat sheet: outward refused: %s", e.msg);
-    free(p);
-    free(q);
+    rt_free(p);
+    rt_free(q);
 }
 
 int main(void)
