@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "builtin.h"
+#include "cstack.h"
 #include "fileio.h"
 #include "par.h"
 #include "repl.h"
@@ -156,7 +157,7 @@ static void print_params(interp *I)
     }
 }
 
-int main(int argc, char **argv)
+static int frac_main(int argc, char **argv)
 {
     interp st, *I = &st;
     interp_init(I);
@@ -220,7 +221,12 @@ int main(int argc, char **argv)
         } else if (strcmp(a, "--max-memory") == 0 && val && parse_number(val, 1, 1 << 30, &d) == 0) {
             I->lim.max_memory = (size_t)(d * 1048576.0);
             i++;
-        } else if (strcmp(a, "--max-depth") == 0 && val && parse_number(val, 1, 1e6, &d) == 0) {
+        } else if (strcmp(a, "--max-depth") == 0 && val && parse_number(val, 1, 1e300, &d) == 0 &&
+                   d > CSTACK_MAX_DEPTH) {
+            free(ov);
+            return usage_error("--max-depth %s is more than the interpreter's stack holds (at most "
+                               CSTACK_STR(CSTACK_MAX_DEPTH) ")", val);
+        } else if (strcmp(a, "--max-depth") == 0 && val && parse_number(val, 1, CSTACK_MAX_DEPTH, &d) == 0) {
             I->lim.max_depth = (int)d;
             i++;
         } else if (strcmp(a, "--max-pixels") == 0 && val && parse_number(val, 1, 1e12, &d) == 0) {
@@ -341,3 +347,6 @@ int main(int argc, char **argv)
     interp_free(I);
     return rc;
 }
+
+/* The interpreter runs on a thread with a stack size frac chooses (cstack.h). */
+int main(int argc, char **argv) { return cstack_main(frac_main, argc, argv); }
