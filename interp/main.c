@@ -34,7 +34,7 @@ static const char usage_text[] =
     "  --params              with check: list the script's params and defaults\n"
     "limits (a script that exceeds one stops with an error naming it):\n"
     "  --max-memory MIB      memory for values, images, volumes (default 4096)\n"
-    "  --max-depth N         function call depth (default 1000)\n"
+    "  --max-depth N         function call depth (default 1000, at most " CSTACK_STR(CSTACK_MAX_DEPTH) ")\n"
     "  --max-pixels N        pixels per image (default 64000000)\n"
     "  --max-points N        points per chaos game or sampling (default 1e10)\n"
     "  --max-voxels N        voxels per volume (default 134217728 = 512^3)\n"
