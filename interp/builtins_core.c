@@ -7,6 +7,7 @@
 
 #include "builtin.h"
 #include "contract.h"
+#include "cstack.h"
 #include "eval.h"
 #include "fileio.h"
 #include "lexer.h"
@@ -131,6 +132,8 @@ static int apply1(interp *I, value a, math1 f, int opcode, value *out)
         return 0;
     }
     if (a.k == V_LIST) {
+        if (cstack_exhausted()) /* nested lists recurse */
+            return cstack_error(I, NULL, "lists nested too deeply");
         value res = val_list(I, AS_LIST(a)->n);
         if (res.k == V_NIL)
             return -1;

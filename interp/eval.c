@@ -8,6 +8,7 @@
 
 #include "builtin.h"
 #include "contract.h"
+#include "cstack.h"
 #include "fileio.h"
 #include "lang_objects.h"
 #include "lexer.h"
@@ -72,7 +73,22 @@ static int obj_arith(interp *I, int op, value a, value b, value *out, int *handl
     return 0;
 }
 
+static int binary_op(interp *I, int op, value a, value b, value *out, const node *at);
+
 int eval_binary(interp *I, int op, value a, value b, value *out, const node *at)
+{
+    if (a.k == V_NUM && b.k == V_NUM)
+        return binary_op(I, op, a, b, out, at);
+    /* allocation failures (a memory limit inside `+`) are reported at the operator */
+    const node *save = I->cur;
+    if (at)
+        I->cur = at;
+    int r = binary_op(I, op, a, b, out, at);
+    I->cur = save;
+    return r;
+}
+
+static int binary_op(interp *I, int op, value a, value b, value *out, const node *at)
 {
     *out = val_nil();
     if (a.k == V_NUM && b.k == V_NUM) {
@@ -110,7 +126,9 @@ int eval_binary(interp *I, int op, value a, value b, value *out, const node *at)
                 op == T_CARET;
     if (arith && (a.k == V_LIST || b.k == V_LIST) &&
         (a.k == V_LIST || a.k == V_NUM) && (b.k == V_LIST || b.k == V_NUM)) {
-        /* element-wise: vectors are lists of numbers */
+        /* element-wise: vectors are lists of numbers (nested lists recurse) */
+        if (cstack_exhausted())
+            return cstack_error(I, at, "lists nested too deeply");
         size_t n = a.k == V_LIST ? AS_LIST(a)->n : AS_LIST(b)->n;
         if (a.k == V_LIST && b.k == V_LIST && AS_LIST(a)->n != AS_LIST(b)->n)
             return err_at(I, at, ERR_TYPE, "cannot apply '%s' to lists of different lengths (%zu and %zu)",
@@ -122,7 +140,7 @@ int eval_binary(interp *I, int op, value a, value b, value *out, const node *at)
             value x = a.k == V_LIST ? AS_LIST(a)->items[i] : a;
             value y = b.k == V_LIST ? AS_LIST(b)->items[i] : b;
             value r;
-            if (eval_binary(I, op, x, y, &r, at) || list_push(I, AS_LIST(res), r)) {
+            if (binary_op(I, op, x, y, &r, at) || list_push(I, AS_LIST(res), r)) {
                 val_unref(I, res);
                 return -1;
             }
@@ -334,7 +352,9 @@ int call_value(interp *I, value fn, const value *args, int nargs, value *out)
     return call_any(I, fn, args, nargs, NULL, NULL, 0, NULL, I->cur, out);
 }
 
-static int eval_call(interp *I, env *e, const node *n, value *out)
+/* Kept out of eval_expr so its argument arrays do not enlarge every nested
+ * evaluation's frame (the C stack is the nesting limit, see cstack.h). */
+__attribute__((noinline)) static int eval_call(interp *I, env *e, const node *n, value *out)
 {
     value fn;
     if (eval_expr(I, e, n->kids[0], &fn))
@@ -435,7 +455,7 @@ static int eval_field(interp *I, value a, const char *name, value *out, const no
 
 /* ---- expressions ------------------------------------------------------------- */
 
-static int eval_table(interp *I, env *e, const node *n, value *out)
+__attribute__((noinline)) static int eval_table(interp *I, env *e, const node *n, value *out)
 {
     value t = val_list(I, (size_t)n->nkids);
     if (t.k == V_NIL)
@@ -481,7 +501,7 @@ static int iterate_list(interp *I, value it, const node *at)
     return 0;
 }
 
-static int eval_comp(interp *I, env *e, const node *n, value *out)
+__attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n, value *out)
 {
     value it;
     if (eval_expr(I, e, n->kids[1], &it))
@@ -530,9 +550,22 @@ fail:
     return -1;
 }
 
+/* The C stack is nearly full. Inside a function the error is reported at
+ * the innermost call (the recursion the reader looks for; where exactly the
+ * stack ran out depends on frame sizes), else at the node. */
+static int stack_overflow(interp *I, const node *n)
+{
+    if (I->depth > 0 && I->stack[I->depth - 1].call)
+        n = I->stack[I->depth - 1].call;
+    return cstack_error(I, n, "calls and expressions nested too deeply");
+}
+
 int eval_expr(interp *I, env *e, const node *n, value *out)
 {
     *out = val_nil();
+    /* every nested evaluation passes here: the C stack bounds the nesting */
+    if (cstack_exhausted())
+        return stack_overflow(I, n);
     switch (n->kind) {
     case N_NUM:
         *out = val_num(n->num);
@@ -607,8 +640,16 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
             r = 0;
             if (a.k == V_OBJ || b.k == V_OBJ)
                 r = obj_arith(I, n->op, a, b, out, &handled);
-            if (!handled && r == 0)
-                *out = val_bool(val_equal(a, b) == (n->op == T_EQ));
+            if (!handled && r == 0) {
+                const node *save = I->cur;
+                I->cur = n; /* a stack overflow comparing deep lists is reported here */
+                int eq = val_equal(I, a, b);
+                I->cur = save;
+                if (eq < 0)
+                    r = -1;
+                else
+                    *out = val_bool(eq == (n->op == T_EQ));
+            }
         } else {
             r = eval_binary(I, n->op, a, b, out, n);
         }
@@ -878,6 +919,8 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
 
 int eval_block(interp *I, env *e, const node *block, value *out)
 {
+    if (cstack_exhausted()) /* imports nest blocks without an expression between */
+        return stack_overflow(I, block);
     value last = val_nil();
     for (int i = 0; i < block->nkids; i++) {
         const node *s = block->kids[i];

@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "builtin.h"
+#include "cstack.h"
 #include "eval.h"
 #include "fileio.h"
 #include "par.h"
@@ -67,7 +68,7 @@ static const char usage_text[] =
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
-    "  --max-depth N         function call depth (default 1000)\n"
+    "  --max-depth N         function call depth (default 1000, at most " CSTACK_STR(CSTACK_MAX_DEPTH) ")\n"
     "  --max-pixels N        pixels per image (default 64000000)\n"
     "  --max-points N        points per chaos game or sampling (default 1e10)\n"
     "  --max-voxels N        voxels per volume (default 134217728 = 512^3)\n"
@@ -112,7 +113,8 @@ static const struct numflag {
     [F_SEED] = {"--seed", 0, 9007199254740992.0, "a whole number from 0 to 2^53 = 9007199254740992"},
     [F_THREADS] = {"--threads", 1, 256, "a whole number from 1 to 256"},
     [F_MEMORY] = {"--max-memory", 1, 1073741824.0, "a whole number of MiB from 1 to 2^30"},
-    [F_DEPTH] = {"--max-depth", 1, 1e6, "a whole number from 1 to 1000000"},
+    [F_DEPTH] = {"--max-depth", 1, CSTACK_MAX_DEPTH,
+                 "a whole number from 1 to " CSTACK_STR(CSTACK_MAX_DEPTH) " (the most the interpreter's stack holds)"},
     [F_PIXELS] = {"--max-pixels", 1, 1e12, "a whole number from 1 to 1e12"},
     [F_POINTS] = {"--max-points", 1, 1e15, "a whole number from 1 to 1e15"},
     [F_VOXELS] = {"--max-voxels", 1, 1e12, "a whole number from 1 to 1e12"},
@@ -583,7 +585,7 @@ static int run_frac(interp *I, opts *o)
     return rc;
 }
 
-int main(int argc, char **argv)
+static int frac_main(int argc, char **argv)
 {
     interp st, *I = &st;
     interp_init(I);
@@ -603,3 +605,6 @@ int main(int argc, char **argv)
     interp_free(I);
     return finish_output(rc);
 }
+
+/* The interpreter runs on a thread with a stack size frac chooses (cstack.h). */
+int main(int argc, char **argv) { return cstack_main(frac_main, argc, argv); }

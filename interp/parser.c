@@ -23,6 +23,7 @@ typedef struct parser {
     int closing;    /* the error being reported is a missing closer */
     const token *construct; /* innermost 'if', 'fn' or 'for' being parsed */
     int failed;
+    int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
 } parser;
 
 /* ---- token access ---------------------------------------------------------- */
@@ -154,6 +155,27 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
     else
         snprintf(buf, n, "%s", lex_name(t->type));
     return buf;
+}
+
+/* Enter one nesting level; past PARSE_MAX_NESTING, fail at the token that
+ * went too deep. Every recursive production passes here (parse_binary, the
+ * operand of a unary operator or '^', the body of 'for' and of a named 'fn'),
+ * so the recursion of every walk over the tree is bounded. At the end of
+ * the input the usual "expected …, found end of input" follows instead (the
+ * REPL asks for more). Callers that succeed must leave with p->depth--. */
+static int enter_level(parser *p)
+{
+    token *t = peek(p);
+    if (++p->depth <= PARSE_MAX_NESTING || t->type == T_EOF)
+        return 0;
+    p->depth--;
+    if (!p->failed) {
+        p->failed = 1;
+        err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX,
+                "nested too deeply: more than %d levels of brackets, blocks or operators",
+                PARSE_MAX_NESTING);
+    }
+    return -1;
 }
 
 /* Expect token type t; `what` describes the context for the message. */
@@ -716,47 +738,57 @@ static node *parse_list(parser *p)
     return p->failed ? NULL : n;
 }
 
-/* if -> 'if' expr 'then' expr {'elif' expr 'then' expr} ['else' expr] */
+/* if -> 'if' expr 'then' expr {'elif' expr 'then' expr} ['else' expr]
+ * An elif chain is built by a loop (each elif is the else branch of the
+ * one before), so a long chain is not nesting. */
 static node *parse_if(parser *p, token *at)
 {
-    node *n = mk(p, N_IF, at);
-    if (!n)
-        return NULL;
-    n->nkids = 3;
-    n->kids = arena_alloc(p->I, 3 * sizeof(node *));
-    if (!n->kids)
-        return NULL;
+    /* an elif chain is built by this loop, not by recursion, so a long
+     * chain needs no nesting depth */
     int save_tm = p->table_mode;
     const token *save_c = p->construct;
     p->table_mode = 0;
-    p->construct = at;
-    n->kids[0] = parse_expr(p);
-    if (!n->kids[0] || expect(p, T_THEN, "after the condition of 'if'"))
-        return NULL;
-    n->kids[1] = parse_expr(p);
-    if (!n->kids[1])
-        return NULL;
-    /* 'else' may start the next line */
-    size_t save = p->pos;
-    while (peek_raw(p)->type == T_NEWLINE)
-        p->pos++;
-    token *t = peek_raw(p);
-    if (t->type == T_ELIF) {
-        next(p);
-        n->kids[2] = parse_if(p, t);
-        if (!n->kids[2])
+    node *first = NULL, **slot = &first;
+    for (;;) {
+        node *n = mk(p, N_IF, at);
+        if (!n)
             return NULL;
-    } else if (t->type == T_ELSE) {
-        next(p);
-        n->kids[2] = parse_expr(p);
-        if (!n->kids[2])
+        n->nkids = 3;
+        n->kids = arena_alloc(p->I, 3 * sizeof(node *));
+        if (!n->kids)
             return NULL;
-    } else {
-        p->pos = save;
+        *slot = n;
+        p->construct = at; /* an unfinished 'if' / 'elif' names where it began */
+        n->kids[0] = parse_expr(p);
+        if (!n->kids[0] || expect(p, T_THEN, "after the condition of 'if'"))
+            return NULL;
+        n->kids[1] = parse_expr(p);
+        if (!n->kids[1])
+            return NULL;
+        /* 'else' may start the next line */
+        size_t save = p->pos;
+        while (peek_raw(p)->type == T_NEWLINE)
+            p->pos++;
+        token *t = peek_raw(p);
+        if (t->type == T_ELIF) {
+            next(p);
+            at = t;
+            slot = &n->kids[2];
+            continue;
+        }
+        if (t->type == T_ELSE) {
+            next(p);
+            n->kids[2] = parse_expr(p);
+            if (!n->kids[2])
+                return NULL;
+        } else {
+            p->pos = save;
+        }
+        break;
     }
     p->table_mode = save_tm;
     p->construct = save_c;
-    return n;
+    return first;
 }
 
 static node *parse_primary(parser *p)
@@ -866,7 +898,18 @@ static node *parse_primary(parser *p)
 
 static node *parse_unary(parser *p);
 
+static node *parse_binary_level(parser *p, int min_prec);
+
 static node *parse_binary(parser *p, int min_prec)
+{
+    if (enter_level(p))
+        return NULL;
+    node *n = parse_binary_level(p, min_prec);
+    p->depth--;
+    return n;
+}
+
+static node *parse_binary_level(parser *p, int min_prec)
 {
     node *left;
     token *t = peek(p);
@@ -940,13 +983,23 @@ static node *parse_binary(parser *p, int min_prec)
     return left;
 }
 
+/* an operand of a unary operator or '^': one more nesting level */
+static node *parse_unary_nested(parser *p)
+{
+    if (enter_level(p))
+        return NULL;
+    node *n = parse_unary(p);
+    p->depth--;
+    return n;
+}
+
 /* unary -> ('-' | '+') unary | power ; power -> postfix ['^' unary] */
 static node *parse_unary(parser *p)
 {
     token *t = peek(p);
     if (t->type == T_MINUS || t->type == T_PLUS) {
         next(p);
-        node *a = parse_unary(p);
+        node *a = parse_unary_nested(p);
         if (!a)
             return NULL;
         node *n = mk1(p, N_UNARY, t, a);
@@ -963,7 +1016,7 @@ static node *parse_unary(parser *p)
     token *op = peek(p);
     if (op->type == T_CARET) {
         next(p);
-        node *e = parse_unary(p);
+        node *e = parse_unary_nested(p);
         if (!e)
             return NULL;
         node *b = mk2(p, N_BINARY, op, base, e);
@@ -1049,9 +1102,10 @@ static node *parse_statement(parser *p)
             break; /* an anonymous fn expression */
         next(p);
         const char *name = expect_name(p, "a function name");
-        if (!name)
+        if (!name || enter_level(p))
             return NULL;
         node *l = parse_lambda_rest(p, t, name);
+        p->depth--;
         return l ? one_kid(p, N_FNDEF, t, l, name) : NULL;
     }
     case T_IMPORT: {
@@ -1093,9 +1147,10 @@ static node *parse_statement(parser *p)
         if (!it)
             return NULL;
         token *d = peek(p);
-        if (expect(p, T_DO, "to start the body of 'for'"))
+        if (expect(p, T_DO, "to start the body of 'for'") || enter_level(p))
             return NULL;
         node *body = parse_block_until(p, d, 0);
+        p->depth--;
         if (!body || expect_close(p, T_END, d))
             return NULL;
         p->construct = save_c;

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "cstack.h"
 #include "eval.h"
 #include "lexer.h"
 #include "parser.h"
@@ -234,6 +235,9 @@ static int resolve_node(resolver *r, scope *s, const node *n)
 {
     if (!n)
         return 0;
+    /* nesting is bounded by the parser, but flat chains (1+1+…) are left-deep trees */
+    if (cstack_exhausted())
+        return cstack_error(r->I, n, "expression nested too deeply");
     switch (n->kind) {
     case N_NAME:
         return visible(r, s, n->str) ? 0 : unknown(r, s, n, n->str);
@@ -276,6 +280,8 @@ static int resolve_node(resolver *r, scope *s, const node *n)
 
 static int resolve_block(resolver *r, scope *s, const node *b)
 {
+    if (cstack_exhausted())
+        return cstack_error(r->I, b, "blocks nested too deeply");
     /* functions defined in a block are visible throughout it */
     for (int i = 0; i < b->nkids; i++)
         if (b->kids[i]->kind == N_FNDEF && declare(r, s, b->kids[i]->str))

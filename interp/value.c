@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "builtin.h"
+#include "cstack.h"
 #include "fileio.h"
 #include "state.h"
 
@@ -36,43 +37,71 @@ static void heap_unlink(interp *I, heap *h)
         h->next->prev = h->prev;
 }
 
-/* Free the object's own storage; children are dropped by the caller. */
-static void heap_destroy(interp *I, heap *h, int drop_children)
+/* Queue a heap object whose last reference is being dropped: it leaves the
+ * list of all objects, and its `next` links it into `pending`. */
+static void drop_heap(interp *I, heap *h, heap **pending)
+{
+    if (h && --h->rc == 0) {
+        heap_unlink(I, h);
+        h->next = *pending;
+        *pending = h;
+    }
+}
+
+static void drop_value(interp *I, value v, heap **pending)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN)
+        drop_heap(I, v.u.h, pending);
+}
+
+/* Drop the references an object holds (into `pending`, not recursively). */
+static void drop_children(interp *I, heap *h, heap **pending)
 {
     switch (h->kind) {
-    case H_STR:
-        break;
     case H_LIST: {
         vlist *l = (vlist *)h;
-        if (drop_children)
-            for (size_t i = 0; i < l->n; i++)
-                val_unref(I, l->items[i]);
-        mem_free(I, l->items);
+        for (size_t i = 0; i < l->n; i++)
+            drop_value(I, l->items[i], pending);
         break;
     }
     case H_REC: {
         vrec *r = (vrec *)h;
-        if (drop_children)
-            for (size_t i = 0; i < r->n; i++)
-                val_unref(I, r->vals[i]);
-        mem_free(I, r->keys);
-        mem_free(I, r->vals);
+        for (size_t i = 0; i < r->n; i++)
+            drop_value(I, r->vals[i], pending);
         break;
     }
     case H_FUNC: {
         vfunc *f = (vfunc *)h;
-        if (drop_children && f->closure)
-            heap_unref(I, &f->closure->h);
+        if (f->closure)
+            drop_heap(I, &f->closure->h, pending);
         break;
     }
     case H_ENV: {
         env *e = (env *)h;
-        if (drop_children) {
-            for (size_t i = 0; i < e->n; i++)
-                val_unref(I, e->vals[i]);
-            if (e->parent)
-                heap_unref(I, &e->parent->h);
-        }
+        for (size_t i = 0; i < e->n; i++)
+            drop_value(I, e->vals[i], pending);
+        if (e->parent)
+            drop_heap(I, &e->parent->h, pending);
+        break;
+    }
+    default:
+        break;
+    }
+}
+
+/* Free an unlinked object's own storage. */
+static void free_storage(interp *I, heap *h)
+{
+    switch (h->kind) {
+    case H_LIST:
+        mem_free(I, ((vlist *)h)->items);
+        break;
+    case H_REC:
+        mem_free(I, ((vrec *)h)->keys);
+        mem_free(I, ((vrec *)h)->vals);
+        break;
+    case H_ENV: {
+        env *e = (env *)h;
         mem_free(I, e->names);
         mem_free(I, e->vals);
         mem_free(I, e->index);
@@ -81,18 +110,35 @@ static void heap_destroy(interp *I, heap *h, int drop_children)
     case H_OBJ: {
         vobj *o = (vobj *)h;
         if (o->cls->destroy)
-            o->cls->destroy(o->payload);
+            o->cls->destroy(o->payload); /* may drop values itself (re-entrant) */
         break;
     }
+    default:
+        break;
     }
-    heap_unlink(I, h);
     mem_free(I, h);
 }
 
+/* Free one object without touching what it refers to. */
+static void heap_destroy(interp *I, heap *h)
+{
+    heap_unlink(I, h);
+    free_storage(I, h);
+}
+
+/* Freeing is iterative: objects whose count reaches zero wait on a local
+ * list instead of being freed recursively, so dropping a list nested 10^6
+ * deep uses no stack. */
 void heap_unref(interp *I, heap *h)
 {
-    if (h && --h->rc == 0)
-        heap_destroy(I, h, 1);
+    heap *pending = NULL;
+    drop_heap(I, h, &pending);
+    while (pending) {
+        heap *x = pending;
+        pending = x->next;
+        drop_children(I, x, &pending);
+        free_storage(I, x);
+    }
 }
 
 void val_ref(value v)
@@ -110,7 +156,7 @@ void val_unref(interp *I, value v)
 void heap_free_all(interp *I)
 {
     while (I->heap_all)
-        heap_destroy(I, I->heap_all, 0);
+        heap_destroy(I, I->heap_all);
 }
 
 value val_str(interp *I, const char *s, size_t len)
@@ -141,7 +187,7 @@ value val_list(interp *I, size_t cap)
     if (cap) {
         l->items = mem_alloc(I, cap * sizeof(value));
         if (!l->items) {
-            heap_destroy(I, &l->h, 0);
+            heap_destroy(I, &l->h);
             return val_nil();
         }
         l->cap = cap;
@@ -377,7 +423,7 @@ int val_truthy(value v)
     }
 }
 
-int val_equal(value a, value b)
+int val_equal(interp *I, value a, value b)
 {
     if (a.k != b.k)
         return 0;
@@ -386,29 +432,40 @@ int val_equal(value a, value b)
     case V_BOOL: return a.u.b == b.u.b;
     case V_NUM: return a.u.n == b.u.n;
     case V_STR: return AS_STR(a)->len == AS_STR(b)->len && memcmp(AS_STR(a)->s, AS_STR(b)->s, AS_STR(a)->len) == 0;
-    case V_LIST: {
-        vlist *x = AS_LIST(a), *y = AS_LIST(b);
-        if (x->n != y->n)
-            return 0;
-        for (size_t i = 0; i < x->n; i++)
-            if (!val_equal(x->items[i], y->items[i]))
-                return 0;
-        return 1;
-    }
-    case V_REC: {
-        vrec *x = AS_REC(a), *y = AS_REC(b);
-        if (x->n != y->n)
-            return 0;
-        for (size_t i = 0; i < x->n; i++) {
-            value *o = rec_get(y, x->keys[i]);
-            if (!o || !val_equal(x->vals[i], *o))
-                return 0;
+    case V_LIST:
+    case V_REC:
+        if (a.u.h == b.u.h)
+            return 1;
+        /* lists nest as deep as the data: the C stack bounds the recursion */
+        if (cstack_exhausted()) {
+            cstack_error(I, NULL, "values nested too deeply to compare");
+            return -1;
         }
-        return 1;
-    }
+        break;
     case V_BUILTIN: return a.u.bi == b.u.bi;
     default: return a.u.h == b.u.h;
     }
+    if (a.k == V_LIST) {
+        vlist *x = AS_LIST(a), *y = AS_LIST(b);
+        if (x->n != y->n)
+            return 0;
+        for (size_t i = 0; i < x->n; i++) {
+            int r = val_equal(I, x->items[i], y->items[i]);
+            if (r != 1)
+                return r;
+        }
+        return 1;
+    }
+    vrec *x = AS_REC(a), *y = AS_REC(b);
+    if (x->n != y->n)
+        return 0;
+    for (size_t i = 0; i < x->n; i++) {
+        value *o = rec_get(y, x->keys[i]);
+        int r = o ? val_equal(I, x->vals[i], *o) : 0;
+        if (r != 1)
+            return r;
+    }
+    return 1;
 }
 
 /* Numbers print in the shortest form that reads back to the same double
@@ -450,7 +507,8 @@ static void print_string_repr(bytebuf *out, const vstr *s)
     bytebuf_byte(out, '"');
 }
 
-void val_print(interp *I, value v, bytebuf *out, int repr)
+/* A value that is not a list or record. */
+static void print_atom(value v, bytebuf *out, int repr)
 {
     char buf[64];
     switch (v.k) {
@@ -466,30 +524,6 @@ void val_print(interp *I, value v, bytebuf *out, int repr)
         else
             bytebuf_append(out, AS_STR(v)->s, AS_STR(v)->len);
         break;
-    case V_LIST: {
-        vlist *l = AS_LIST(v);
-        bytebuf_byte(out, '[');
-        size_t shown = l->n > 1000 ? 1000 : l->n;
-        for (size_t i = 0; i < shown; i++) {
-            if (i)
-                bytebuf_append(out, ", ", 2);
-            val_print(I, l->items[i], out, 1);
-        }
-        if (shown < l->n)
-            bytebuf_printf(out, ", … (%zu items)", l->n);
-        bytebuf_byte(out, ']');
-        break;
-    }
-    case V_REC: {
-        vrec *r = AS_REC(v);
-        bytebuf_byte(out, '{');
-        for (size_t i = 0; i < r->n; i++) {
-            bytebuf_printf(out, "%s%s: ", i ? ", " : "", r->keys[i]);
-            val_print(I, r->vals[i], out, 1);
-        }
-        bytebuf_byte(out, '}');
-        break;
-    }
     case V_FUNC: {
         vfunc *f = AS_FUNC(v);
         bytebuf_printf(out, "<fn %s>", f->name ? f->name : "lambda");
@@ -504,6 +538,76 @@ void val_print(interp *I, value v, bytebuf *out, int repr)
             bytebuf_printf(out, "<%s>", o->cls->name);
         break;
     }
+    case V_LIST:
+    case V_REC:
+        break;
     }
+}
+
+/* Lists and records print with an explicit stack of open containers (not
+ * recursion), so a list nested 10^5 deep prints. The stack is plain memory,
+ * like the output buffer; if it cannot grow the rest shows as `…`. */
+typedef struct print_frame {
+    value v;
+    size_t i; /* next item */
+} print_frame;
+
+void val_print(interp *I, value v, bytebuf *out, int repr)
+{
     (void)I;
+    if (v.k != V_LIST && v.k != V_REC) {
+        print_atom(v, out, repr);
+        return;
+    }
+    print_frame local[64], *st = local;
+    size_t n = 0, cap = sizeof local / sizeof local[0];
+    st[n++] = (print_frame){v, 0};
+    bytebuf_byte(out, v.k == V_LIST ? '[' : '{');
+    while (n) {
+        print_frame *f = &st[n - 1];
+        value child;
+        if (f->v.k == V_LIST) {
+            vlist *l = AS_LIST(f->v);
+            size_t shown = l->n > 1000 ? 1000 : l->n;
+            if (f->i == shown) {
+                if (shown < l->n)
+                    bytebuf_printf(out, ", … (%zu items)", l->n);
+                bytebuf_byte(out, ']');
+                n--;
+                continue;
+            }
+            if (f->i)
+                bytebuf_append(out, ", ", 2);
+            child = l->items[f->i++];
+        } else {
+            vrec *r = AS_REC(f->v);
+            if (f->i == r->n) {
+                bytebuf_byte(out, '}');
+                n--;
+                continue;
+            }
+            bytebuf_printf(out, "%s%s: ", f->i ? ", " : "", r->keys[f->i]);
+            child = r->vals[f->i++];
+        }
+        if (child.k != V_LIST && child.k != V_REC) {
+            print_atom(child, out, 1);
+            continue;
+        }
+        if (n == cap) {
+            size_t nc = cap * 2;
+            print_frame *ns = st == local ? malloc(nc * sizeof *ns) : realloc(st, nc * sizeof *ns);
+            if (!ns) {
+                bytebuf_append(out, "…", strlen("…"));
+                continue;
+            }
+            if (st == local)
+                memcpy(ns, local, sizeof local);
+            st = ns;
+            cap = nc;
+        }
+        st[n++] = (print_frame){child, 0};
+        bytebuf_byte(out, child.k == V_LIST ? '[' : '{');
+    }
+    if (st != local)
+        free(st);
 }

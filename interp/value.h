@@ -153,8 +153,11 @@ value *env_lookup(env *e, const char *name);                        /* borrowed,
 /* The type name used in messages: "number", "string", "list", "image"… */
 const char *val_type_name(value v);
 int val_truthy(value v);
-int val_equal(value a, value b);
-/* Printed form: strings quoted when repr is set (inside lists). */
+/* Structural equality: 1 equal, 0 not, -1 with an error recorded (values
+ * nested deeper than the C stack allows: "stack overflow", see cstack.h). */
+int val_equal(struct interp *I, value a, value b);
+/* Printed form: strings quoted when repr is set (inside lists). Iterative:
+ * values nested any depth print. */
 void val_print(struct interp *I, value v, struct bytebuf *out, int repr);
 
 /* Free every heap object (end of session): ignores reference counts. */
