@@ -830,7 +830,9 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         if (eval_expr(I, e, n->kids[0], &def))
             return -1;
         value ov;
-        int r = apply_param_override(I, n, def, &ov);
+        /* -D overrides the params of the script run, not those of the modules
+         * it imports (their top-level scope is the module's own) */
+        int r = e == I->globals ? apply_param_override(I, n, def, &ov) : 0;
         if (r < 0) {
             val_unref(I, def);
             return -1;
