@@ -463,10 +463,11 @@ static int b_mesh_stats(interp *I, value *a, int n, value *out)
              {"degenerate", (double)st.degenerate},
              {"euler", (double)st.euler},
              {"area", st.area},
+             {"volume", st.volume},
              {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
         const char *k = intern(I, f[i].k, strlen(f[i].k));
-        value v = i == 8 ? val_bool(f[i].v != 0) : val_num(f[i].v);
+        value v = i == 9 ? val_bool(f[i].v != 0) : val_num(f[i].v);
         if (!k || rec_set(I, AS_REC(r), k, v)) {
             val_unref(I, r);
             return -1;
@@ -541,7 +542,7 @@ static const builtin volume_builtins[] = {
     BUILTIN("load_volume", b_load_volume, p_path, "Load a volume from .nrrd, .nhdr or .vtk (relative to the script)."),
     BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
     BUILTIN("mesh_stats", b_mesh_stats, p_mesh,
-            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight}."),
+            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, volume, watertight}; volume is signed: Σ a·(b×c)/6 over the triangles, negative for a closed mesh wound inside out."),
     BUILTIN("slice", b_slice, p_slice,
             "An axis-aligned slice of a volume as an image: axis \"x\", \"y\" or \"z\", index (default: the middle), values lo..hi (default: the volume's range) through a palette."),
 };
