@@ -94,42 +94,31 @@ int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
 
 /* ---- cameras ------------------------------------------------------------------------ */
 
-static int rec_vec3(interp *I, value rec, const char *key, double out[3], int required, const char *what)
+/* A camera record as TY_CAMERA declares it (checked before the builtin
+ * runs: eye and target present, 3 finite numbers each, fov in (0, 179)). */
+static void rec_vec3(interp *I, value rec, const char *key, double out[3])
 {
     const char *k = intern(I, key, strlen(key));
     value *v = k ? rec_get(AS_REC(rec), k) : NULL;
-    if (!v) {
-        if (required)
-            return err_at(I, NULL, ERR_VALUE, "%s: the camera record needs '%s'", what, key);
-        return 1;
-    }
-    char w[128];
-    snprintf(w, sizeof w, "%s: camera %s", what, key);
-    return get_vec(I, *v, out, 3, w);
+    if (v)
+        for (int i = 0; i < 3; i++)
+            out[i] = AS_LIST(*v)->items[i].u.n;
 }
 
 int lang_get_camera(interp *I, value v, camera *cam, const char *what)
 {
-    if (v.k != V_REC)
-        return err_at(I, NULL, ERR_TYPE, "%s: camera must be a record like orbit(30, 20) gives, got %s", what,
-                      val_type_name(v));
     memset(cam, 0, sizeof *cam);
     cam->up[1] = 1;
     cam->fov = 40;
-    if (rec_vec3(I, v, "eye", cam->eye, 1, what) < 0 || rec_vec3(I, v, "target", cam->target, 1, what) < 0 ||
-        rec_vec3(I, v, "up", cam->up, 0, what) < 0)
-        return -1;
+    rec_vec3(I, v, "eye", cam->eye);
+    rec_vec3(I, v, "target", cam->target);
+    rec_vec3(I, v, "up", cam->up);
     double fov;
-    int r = opt_num(I, v, "fov", &fov);
-    if (r < 0)
-        return -1;
-    if (r == 1) {
-        if (!(fov > 0 && fov < 179))
-            return err_at(I, NULL, ERR_VALUE, "%s: camera fov must be between 0 and 179 degrees, got %g", what, fov);
+    if (opt_num(I, v, "fov", &fov) == 1)
         cam->fov = fov;
-    }
     if (camera_setup(cam))
-        return err_at(I, NULL, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view", what);
+        return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view",
+                        what);
     return 0;
 }
 

@@ -1367,12 +1367,12 @@ static const bparam p_surface[] = {{"control", "list", NULL},     {"heights", "n
                                    {"shuffle", "str|list", "nil"}, {"tension", "num", "2/3"},
                                    {"crack_band", "num", "0"},    {"jitter", "bool", "false"},
                                    {"extra", "int", "0"},         {"seed", "num", "nil"}};
-static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera", "rec", "nil"},
+static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera", TY_CAMERA, "nil"},
                                 {"size", "vec|num", "[256, 256]"},    {"pixel", "num", "1"},
                                 {"tolerance", "num", "nil"},          {"iterations", "int", "nil"},
                                 {"kmax", "int", "8"}};
 static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
-                                  {"camera", "rec", "nil"},
+                                  {"camera", TY_CAMERA, "nil"},
                                   {"size", "vec|num", "[256, 256]"},
                                   {"background", "any", "0"},
                                   {"light", "vec", "nil"},
