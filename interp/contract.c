@@ -694,7 +694,18 @@ static void describe_alt(const calt *a, sbuf *out)
     case K_REC: sb_printf(out, "a record"); break;
     case K_FUNC: sb_printf(out, "a function"); break;
     case K_NIL: sb_printf(out, "nil"); break;
-    default: sb_printf(out, "%s %.*s", strchr("aeiou", a->cls[0]) ? "an" : "a", (int)a->clslen, a->cls);
+    default: {
+        /* classes a script makes with a builtin of another name: say how */
+        static const struct { const char *cls, *how; } hints[] = {
+            {"order", " (order([1, 2]), order(\"W2 ∘ W1\"), …)"},
+            {"shape", " (polygon(…), polyline(…) or pointset(…))"},
+        };
+        const char *how = "";
+        for (size_t i = 0; i < sizeof hints / sizeof hints[0]; i++)
+            if (strlen(hints[i].cls) == a->clslen && memcmp(hints[i].cls, a->cls, a->clslen) == 0)
+                how = hints[i].how;
+        sb_printf(out, "%s %.*s%s", strchr("aeiou", a->cls[0]) ? "an" : "a", (int)a->clslen, a->cls, how);
+    }
     }
 }
 
