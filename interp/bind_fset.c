@@ -279,7 +279,7 @@ static int b_order(interp *I, value *a, int n, value *out)
     (void)n;
     value sq = a[0], pr = a[2];
     if (sq.k != V_NIL && pr.k != V_NIL)
-        return err_at(I, NULL, ERR_VALUE,
+        return err_arg(I, 2, ERR_VALUE,
                       "order: give a sequence (a list of set numbers or \"W2 ∘ W1\") or probabilities, not both");
     if (sq.k == V_NIL && pr.k == V_NIL)
         return err_at(I, NULL, ERR_VALUE,
@@ -291,12 +291,12 @@ static int b_order(interp *I, value *a, int n, value *out)
         size_t np = AS_LIST(pr)->n;
         if (val_truthy(a[1])) {
             mem_free(I, o);
-            return err_at(I, NULL, ERR_VALUE, "order: repeat applies to a sequence, not to a random order");
+            return err_arg(I, 1, ERR_VALUE, "order: repeat applies to a sequence, not to a random order");
         }
         if (np < 1 || np > 4096) {
             mem_free(I, o);
-            return err_at(I, NULL, ERR_VALUE, "order: probabilities must be 1 to 4096 numbers (one per set), got %zu",
-                          np);
+            return err_arg(I, 2, ERR_VALUE, "order: probabilities must be 1 to 4096 numbers (one per set), got %zu",
+                           np);
         }
         o->p = mem_alloc(I, sizeof(double) * np);
         if (!o->p) {
@@ -307,17 +307,11 @@ static int b_order(interp *I, value *a, int n, value *out)
             order_destroy(o);
             return -1;
         }
-        double s = 0;
-        for (size_t i = 0; i < np; i++) {
-            if (!(o->p[i] >= 0) || !isfinite(o->p[i])) {
-                err_at(I, NULL, ERR_VALUE, "order: probability %zu is %g (expected a number >= 0)", i + 1, o->p[i]);
-                order_destroy(o);
-                return -1;
-            }
+        double s = 0; /* each in [0, 1] (declared) */
+        for (size_t i = 0; i < np; i++)
             s += o->p[i];
-        }
         if (fabs(s - 1) > 1e-6) {
-            err_at(I, NULL, ERR_VALUE, "order: probabilities sum to %.9g (expected 1)", s);
+            err_arg(I, 2, ERR_VALUE, "order: probabilities sum to %.9g (expected 1)", s);
             order_destroy(o);
             return -1;
         }
@@ -327,7 +321,7 @@ static int b_order(interp *I, value *a, int n, value *out)
     } else {
         if (a[3].k != V_NIL) {
             mem_free(I, o);
-            return err_at(I, NULL, ERR_VALUE, "order: seed applies to a random order (probabilities:), not to a sequence");
+            return err_arg(I, 3, ERR_VALUE, "order: seed applies to a random order (probabilities:), not to a sequence");
         }
         if (sq.k == V_STR) {
             size_t off = 0;
@@ -336,14 +330,15 @@ static int b_order(interp *I, value *a, int n, value *out)
             if (c) {
                 mem_free(I, o);
                 if (c == RT_EINVAL && strncmp(e.msg, "order: ", 7) == 0)
-                    return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
-                return lang_rt_error(I, c, &e, "order");
+                    return err_arg(I, 0, ERR_VALUE, "%s", e.msg);
+                return c == RT_EINVAL ? err_arg(I, 0, ERR_VALUE, "order: %s", e.msg) : lang_rt_error(I, c, &e, "order");
             }
-        } else if (sq.k == V_LIST) {
+        } else { /* a list (declared list|str) */
             size_t len = AS_LIST(sq)->n;
             if (len < 1 || len > 100000000) {
                 mem_free(I, o);
-                return err_at(I, NULL, ERR_VALUE, "order: the sequence is empty (give set numbers like [1, 2, 1, 2])");
+                return err_arg(I, 0, ERR_VALUE, len < 1 ? "order: the sequence is empty (give set numbers like [1, 2, 1, 2])"
+                                                        : "order: the sequence is too long (at most 100000000 steps)");
             }
             o->seq = mem_alloc(I, sizeof(int) * len);
             if (!o->seq) {
@@ -353,9 +348,13 @@ static int b_order(interp *I, value *a, int n, value *out)
             for (size_t i = 0; i < len; i++) {
                 value x = AS_LIST(sq)->items[i];
                 if (x.k != V_NUM || x.u.n != floor(x.u.n) || x.u.n < 1 || x.u.n > 4096) {
-                    err_at(I, NULL, ERR_VALUE,
-                           "order: item %zu must be a set number from 1 (W1) to 4096, got %s", i + 1,
-                           x.k == V_NUM ? "a number out of range" : val_type_name(x));
+                    char got[40];
+                    if (x.k == V_NUM)
+                        fmt_number(x.u.n, got, sizeof got);
+                    else
+                        snprintf(got, sizeof got, "%s", val_type_name(x));
+                    err_item(I, sq, i, ERR_VALUE, "order: item %zu must be a set number from 1 (W1) to 4096, got %s",
+                             i + 1, got);
                     mem_free(I, o->seq);
                     mem_free(I, o);
                     return -1;
@@ -363,10 +362,6 @@ static int b_order(interp *I, value *a, int n, value *out)
                 o->seq[i] = (int)x.u.n - 1;
             }
             o->o.len = (int)len;
-        } else {
-            mem_free(I, o);
-            return err_at(I, NULL, ERR_TYPE, "order: sequence must be a list of set numbers or a string like \"W2 ∘ W1\", got %s",
-                          val_type_name(sq));
         }
         o->o.kind = val_truthy(a[1]) ? FSET_PERIODIC : FSET_SEQUENCE;
         o->o.seq = o->seq;
@@ -377,7 +372,7 @@ static int b_order(interp *I, value *a, int n, value *out)
 
 /* The order to use with a function set of nsets sets: given, or periodic
  * W1, W2, …, WN. *tmp holds a default's storage. */
-static int order_arg(interp *I, value v, int nsets, fset_order *o, int **tmp, const char *what)
+static int order_arg(interp *I, value v, int slot, int nsets, fset_order *o, int **tmp, const char *what)
 {
     *tmp = NULL;
     const lang_order *lo = as_order(v);
@@ -393,21 +388,18 @@ static int order_arg(interp *I, value v, int nsets, fset_order *o, int **tmp, co
         o->kind = FSET_PERIODIC;
         o->len = nsets;
         o->seq = *tmp;
-    } else {
-        return err_at(I, NULL, ERR_TYPE, "%s: order must be an order (order([1, 2]), order(\"W2 ∘ W1\"), …), got %s",
-                      what, val_type_name(v));
     }
     if (o->kind == FSET_RANDOM && lo->np != nsets) {
         mem_free(I, *tmp);
-        return err_at(I, NULL, ERR_VALUE, "%s: the random order has %d probabilities but the function set has %d sets",
-                      what, lo->np, nsets);
+        return err_arg(I, slot, ERR_VALUE, "%s: the random order has %d probabilities but the function set has %d sets",
+                       what, lo->np, nsets);
     }
     if (o->kind != FSET_RANDOM)
         for (int i = 0; i < o->len; i++)
             if (o->seq[i] >= nsets) {
                 mem_free(I, *tmp);
-                return err_at(I, NULL, ERR_VALUE, "%s: the order uses W%d but the function set has %d set%s", what,
-                              o->seq[i] + 1, nsets, nsets == 1 ? "" : "s");
+                return err_arg(I, slot, ERR_VALUE, "%s: the order uses W%d but the function set has %d set%s", what,
+                               o->seq[i] + 1, nsets, nsets == 1 ? "" : "s");
             }
     return 0;
 }
@@ -669,7 +661,7 @@ static int b_iterate(interp *I, value *a, int n, value *out)
     const lang_fset *f = as_fset(fv);
     fset_order o;
     int *tmp = NULL;
-    if (order_arg(I, a[3], f->n, &o, &tmp, "iterate")) {
+    if (order_arg(I, a[3], 3, f->n, &o, &tmp, "iterate")) {
         val_unref(I, fv);
         return -1;
     }
@@ -683,8 +675,9 @@ static int b_iterate(interp *I, value *a, int n, value *out)
             goto done;
         }
         steps = o.len;
-    } else if (get_int(I, a[2], 0, 1000000, &steps, "iterate: steps"))
-        goto done;
+    } else {
+        steps = (long)a[2].u.n; /* declared int[0,1000000] */
+    }
     if (a[1].k == V_NIL) {
         /* seed 003 §2-2: the triangle (0,0), (1,0), (1/2, √3/6) */
         double tri[9] = {0, 0, 0, 1, 0, 0, 0.5, sqrt(3.0) / 6, 0};
@@ -697,13 +690,11 @@ static int b_iterate(interp *I, value *a, int n, value *out)
         }
         k0 = &k0def;
         own_k0 = 1;
-    } else if (!(k0 = (detiter_shape *)as_shape(a[1]))) {
-        err_at(I, NULL, ERR_TYPE, "iterate: start must be a shape (polygon(…), polyline(…) or pointset(…)), got %s",
-               val_type_name(a[1]));
-        goto done;
+    } else {
+        k0 = (detiter_shape *)as_shape(a[1]); /* declared shape */
     }
     if (o.kind == FSET_SEQUENCE && steps > o.len) {
-        err_at(I, NULL, ERR_VALUE, "iterate: the order has %d step%s but steps is %ld (use order(…, repeat: true) to cycle)",
+        err_arg(I, 2, ERR_VALUE, "iterate: the order has %d step%s but steps is %ld (use order(…, repeat: true) to cycle)",
                o.len, o.len == 1 ? "" : "s", steps);
         goto done;
     }
@@ -751,7 +742,7 @@ static int window_arg(interp *I, value v, double lo[2], double hi[2], const char
     lo[1] = win[2];
     hi[1] = win[3];
     if (!(hi[0] > lo[0]) || !(hi[1] > lo[1]))
-        return err_at(I, NULL, ERR_VALUE, "%s is [xmin, xmax, ymin, ymax] with min < max", what);
+        return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s is [xmin, xmax, ymin, ymax] with min < max", what);
     return 0;
 }
 
@@ -835,10 +826,6 @@ static int b_draw(interp *I, value *a, int n, value *out)
     if (lang_get_colour(I, a[3], col, "draw: colour") || fill_arg(I, a[6], &fill, fillc, col, "draw: fill") ||
         lang_get_colour(I, a[7], bg, "draw: background"))
         return -1;
-    if (!(a[4].u.n >= 0 && a[4].u.n <= 1000))
-        return err_at(I, NULL, ERR_VALUE, "draw: width must be between 0 and 1000 pixels, got %g", a[4].u.n);
-    if (!(a[5].u.n >= 0 && a[5].u.n <= 1000))
-        return err_at(I, NULL, ERR_VALUE, "draw: radius must be between 0 and 1000 pixels, got %g", a[5].u.n);
     draw_view view;
     if (shape_view(I, s, a[2], w, h, &view, "draw"))
         return -1;
@@ -939,11 +926,9 @@ static int shape_preview(interp *I, const void *p, image **out)
 
 /* ---- chaos game with a function set ------------------------------------------------------- */
 
+/* points: declared int>=1; the limit is the session's. */
 static int points_arg(interp *I, value v, uint64_t *out, const char *what)
 {
-    if (v.k != V_NUM || !(v.u.n >= 1) || v.u.n != floor(v.u.n))
-        return err_at(I, NULL, ERR_VALUE, "%s: points must be a whole number >= 1, got %g", what,
-                      v.k == V_NUM ? v.u.n : NAN);
     if (v.u.n > I->lim.max_points)
         return err_at(I, NULL, ERR_LIMIT, "%s: %.0f points exceed the limit of %.0f (raise it with --max-points)", what,
                       v.u.n, I->lim.max_points);
@@ -960,15 +945,8 @@ static int tone_args(interp *I, value palette, value curve, value gamma, value b
     snprintf(w, sizeof w, "%s: palette", what);
     if (lang_get_ramp(I, palette, r, w))
         return -1;
-    const char *cv = AS_STR(curve)->s;
-    if (strcmp(cv, "log") == 0)
-        t->curve = TONEMAP_LOG;
-    else if (strcmp(cv, "linear") == 0)
-        t->curve = TONEMAP_LINEAR;
-    else
-        return err_at(I, NULL, ERR_VALUE, "%s: curve must be \"log\" or \"linear\", got \"%s\"", what, cv);
-    if (!(gamma.u.n > 0) || !(bright.u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "%s: gamma and brightness must be positive", what);
+    /* declared: curve str{log,linear}, gamma and brightness num>0 */
+    t->curve = strcmp(AS_STR(curve)->s, "linear") == 0 ? TONEMAP_LINEAR : TONEMAP_LOG;
     t->gamma = gamma.u.n;
     t->brightness = bright.u.n;
     t->colour = TONEMAP_RAMP;
@@ -1074,40 +1052,37 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     int w, h;
     ramp r;
     tonemap_opts t;
-    long depth, burn;
-    if (order_arg(I, a[1], f->n, &o, &tmp, "chaos_fset"))
+    long depth;
+    if (order_arg(I, a[1], 1, f->n, &o, &tmp, "chaos_fset"))
         goto done;
     if (points_arg(I, a[2], &co.points, "chaos_fset") || arg_size2(I, a[3], &w, &h, "chaos_fset: size") ||
         tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || arg_seed(I, a[14], &co.seed, "chaos_fset") ||
-        get_int(I, a[7], 0, 1000000, &burn, "chaos_fset: burn") || get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
+        get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
         goto done;
     if (f->dim != 2) {
-        err_at(I, NULL, ERR_VALUE, "chaos_fset: the function set is 3-D; the chaos game draws 2-D sets (use iterate for 3-D shapes)");
+        err_arg(I, 0, ERR_VALUE, "chaos_fset: the function set is 3-D; the chaos game draws 2-D sets (use iterate for 3-D shapes)");
         goto done;
     }
-    const char *mode = AS_STR(a[5])->s;
-    if (strcmp(mode, "orbit") == 0) {
+    if (strcmp(AS_STR(a[5])->s, "orbit") == 0) { /* declared str{orbit,walk} */
         co.mode = FSET_ORBIT;
         co.plot_period = o.kind != FSET_RANDOM;
-        co.burn = (uint64_t)burn;
+        co.burn = (uint64_t)a[7].u.n;
         if (a[6].k != V_NIL) {
-            err_at(I, NULL, ERR_VALUE, "chaos_fset: depth applies to mode \"walk\", not \"orbit\"");
+            err_arg(I, 6, ERR_VALUE, "chaos_fset: depth applies to mode \"walk\", not \"orbit\"");
             goto done;
         }
-    } else if (strcmp(mode, "walk") == 0) {
+    } else {
         co.mode = FSET_WALK;
         if (a[6].k == V_NIL) {
             if (o.kind == FSET_RANDOM) {
-                err_at(I, NULL, ERR_VALUE, "chaos_fset: mode \"walk\" with a random order needs depth: (steps per walk)");
+                err_arg(I, 1, ERR_VALUE, "chaos_fset: mode \"walk\" with a random order needs depth: (steps per walk)");
                 goto done;
             }
             depth = o.len;
-        } else if (get_int(I, a[6], 1, 1000000, &depth, "chaos_fset: depth"))
-            goto done;
+        } else {
+            depth = (long)a[6].u.n;
+        }
         co.depth = (uint64_t)depth;
-    } else {
-        err_at(I, NULL, ERR_VALUE, "chaos_fset: mode must be \"orbit\" or \"walk\", got \"%s\"", mode);
-        goto done;
     }
     double lo[2], hi[2];
     rt_error e;
@@ -1174,15 +1149,6 @@ static int ifs_window(interp *I, const lang_ifs *li, value window, int w, int h,
     return c ? lang_rt_error(I, c, &e, what) : 0;
 }
 
-static int depth_arg(interp *I, value v, int *depth, const char *what)
-{
-    long d;
-    if (get_int(I, v, 0, 64, &d, what))
-        return -1;
-    *depth = (int)d;
-    return 0;
-}
-
 /* top(system, size, points, window, palette, symbols, depth, background, seed) */
 static int b_top(interp *I, value *a, int n, value *out)
 {
@@ -1193,14 +1159,14 @@ static int b_top(interp *I, value *a, int n, value *out)
     memset(&to, 0, sizeof to);
     ramp r;
     float bg[4];
-    long nsym;
+    long nsym = (long)a[5].u.n; /* declared int[1,64] */
+    to.depth = (int)a[6].u.n;   /* declared int[0,64] */
     if (arg_size2(I, a[1], &w, &h, "top: size") || points_arg(I, a[2], &to.points, "top") ||
-        lang_get_ramp(I, a[4], &r, "top: palette") || get_int(I, a[5], 1, 64, &nsym, "top: symbols") ||
-        depth_arg(I, a[6], &to.depth, "top: depth") || lang_get_colour(I, a[7], bg, "top: background") ||
+        lang_get_ramp(I, a[4], &r, "top: palette") || lang_get_colour(I, a[7], bg, "top: background") ||
         arg_seed(I, a[8], &to.seed, "top"))
         return -1;
     if (li->f.dim != 2)
-        return err_at(I, NULL, ERR_VALUE, "top: the IFS is 3-D; fractal tops need 2-D maps");
+        return err_arg(I, 0, ERR_VALUE, "top: the IFS is 3-D; fractal tops need 2-D maps");
     double lo[2], hi[2];
     if (ifs_window(I, li, a[3], w, h, to.seed, lo, hi, "top: window"))
         return -1;
@@ -1222,7 +1188,7 @@ static int b_top(interp *I, value *a, int n, value *out)
         return lang_rt_error(I, c, &e, "top");
     if (nsym > tb.depth) {
         tops_free(&tb);
-        return err_at(I, NULL, ERR_VALUE, "top: symbols must be between 1 and the address depth %d, got %ld", tb.depth, nsym);
+        return err_arg(I, 5, ERR_VALUE, "top: symbols must be between 1 and the address depth %d, got %ld", tb.depth, nsym);
     }
     if (lang_image_new(I, w, h, &im)) {
         tops_free(&tb);
@@ -1255,15 +1221,15 @@ static int steal_args(interp *I, value *a, int k, steal_setup *s, int src_w, int
     snprintf(wn, sizeof wn, "%s: background", what);
     if (lang_get_colour(I, a[k + 4], s->bg, wn))
         return -1;
-    snprintf(wn, sizeof wn, "%s: depth", what);
-    if (depth_arg(I, a[k + 5], &s->to.depth, wn) || arg_seed(I, a[k + 6], &s->to.seed, what))
+    s->to.depth = (int)a[k + 5].u.n; /* declared int[0,64] */
+    if (arg_seed(I, a[k + 6], &s->to.seed, what))
         return -1;
     if (fi->f.n != gi->f.n)
-        return err_at(I, NULL, ERR_VALUE,
+        return err_arg(I, 1, ERR_VALUE,
                       "%s: the screen IFS has %d maps but the source IFS has %d; colour stealing pairs map i of one with map i of the other",
                       what, fi->f.n, gi->f.n);
     if (fi->f.dim != 2 || gi->f.dim != 2)
-        return err_at(I, NULL, ERR_VALUE, "%s: colour stealing needs 2-D IFSs", what);
+        return err_arg(I, fi->f.dim != 2 ? 0 : 1, ERR_VALUE, "%s: colour stealing needs 2-D IFSs", what);
     snprintf(wn, sizeof wn, "%s: window", what);
     if (ifs_window(I, fi, a[k + 2], s->w, s->h, s->to.seed, s->lo, s->hi, wn))
         return -1;
@@ -1316,9 +1282,9 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
     (void)n;
     vlist *fl = AS_LIST(a[2]);
     if (fl->n < 1)
-        return err_at(I, NULL, ERR_VALUE, "fractal_filter: frames is empty (give a list of images of one size)");
+        return err_arg(I, 2, ERR_VALUE, "fractal_filter: frames is empty (give a list of images of one size)");
     if (fl->n > 100000)
-        return err_at(I, NULL, ERR_VALUE, "fractal_filter: %zu frames, at most 100000", fl->n);
+        return err_arg(I, 2, ERR_VALUE, "fractal_filter: %zu frames, at most 100000", fl->n);
     image *frames = mem_alloc(I, sizeof(image) * fl->n);
     if (!frames)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
@@ -1326,15 +1292,15 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
         const image *im = lang_as_image(fl->items[i]);
         if (!im) {
             mem_free(I, frames);
-            return err_at(I, NULL, ERR_TYPE, "fractal_filter: frame %zu must be an image, got %s", i + 1,
-                          val_type_name(fl->items[i]));
+            return err_item(I, a[2], i, ERR_TYPE, "fractal_filter: frame %zu must be an image, got %s", i + 1,
+                            val_type_name(fl->items[i]));
         }
         frames[i] = *im;
         if (im->w != frames[0].w || im->h != frames[0].h) {
             int w0 = frames[0].w, h0 = frames[0].h;
             mem_free(I, frames);
-            return err_at(I, NULL, ERR_VALUE, "fractal_filter: frame %zu is %d×%d but frame 1 is %d×%d", i + 1, im->w, im->h,
-                          w0, h0);
+            return err_item(I, a[2], i, ERR_VALUE, "fractal_filter: frame %zu is %d×%d but frame 1 is %d×%d", i + 1, im->w,
+                            im->h, w0, h0);
         }
     }
     steal_setup s;
@@ -1471,20 +1437,19 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     double *P = NULL;
     superifs_opts so;
     memset(&so, 0, sizeof so);
-    long V, steps;
-    uint64_t pts;
-    if (get_int(I, a[2], 1, 1024, &V, "superifs: V") || points_arg(I, a[3], &pts, "superifs") ||
-        get_int(I, a[4], 0, 100000, &steps, "superifs: steps") || get_vec(I, a[5], so.start, 2, "superifs: start") ||
+    long V = (long)a[2].u.n, steps = (long)a[4].u.n; /* declared int[1,1024], int[0,100000] */
+    uint64_t pts = 0;
+    if (points_arg(I, a[3], &pts, "superifs") || get_vec(I, a[5], so.start, 2, "superifs: start") ||
         arg_seed(I, a[6], &so.seed, "superifs"))
         goto done;
     if (f->dim != 2) {
-        err_at(I, NULL, ERR_VALUE, "superifs: the IFSs are 3-D; a super IFS needs 2-D maps");
+        err_arg(I, 0, ERR_VALUE, "superifs: the IFSs are 3-D; a super IFS needs 2-D maps");
         goto done;
     }
     if (a[1].k != V_NIL) {
         size_t np = AS_LIST(a[1])->n;
         if ((int)np != f->n) {
-            err_at(I, NULL, ERR_VALUE, "superifs: probabilities must be a list of %d numbers (one per IFS), got %zu", f->n, np);
+            err_arg(I, 1, ERR_VALUE, "superifs: probabilities must be a list of %d numbers (one per IFS), got %zu", f->n, np);
             goto done;
         }
         P = mem_alloc(I, sizeof(double) * np);
@@ -1494,16 +1459,11 @@ static int b_superifs(interp *I, value *a, int n, value *out)
         }
         if (get_vec(I, a[1], P, np, "superifs: probabilities"))
             goto done;
-        double sum = 0;
-        for (size_t i = 0; i < np; i++) {
-            if (!(P[i] >= 0)) {
-                err_at(I, NULL, ERR_VALUE, "superifs: probability %zu is %g (expected a number >= 0)", i + 1, P[i]);
-                goto done;
-            }
+        double sum = 0; /* each in [0, 1] (declared) */
+        for (size_t i = 0; i < np; i++)
             sum += P[i];
-        }
         if (fabs(sum - 1) > 1e-6) {
-            err_at(I, NULL, ERR_VALUE, "superifs: probabilities sum to %.9g (expected 1)", sum);
+            err_arg(I, 1, ERR_VALUE, "superifs: probabilities sum to %.9g (expected 1)", sum);
             goto done;
         }
     }
@@ -1546,12 +1506,13 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
 {
     (void)n;
     const lang_superifs *s = AS_OBJ(a[0])->payload;
-    long buf;
+    long buf = (long)a[1].u.n; /* declared int>=1 */
     int w, h;
     ramp r;
     tonemap_opts t;
-    if (get_int(I, a[1], 1, s->st.V, &buf, "superifs_image: buffer") ||
-        arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
+    if (buf > s->st.V)
+        return err_arg(I, 1, ERR_VALUE, "superifs_image: buffer must be between 1 and V = %d, got %ld", s->st.V, buf);
+    if (arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
         tone_args(I, a[4], a[5], a[6], a[7], a[8], &t, &r, "superifs_image"))
         return -1;
     double lo[2], hi[2];
@@ -1615,24 +1576,9 @@ static int b_tile(interp *I, value *a, int n, value *out)
     (void)n;
     const image *src = lang_as_image(a[0]);
     const char *m = AS_STR(a[1])->s, *md = AS_STR(a[2])->s;
-    int mirror;
-    tiles_overlay rule;
-    if (strcmp(m, "lr") == 0)
-        mirror = TILES_LR;
-    else if (strcmp(m, "tb") == 0)
-        mirror = TILES_TB;
-    else if (strcmp(m, "both") == 0)
-        mirror = TILES_LR | TILES_TB;
-    else
-        return err_at(I, NULL, ERR_VALUE, "tile: mirror must be \"lr\", \"tb\" or \"both\", got \"%s\"", m);
-    if (strcmp(md, "max") == 0)
-        rule = TILES_MAX;
-    else if (strcmp(md, "mean") == 0)
-        rule = TILES_MEAN;
-    else if (strcmp(md, "over") == 0)
-        rule = TILES_OVER;
-    else
-        return err_at(I, NULL, ERR_VALUE, "tile: mode must be \"max\", \"mean\" or \"over\", got \"%s\"", md);
+    /* declared str{lr,tb,both} and str{max,mean,over} */
+    int mirror = strcmp(m, "lr") == 0 ? TILES_LR : strcmp(m, "tb") == 0 ? TILES_TB : TILES_LR | TILES_TB;
+    tiles_overlay rule = strcmp(md, "mean") == 0 ? TILES_MEAN : strcmp(md, "over") == 0 ? TILES_OVER : TILES_MAX;
     image res;
     rt_error e;
     rt_code c = tiles_symmetric(src, mirror, rule, &res, &e);
@@ -1666,52 +1612,56 @@ static int b_tiling(interp *I, value *a, int n, value *out)
 static const bparam p_fset[] = {{"sets", "list", NULL}};
 static const bparam p_order[] = {{"sequence", "list|str", "nil"},
                                  {"repeat", "bool", "false"},
-                                 {"probabilities", "vec", "nil"},
-                                 {"seed", "num", "nil"}};
+                                 {"probabilities", "vec[0,1]", "nil"},
+                                 {"seed", "int>=0", "nil"}};
 static const bparam p_shape[] = {{"points", "list", "nil"}};
 static const bparam p_iterate[] = {{"system", "ifs|fset|list", NULL},
-                                   {"start", "any", "nil"},
-                                   {"steps", "num", "nil"},
-                                   {"order", "any", "nil"}};
-static const bparam p_draw[] = {{"shape", "shape", NULL},          {"size", "vec|num", "[512, 512]"},
-                                {"window", "vec", "nil"},          {"colour", "any", "1"},
-                                {"width", "num", "1"},             {"radius", "num", "1"},
-                                {"fill", "any", "nil"},            {"background", "any", "[0, 0, 0, 1]"},
+                                   {"start", "shape", "nil"},
+                                   {"steps", "int[0,1000000]", "nil"},
+                                   {"order", "order", "nil"}};
+#define TY_FILL "bool|" TY_COLOUR
+#define TY_CURVE "str{log,linear}"
+static const bparam p_draw[] = {{"shape", "shape", NULL},            {"size", TY_SIZE, "[512, 512]"},
+                                {"window", "vec4", "nil"},           {"colour", TY_COLOUR, "1"},
+                                {"width", "num[0,1000]", "1"},       {"radius", "num[0,1000]", "1"},
+                                {"fill", TY_FILL, "nil"},            {"background", TY_COLOUR, "[0, 0, 0, 1]"},
                                 {"onto", "image", "nil"}};
-static const bparam p_chaos_fset[] = {{"system", "fset|ifs|list", NULL}, {"order", "any", "nil"},
-                                      {"points", "num", "1e6"},          {"size", "vec|num", "[512, 512]"},
-                                      {"window", "vec", "nil"},          {"mode", "str", "\"orbit\""},
-                                      {"depth", "num", "nil"},           {"burn", "num", "20"},
-                                      {"start", "vec", "[0, 0]"},        {"palette", "list", "nil"},
-                                      {"curve", "str", "\"log\""},       {"gamma", "num", "2.2"},
-                                      {"brightness", "num", "1"},        {"background", "any", "[0, 0, 0, 1]"},
-                                      {"seed", "num", "nil"}};
-static const bparam p_top[] = {{"system", "ifs", NULL},          {"size", "vec|num", "[512, 512]"},
-                               {"points", "num", "1e6"},         {"window", "vec", "nil"},
-                               {"palette", "list", "nil"},       {"symbols", "num", "1"},
-                               {"depth", "num", "0"},            {"background", "any", "[0, 0, 0, 1]"},
-                               {"seed", "num", "nil"}};
-static const bparam p_steal[] = {{"screen", "ifs", NULL},         {"source", "ifs", NULL},
-                                 {"picture", "image", NULL},      {"size", "vec|num", "[512, 512]"},
-                                 {"points", "num", "1e6"},        {"window", "vec", "nil"},
-                                 {"source_window", "vec", "nil"}, {"background", "any", "[0, 0, 0, 1]"},
-                                 {"depth", "num", "0"},           {"seed", "num", "nil"}};
-static const bparam p_filter[] = {{"screen", "ifs", NULL},         {"source", "ifs", NULL},
-                                  {"frames", "list", NULL},        {"size", "vec|num", "[512, 512]"},
-                                  {"points", "num", "1e6"},        {"window", "vec", "nil"},
-                                  {"source_window", "vec", "nil"}, {"background", "any", "[0, 0, 0, 1]"},
-                                  {"depth", "num", "0"},           {"seed", "num", "nil"}};
-static const bparam p_superifs[] = {{"sets", "list|fset", NULL}, {"probabilities", "vec", "nil"},
-                                    {"V", "num", "3"},           {"points", "num", "1e5"},
-                                    {"steps", "num", "20"},      {"start", "vec", "[0, 0]"},
-                                    {"seed", "num", "nil"}};
-static const bparam p_superifs_image[] = {{"superifs", "superifs", NULL}, {"buffer", "num", "1"},
-                                          {"size", "vec|num", "[512, 512]"}, {"window", "vec", "nil"},
-                                          {"palette", "list", "nil"},      {"curve", "str", "\"log\""},
-                                          {"gamma", "num", "2.2"},         {"brightness", "num", "1"},
-                                          {"background", "any", "[0, 0, 0, 1]"}};
-static const bparam p_tile[] = {{"image", "image", NULL}, {"mirror", "str", "\"both\""}, {"mode", "str", "\"max\""}};
-static const bparam p_tiling[] = {{"tile", "image", NULL}, {"size", "vec|num", NULL}, {"mirrored", "bool", "false"}};
+static const bparam p_chaos_fset[] = {{"system", "fset|ifs|list", NULL},   {"order", "order", "nil"},
+                                      {"points", "int>=1", "1e6"},          {"size", TY_SIZE, "[512, 512]"},
+                                      {"window", "vec4", "nil"},            {"mode", "str{orbit,walk}", "\"orbit\""},
+                                      {"depth", "int[1,1000000]", "nil"},   {"burn", "int[0,1000000]", "20"},
+                                      {"start", "vec2", "[0, 0]"},          {"palette", "list", "nil"},
+                                      {"curve", TY_CURVE, "\"log\""},       {"gamma", "num>0", "2.2"},
+                                      {"brightness", "num>0", "1"},         {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                                      {"seed", "int>=0", "nil"}};
+static const bparam p_top[] = {{"system", "ifs", NULL},           {"size", TY_SIZE, "[512, 512]"},
+                               {"points", "int>=1", "1e6"},      {"window", "vec4", "nil"},
+                               {"palette", "list", "nil"},       {"symbols", "int[1,64]", "1"},
+                               {"depth", "int[0,64]", "0"},      {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                               {"seed", "int>=0", "nil"}};
+static const bparam p_steal[] = {{"screen", "ifs", NULL},          {"source", "ifs", NULL},
+                                 {"picture", "image", NULL},       {"size", TY_SIZE, "[512, 512]"},
+                                 {"points", "int>=1", "1e6"},      {"window", "vec4", "nil"},
+                                 {"source_window", "vec4", "nil"}, {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                                 {"depth", "int[0,64]", "0"},      {"seed", "int>=0", "nil"}};
+static const bparam p_filter[] = {{"screen", "ifs", NULL},          {"source", "ifs", NULL},
+                                  {"frames", "list", NULL},         {"size", TY_SIZE, "[512, 512]"},
+                                  {"points", "int>=1", "1e6"},      {"window", "vec4", "nil"},
+                                  {"source_window", "vec4", "nil"}, {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                                  {"depth", "int[0,64]", "0"},      {"seed", "int>=0", "nil"}};
+static const bparam p_superifs[] = {{"sets", "list|fset", NULL},   {"probabilities", "vec[0,1]", "nil"},
+                                    {"V", "int[1,1024]", "3"},     {"points", "int>=1", "1e5"},
+                                    {"steps", "int[0,100000]", "20"}, {"start", "vec2", "[0, 0]"},
+                                    {"seed", "int>=0", "nil"}};
+static const bparam p_superifs_image[] = {{"superifs", "superifs", NULL},   {"buffer", "int>=1", "1"},
+                                          {"size", TY_SIZE, "[512, 512]"},  {"window", "vec4", "nil"},
+                                          {"palette", "list", "nil"},       {"curve", TY_CURVE, "\"log\""},
+                                          {"gamma", "num>0", "2.2"},        {"brightness", "num>0", "1"},
+                                          {"background", TY_COLOUR, "[0, 0, 0, 1]"}};
+static const bparam p_tile[] = {{"image", "image", NULL},
+                                {"mirror", "str{lr,tb,both}", "\"both\""},
+                                {"mode", "str{max,mean,over}", "\"max\""}};
+static const bparam p_tiling[] = {{"tile", "image", NULL}, {"size", TY_SIZE, NULL}, {"mirrored", "bool", "false"}};
 
 static const builtin fset_builtins[] = {
     BUILTIN("fset", b_fset, p_fset,

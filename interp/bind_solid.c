@@ -259,14 +259,9 @@ static int largest_r2(int R, size_t limit)
     return best;
 }
 
-static int get_R(interp *I, value v, int *R, const char *what)
-{
-    if (v.k != V_NUM || v.u.n != floor(v.u.n) || v.u.n < 1 || v.u.n > MPD_MAX_R)
-        return err_at(I, NULL, ERR_VALUE, "%s: R = %g is out of range (expected a whole number 1 .. %d)", what,
-                      v.u.n, MPD_MAX_R);
-    *R = (int)v.u.n;
-    return 0;
-}
+/* R is declared TY_R: a whole number 1 .. MPD_MAX_R. */
+#define TY_R "int[1,20]"
+_Static_assert(MPD_MAX_R == 20, "TY_R writes MPD_MAX_R out");
 
 static int b_fractal(interp *I, value *a, int n, value *out)
 {
@@ -274,8 +269,7 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     const char *W = "fractal";
     mpd_params p;
     mpd_params_default(&p);
-    if (get_R(I, a[0], &p.R, W))
-        return -1;
+    p.R = (int)a[0].u.n;
     p.beta = a[1].u.n; /* declared: finite, >= 0 */
     if (arg_seed(I, a[2], &p.seed, W))
         return -1;
@@ -382,9 +376,7 @@ static int rec_num(interp *I, value r, const char *key, double v)
 static int b_fractal_memory(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    int R;
-    if (get_R(I, a[0], &R, "fractal_memory"))
-        return -1;
+    int R = (int)a[0].u.n;
     int R2;
     if (a[1].k == V_NIL) {
         R2 = largest_r2(R, AUTO_BUDGET < I->lim.max_memory ? AUTO_BUDGET : I->lim.max_memory);
@@ -638,11 +630,11 @@ static int b_slice_plane(interp *I, value *a, int n, value *out)
 
 /* ---- registration --------------------------------------------------------------------- */
 
-static const bparam p_fractal[] = {{"R", "num", "8"},          {"beta", "num>=0", "0.5"},
+static const bparam p_fractal[] = {{"R", TY_R, "8"},          {"beta", "num>=0", "0.5"},
                                    {"seed", "num", "nil"},     {"corners", "vec|num", "nil"},
                                    {"strategy", "str|num", "\"auto\""}, {"R2", "num", "nil"},
                                    {"lo", "vec", "[-1, -1, -1]"}, {"hi", "vec", "[1, 1, 1]"}};
-static const bparam p_fmem[] = {{"R", "num", NULL}, {"R2", "num", "nil"}};
+static const bparam p_fmem[] = {{"R", TY_R, NULL}, {"R2", "int>=0", "nil"}};
 static const bparam p_marble[] = {{"layers", "list", NULL},
                                   {"fluct", "num|field|volume", "nil"},
                                   {"k", "num", "0.1"},

@@ -97,42 +97,31 @@ int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
 
 /* ---- cameras ------------------------------------------------------------------------ */
 
-static int rec_vec3(interp *I, value rec, const char *key, double out[3], int required, const char *what)
+/* A camera record as TY_CAMERA declares it (checked before the builtin
+ * runs: eye and target present, 3 finite numbers each, fov in (0, 179)). */
+static void rec_vec3(interp *I, value rec, const char *key, double out[3])
 {
     const char *k = intern(I, key, strlen(key));
     value *v = k ? rec_get(AS_REC(rec), k) : NULL;
-    if (!v) {
-        if (required)
-            return err_at(I, NULL, ERR_VALUE, "%s: the camera record needs '%s'", what, key);
-        return 1;
-    }
-    char w[128];
-    snprintf(w, sizeof w, "%s: camera %s", what, key);
-    return get_vec(I, *v, out, 3, w);
+    if (v)
+        for (int i = 0; i < 3; i++)
+            out[i] = AS_LIST(*v)->items[i].u.n;
 }
 
 int lang_get_camera(interp *I, value v, camera *cam, const char *what)
 {
-    if (v.k != V_REC)
-        return err_at(I, NULL, ERR_TYPE, "%s: camera must be a record like orbit(30, 20) gives, got %s", what,
-                      val_type_name(v));
     memset(cam, 0, sizeof *cam);
     cam->up[1] = 1;
     cam->fov = 40;
-    if (rec_vec3(I, v, "eye", cam->eye, 1, what) < 0 || rec_vec3(I, v, "target", cam->target, 1, what) < 0 ||
-        rec_vec3(I, v, "up", cam->up, 0, what) < 0)
-        return -1;
+    rec_vec3(I, v, "eye", cam->eye);
+    rec_vec3(I, v, "target", cam->target);
+    rec_vec3(I, v, "up", cam->up);
     double fov;
-    int r = opt_num(I, v, "fov", &fov);
-    if (r < 0)
-        return -1;
-    if (r == 1) {
-        if (!(fov > 0 && fov < 179))
-            return err_at(I, NULL, ERR_VALUE, "%s: camera fov must be between 0 and 179 degrees, got %g", what, fov);
+    if (opt_num(I, v, "fov", &fov) == 1)
         cam->fov = fov;
-    }
     if (camera_setup(cam))
-        return err_at(I, NULL, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view", what);
+        return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view",
+                        what);
     return 0;
 }
 
@@ -538,10 +527,11 @@ static int b_mesh_stats(interp *I, value *a, int n, value *out)
              {"degenerate", (double)st.degenerate},
              {"euler", (double)st.euler},
              {"area", st.area},
+             {"volume", st.volume},
              {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
         const char *k = intern(I, f[i].k, strlen(f[i].k));
-        value v = i == 8 ? val_bool(f[i].v != 0) : val_num(f[i].v);
+        value v = i == 9 ? val_bool(f[i].v != 0) : val_num(f[i].v);
         if (!k || rec_set(I, AS_REC(r), k, v)) {
             val_unref(I, r);
             return -1;
@@ -618,7 +608,7 @@ static const builtin volume_builtins[] = {
             "Load a volume from .nrrd, .nhdr, .vtk or .vdb (relative to the script); grid: the .vdb grid (default \"density\")."),
     BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
     BUILTIN("mesh_stats", b_mesh_stats, p_mesh,
-            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight}."),
+            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, volume, watertight}; volume is signed: Σ a·(b×c)/6 over the triangles, negative for a closed mesh wound inside out."),
     BUILTIN("slice", b_slice, p_slice,
             "An axis-aligned slice of a volume as an image: axis \"x\", \"y\" or \"z\", index (default: the middle), values lo..hi (default: the volume's range) through a palette."),
 };

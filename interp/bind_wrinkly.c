@@ -23,7 +23,9 @@
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
-/* shuffle: nil (everything), "height", or a list of "height" / "colour" / "opacity". */
+/* shuffle: nil (everything), "height", or a list of "height" / "colour" /
+ * "opacity" (one string is a declared choice; the items of a list are
+ * checked here, with the caret on the item). */
 static int get_shuffle(interp *I, value v, unsigned *bits, const char *what)
 {
     if (v.k == V_NIL) {
@@ -42,35 +44,26 @@ static int get_shuffle(interp *I, value v, unsigned *bits, const char *what)
         else if (t && strcmp(t, "opacity") == 0)
             *bits |= WRINKLY_OPACITY;
         else
-            return err_at(I, NULL, ERR_VALUE,
-                          "%s: shuffle must name attributes \"height\", \"colour\" or \"opacity\" (a string or a list of them), got %s%s%s",
-                          what, t ? "\"" : "", t ? t : val_type_name(s), t ? "\"" : "");
+            return err_item(I, v, i, ERR_VALUE,
+                            "%s: argument 'shuffle' item %zu must be \"height\", \"colour\" or \"opacity\", got %s%s%s",
+                            what, i + 1, t ? "\"" : "", t ? t : val_type_name(s), t ? "\"" : "");
     }
     return 0;
 }
 
 /* Style shared by curves and surfaces: how the attributes are interpolated
- * and sampled (not the level of detail, which the drawing call decides). */
+ * and sampled (not the level of detail, which the drawing call decides).
+ * Ranges are declared (TY_STYLE_*). */
 static int get_style(interp *I, value tension, value shuffle, value crack, value jitter, value extra, value seed,
                      wrinkly_opts *o, const char *what)
 {
     wrinkly_opts_default(o);
-    if (!(tension.u.n > 0 && tension.u.n <= 1))
-        return err_at(I, NULL, ERR_VALUE, "%s: tension must be in (0, 1], got %g", what, tension.u.n);
     o->tension = tension.u.n;
     if (get_shuffle(I, shuffle, &o->shuffle, what))
         return -1;
-    if (!(crack.u.n >= 0 && crack.u.n <= 0.5))
-        return err_at(I, NULL, ERR_VALUE,
-                      "%s: crack_band must be between 0 (off) and 0.5 (parameter units), got %g", what, crack.u.n);
     o->crack_band = crack.u.n;
     o->jitter = jitter.u.b;
-    char w[96];
-    snprintf(w, sizeof w, "%s: extra", what);
-    long ex;
-    if (get_int(I, extra, 0, 8, &ex, w))
-        return -1;
-    o->extra = (int)ex;
+    o->extra = (int)extra.u.n;
     return arg_seed(I, seed, &o->seed, what);
 }
 
@@ -82,6 +75,9 @@ static void style_summary(const wrinkly_opts *o, bytebuf *out)
         bytebuf_printf(out, ", jitter");
     if (o->extra)
         bytebuf_printf(out, ", +%d rounds", o->extra);
+    if (o->normal != WRINKLY_NORMAL_AUTO)
+        bytebuf_printf(out, ", normal %s",
+                       o->normal == WRINKLY_NORMAL_OUTWARD ? "outward" : o->normal == WRINKLY_NORMAL_INWARD ? "inward" : "uv");
 }
 
 /* ---- ist objects -------------------------------------------------------------------- */
@@ -166,56 +162,45 @@ static int b_ist(interp *I, value *a, int n, value *out)
 {
     (void)n;
     const char *W = "ist";
-    long nint = 5, k, m = 0;
+    long nint = 5, k;
     double *bounds = NULL;
     int *ms = NULL;
     if (a[4].k != V_NIL) {
         size_t nb = AS_LIST(a[4])->n;
         if (nb < 2 || nb > MAX_CONTROL + 1)
-            return err_at(I, NULL, ERR_VALUE, "ist: bounds must be a list of 2 to %d numbers (N + 1 for N intervals), got %zu",
-                          MAX_CONTROL + 1, nb);
+            return err_arg(I, 4, ERR_VALUE, "ist: bounds must be a list of 2 to %d numbers (N + 1 for N intervals), got %zu",
+                           MAX_CONTROL + 1, nb);
         if (a[0].k != V_NIL && a[0].u.n + 1 != (double)nb)
-            return err_at(I, NULL, ERR_VALUE, "ist: intervals is %g but bounds gives %zu intervals (N + 1 bounds for N intervals)",
-                          a[0].u.n, nb - 1);
+            return err_arg(I, 4, ERR_VALUE, "ist: intervals is %g but bounds gives %zu intervals (N + 1 bounds for N intervals)",
+                           a[0].u.n, nb - 1);
         nint = (long)nb - 1;
-    } else if (a[0].k != V_NIL && get_int(I, a[0], 1, MAX_CONTROL, &nint, "ist: intervals")) {
-        return -1;
+    } else if (a[0].k != V_NIL) {
+        nint = (long)a[0].u.n;
     }
-    if (get_int(I, a[2], 0, IST_MAX_K, &k, "ist: iterations"))
-        return -1;
+    k = (long)a[2].u.n;
     ist_spec s = {.n = (int)nint, .k = (int)k, .axis = a[3].u.b ? IST_CYCLIC : IST_TRANSLATION};
     const char *meth = AS_STR(a[5])->s;
-    if (strcmp(meth, "auto") == 0)
-        s.method = IST_AUTO;
-    else if (strcmp(meth, "lists") == 0)
-        s.method = IST_LISTS;
-    else if (strcmp(meth, "closed") == 0)
-        s.method = IST_CLOSED;
-    else
-        return err_at(I, NULL, ERR_VALUE, "ist: method must be \"auto\", \"lists\" or \"closed\", got \"%s\"", meth);
+    s.method = strcmp(meth, "lists") == 0 ? IST_LISTS : strcmp(meth, "closed") == 0 ? IST_CLOSED : IST_AUTO;
     int rc = -1;
     if (a[4].k != V_NIL) {
         bounds = mem_alloc(I, sizeof(double) * (size_t)(nint + 1));
         if (!bounds)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
-        get_vec(I, a[4], bounds, (size_t)nint + 1, "ist: bounds");
         for (long i = 0; i <= nint; i++)
-            if (!isfinite(bounds[i])) {
-                err_at(I, NULL, ERR_VALUE, "ist: bound %ld is %g; bounds must be finite", i, bounds[i]);
-                goto done;
-            }
+            bounds[i] = AS_LIST(a[4])->items[i].u.n; /* declared vec: finite numbers */
         for (long i = 0; i < nint; i++)
             if (!(bounds[i + 1] > bounds[i])) {
-                err_at(I, NULL, ERR_VALUE, "ist: bounds must increase, but bound %ld = %g is not greater than bound %ld = %g",
-                       i + 1, bounds[i + 1], i, bounds[i]);
+                err_item(I, a[4], (size_t)i + 1, ERR_VALUE,
+                         "ist: bounds must increase, but bound %ld = %g is not greater than bound %ld = %g", i + 1,
+                         bounds[i + 1], i, bounds[i]);
                 goto done;
             }
         s.bounds = bounds;
     }
     if (a[1].k == V_LIST) {
         if (AS_LIST(a[1])->n != (size_t)nint) {
-            err_at(I, NULL, ERR_VALUE, "ist: crossings must be one whole number or a list of %ld (one per interval), got %zu",
-                   nint, AS_LIST(a[1])->n);
+            err_arg(I, 1, ERR_VALUE, "ist: crossings must be one whole number or a list of %ld (one per interval), got %zu",
+                    nint, AS_LIST(a[1])->n);
             goto done;
         }
         ms = mem_alloc(I, sizeof(int) * (size_t)nint);
@@ -224,17 +209,17 @@ static int b_ist(interp *I, value *a, int n, value *out)
             goto done;
         }
         for (long i = 0; i < nint; i++) {
-            char w[64];
-            snprintf(w, sizeof w, "ist: crossings[%ld]", i);
-            if (get_int(I, AS_LIST(a[1])->items[i], 0, 1000, &m, w))
+            double x = AS_LIST(a[1])->items[i].u.n; /* declared vec[0,1000] */
+            if (x != floor(x)) {
+                err_item(I, a[1], (size_t)i, ERR_VALUE, "ist: argument 'crossings' item %ld must be a whole number, got %g",
+                         i + 1, x);
                 goto done;
-            ms[i] = (int)m;
+            }
+            ms[i] = (int)x;
         }
         s.m_each = ms;
     } else {
-        if (get_int(I, a[1], 0, 1000, &m, "ist: crossings"))
-            goto done;
-        s.m = (int)m;
+        s.m = (int)a[1].u.n;
     }
     ist_obj *o = mem_calloc(I, 1, sizeof *o);
     if (!o) {
@@ -354,16 +339,30 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
     int rc = -1;
     double *pos = NULL;
     if (a[1].k == V_LIST && AS_LIST(a[1])->n != (size_t)t->n) {
-        err_at(I, NULL, ERR_VALUE, "ist_samples: levels must be one whole number or a list of %d (one per interval), got %zu",
-               t->n, AS_LIST(a[1])->n);
+        err_arg(I, 1, ERR_VALUE, "ist_samples: levels must be one whole number or a list of %d (one per interval), got %zu",
+                t->n, AS_LIST(a[1])->n);
         goto done;
     }
     double count = 0;
     for (int i = 0; i < t->n; i++) {
-        long l = t->k;
+        double l = t->k;
         value v = a[1].k == V_LIST ? AS_LIST(a[1])->items[i] : a[1];
-        if (v.k != V_NIL && get_int(I, v, 0, t->k, &l, "ist_samples: levels (at most the ist's iterations)"))
+        if (v.k != V_NIL)
+            l = v.u.n; /* declared: >= 0 */
+        if (l != floor(l) || l > t->k) {
+            char lw[48] = "";
+            if (a[1].k == V_LIST)
+                snprintf(lw, sizeof lw, " item %d", i + 1);
+            if (a[1].k == V_LIST)
+                err_item(I, a[1], (size_t)i, ERR_VALUE,
+                         "ist_samples: argument 'levels'%s must be a whole number from 0 to the ist's iterations %d, got %g",
+                         lw, t->k, l);
+            else
+                err_arg(I, 1, ERR_VALUE,
+                        "ist_samples: argument 'levels' must be a whole number from 0 to the ist's iterations %d, got %g",
+                        t->k, l);
             goto done;
+        }
         ki[i] = (int)l;
         count += pow(2.0 * t->ms[i] + 1, (double)l);
     }
@@ -412,22 +411,21 @@ static int fill_scalar(interp *I, value v, int rows, int cols, wrinkly_point *p,
             if (rows) {
                 size_t r = i / (size_t)cols, c = i % (size_t)cols;
                 if (l->n != (size_t)rows || l->items[r].k != V_LIST || AS_LIST(l->items[r])->n != (size_t)cols)
-                    return err_at(I, NULL, ERR_VALUE,
-                                  "%s: %s must be a number or a grid of %d rows of %d numbers (like the control points)",
-                                  what, name, rows, cols);
+                    return err_item(I, v, l->n != (size_t)rows ? SIZE_MAX : r, ERR_VALUE,
+                                    "%s: %s must be a number or a grid of %d rows of %d numbers (like the control points)",
+                                    what, name, rows, cols);
                 it = AS_LIST(l->items[r])->items[c];
             } else {
                 if (l->n != (size_t)cols)
-                    return err_at(I, NULL, ERR_VALUE, "%s: %s must be a number or a list of %d numbers (one per point), got %zu",
-                                  what, name, cols, l->n);
+                    return err_item(I, v, SIZE_MAX, ERR_VALUE,
+                                    "%s: %s must be a number or a list of %d numbers (one per point), got %zu", what, name,
+                                    cols, l->n);
                 it = l->items[i];
             }
             if (it.k != V_NUM)
                 return err_at(I, NULL, ERR_TYPE, "%s: %s must contain numbers, found %s", what, name, val_type_name(it));
-            x = it.u.n;
+            x = it.u.n; /* declared: finite */
         }
-        if (!isfinite(x))
-            return err_at(I, NULL, ERR_VALUE, "%s: %s must be finite, got %g", what, name, x);
         if (which == 0)
             p[i].h = x;
         else
@@ -472,13 +470,13 @@ static int fill_colours(interp *I, value v, int rows, int cols, wrinkly_point *p
         if (rows) {
             size_t r = i / (size_t)cols, cc = i % (size_t)cols;
             if (l->n != (size_t)rows || l->items[r].k != V_LIST || AS_LIST(l->items[r])->n != (size_t)cols)
-                return err_at(I, NULL, ERR_VALUE, "%s must be one colour or a grid of %d rows of %d colours", w, rows,
-                              cols);
+                return err_item(I, v, l->n != (size_t)rows ? SIZE_MAX : r, ERR_VALUE,
+                                "%s must be one colour or a grid of %d rows of %d colours", w, rows, cols);
             it = AS_LIST(l->items[r])->items[cc];
         } else {
             if (l->n != (size_t)cols)
-                return err_at(I, NULL, ERR_VALUE, "%s must be one colour or a list of %d colours (one per point), got %zu",
-                              w, cols, l->n);
+                return err_item(I, v, SIZE_MAX, ERR_VALUE,
+                                "%s must be one colour or a list of %d colours (one per point), got %zu", w, cols, l->n);
             it = l->items[i];
         }
         if (lang_get_colour(I, it, c, w))
@@ -486,17 +484,6 @@ static int fill_colours(interp *I, value v, int rows, int cols, wrinkly_point *p
         for (int q = 0; q < 3; q++)
             p[i].rgb[q] = c[q];
     }
-    return 0;
-}
-
-static int get_crossings(interp *I, value v, int *m, const char *what)
-{
-    long x;
-    char w[96];
-    snprintf(w, sizeof w, "%s: crossings", what);
-    if (get_int(I, v, 0, MAX_M, &x, w))
-        return -1;
-    *m = (int)x;
     return 0;
 }
 
@@ -555,8 +542,8 @@ static int b_wrinkly_curve(interp *I, value *a, int n, value *out)
     const char *W = "wrinkly_curve";
     vlist *pl = AS_LIST(a[0]);
     if (pl->n < 1 || pl->n > MAX_CONTROL)
-        return err_at(I, NULL, ERR_VALUE, "wrinkly_curve: points must be a list of 1 to %d points [x, y], got %zu",
-                      MAX_CONTROL, pl->n);
+        return err_arg(I, 0, ERR_VALUE, "wrinkly_curve: points must be a list of 1 to %d points [x, y], got %zu",
+                       MAX_CONTROL, pl->n);
     curve_obj *c = mem_calloc(I, 1, sizeof *c);
     if (c)
         c->pts = mem_calloc(I, pl->n, sizeof *c->pts);
@@ -569,16 +556,23 @@ static int b_wrinkly_curve(interp *I, value *a, int n, value *out)
     for (size_t i = 0; i < pl->n; i++) {
         char w[64];
         snprintf(w, sizeof w, "wrinkly_curve: point %zu", i);
-        if (get_vec(I, pl->items[i], c->pts[i].pos, 2, w))
-            goto fail;
-        if (!isfinite(c->pts[i].pos[0]) || !isfinite(c->pts[i].pos[1])) {
-            err_at(I, NULL, ERR_VALUE, "wrinkly_curve: point %zu is not finite", i);
+        value pt = pl->items[i];
+        if (pt.k != V_LIST || AS_LIST(pt)->n != 2) {
+            char got[48];
+            if (pt.k == V_LIST)
+                snprintf(got, sizeof got, "%zu item%s", AS_LIST(pt)->n, AS_LIST(pt)->n == 1 ? "" : "s");
+            else
+                snprintf(got, sizeof got, "%s", val_type_name(pt));
+            err_item(I, a[0], i, ERR_VALUE, "%s must be a list of 2 numbers, got %s", w, got);
             goto fail;
         }
+        if (get_vec(I, pt, c->pts[i].pos, 2, w)) /* numbers: finite (declared list) */
+            goto fail;
     }
     if (fill_scalar(I, a[1], 0, c->n, c->pts, 0, W, "heights") || fill_colours(I, a[2], 0, c->n, c->pts, W) ||
-        fill_scalar(I, a[3], 0, c->n, c->pts, 4, W, "opacity") || get_crossings(I, a[4], &c->ax.m, W))
+        fill_scalar(I, a[3], 0, c->n, c->pts, 4, W, "opacity"))
         goto fail;
+    c->ax.m = (int)a[4].u.n;
     c->ax.cyclic = a[5].u.b;
     c->ax.ist = a[6].u.b;
     if (get_style(I, a[8], a[7], a[9], a[10], a[11], a[12], &c->style, W))
@@ -598,30 +592,23 @@ typedef struct lod {
     int fixed; /* iterations given */
 } lod;
 
-static int get_lod(interp *I, value iterations, value tolerance, value kmax, lod *l, const char *what)
+/* iterations, tolerance and kmax as declared (int[0,20], num>0, int[0,20]);
+ * tol_slot: the argument to blame when both iterations and tolerance are
+ * given (-1: the call). */
+static int get_lod(interp *I, value iterations, value tolerance, value kmax, int tol_slot, lod *l, const char *what)
 {
-    char w[96];
-    long x;
     l->k = 3;
     l->tol = 0;
     l->fixed = iterations.k != V_NIL;
-    snprintf(w, sizeof w, "%s: kmax", what);
-    if (get_int(I, kmax, 0, MAX_KMAX, &x, w))
-        return -1;
-    l->kmax = (int)x;
+    l->kmax = (int)kmax.u.n;
     if (iterations.k != V_NIL) {
-        snprintf(w, sizeof w, "%s: iterations", what);
-        if (get_int(I, iterations, 0, MAX_KMAX, &x, w))
-            return -1;
-        l->k = (int)x;
+        l->k = (int)iterations.u.n;
         if (l->k > l->kmax)
             l->kmax = l->k;
     }
     if (tolerance.k != V_NIL) {
         if (iterations.k != V_NIL)
-            return err_at(I, NULL, ERR_VALUE, "%s: give either iterations or tolerance, not both", what);
-        if (!(tolerance.u.n > 0) || !isfinite(tolerance.u.n))
-            return err_at(I, NULL, ERR_VALUE, "%s: tolerance must be a positive length, got %g", what, tolerance.u.n);
+            return err_arg(I, tol_slot, ERR_VALUE, "%s: give either iterations or tolerance, not both", what);
         l->tol = tolerance.u.n;
     }
     return 0;
@@ -661,7 +648,7 @@ static int b_wrinkly_points(interp *I, value *a, int n, value *out)
     (void)n;
     const curve_obj *c = AS_OBJ(a[0])->payload;
     lod l;
-    if (get_lod(I, a[1], a[2], a[3], &l, "wrinkly_points"))
+    if (get_lod(I, a[1], a[2], a[3], 2, &l, "wrinkly_points"))
         return -1;
     wrinkly_polyline pl;
     if (curve_sample(I, c, &l, &pl, "wrinkly_points"))
@@ -724,11 +711,11 @@ static int get_view(interp *I, const curve_obj *c, value bounds, int w, int h, d
         char m[96];
         snprintf(m, sizeof m, "%s: bounds", what);
         if (l->n != 2 || l->items[0].k != V_LIST || l->items[1].k != V_LIST)
-            return err_at(I, NULL, ERR_VALUE, "%s: bounds must be [[xmin, ymin], [xmax, ymax]]", what);
+            return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must be [[xmin, ymin], [xmax, ymax]]", what);
         if (get_vec(I, l->items[0], lo, 2, m) || get_vec(I, l->items[1], hi, 2, m))
             return -1;
-        if (!(hi[0] > lo[0] && hi[1] > lo[1]) || !isfinite(lo[0] + lo[1] + hi[0] + hi[1]))
-            return err_at(I, NULL, ERR_VALUE, "%s: bounds must have xmin < xmax and ymin < ymax", what);
+        if (!(hi[0] > lo[0] && hi[1] > lo[1]))
+            return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must have xmin < xmax and ymin < ymax", what);
     }
     rt_error e;
     if (draw_view_fit(v, w, h, lo, hi, 1, &e))
@@ -821,20 +808,16 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     draw_view v;
     if (get_view(I, c, a[2], w, h, &v, W))
         return -1;
-    if (!(a[3].u.n >= 0 && a[3].u.n <= 1000))
-        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: width must be between 0 and 1000 pixels, got %g", a[3].u.n);
-    if (!(a[8].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: pixel must be a positive number of pixels, got %g", a[8].u.n);
     float stroke[4] = {1, 1, 1, 1}, fill[4] = {1, 1, 1, 1}, bg[4];
     if ((a[4].k != V_NIL && lang_get_colour(I, a[4], stroke, "wrinkly_draw: colour")) ||
         (a[5].k != V_NIL && lang_get_colour(I, a[5], fill, "wrinkly_draw: fill")) ||
         lang_get_colour(I, a[6], bg, "wrinkly_draw: background"))
         return -1;
     if (a[5].k != V_NIL && !c->ax.cyclic)
-        return err_at(I, NULL, ERR_VALUE, "wrinkly_draw: fill needs a closed curve (wrinkly_curve(…, closed: true))");
+        return err_arg(I, 5, ERR_VALUE, "wrinkly_draw: fill needs a closed curve (wrinkly_curve(…, closed: true))");
     lod l;
     value tol = a[9].k == V_NIL ? val_num(a[8].u.n / v.sx) : val_nil();
-    if (get_lod(I, a[9], tol, a[10], &l, W))
+    if (get_lod(I, a[9], tol, a[10], -1, &l, W))
         return -1;
     image *im;
     if (lang_image_new(I, w, h, &im))
@@ -887,7 +870,7 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE,
                       "save: a wrinkly curve is saved as .svg (draw it with wrinkly_draw for a picture), got '.%s'", ext);
     double size = 512, width = 1.5, iters = -1;
-    if (opts_check(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int>=0}", "save") ||
+    if (opts_check(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int[0,20]}", "save") ||
         opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
         opt_num(I, opts, "iterations", &iters) < 0)
         return -1;
@@ -895,7 +878,7 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
     if (get_view(I, c, val_nil(), (int)size, (int)size, &v, "save"))
         return -1;
     lod l;
-    if (get_lod(I, iters >= 0 ? val_num(iters) : val_nil(), iters >= 0 ? val_nil() : val_num(1 / v.sx), val_num(8),
+    if (get_lod(I, iters >= 0 ? val_num(iters) : val_nil(), iters >= 0 ? val_nil() : val_num(1 / v.sx), val_num(8), -1,
                 &l, "save"))
         return -1;
     wrinkly_polyline pl;
@@ -972,50 +955,33 @@ static const obj_class surf_class = {
     .get = surf_get,
 };
 
-/* An axis record {cyclic: false, crossings: 1, ist: true}. */
-static int get_axis(interp *I, value v, wrinkly_axis *ax, const char *what, const char *name)
+/* An axis record {cyclic: false, crossings: 1, ist: true} (keys and types
+ * declared by TY_AXIS). */
+static void get_axis(interp *I, value v, wrinkly_axis *ax)
 {
     ax->cyclic = 0;
     ax->m = 1;
     ax->ist = 1;
     if (v.k == V_NIL)
-        return 0;
-    vrec *r = AS_REC(v);
-    for (size_t i = 0; i < r->n; i++) {
-        const char *k = r->keys[i];
-        value x = r->vals[i];
-        if (strcmp(k, "cyclic") == 0 || strcmp(k, "ist") == 0) {
-            if (x.k != V_BOOL)
-                return err_at(I, NULL, ERR_TYPE, "%s: %s.%s must be true or false, got %s", what, name, k,
-                              val_type_name(x));
-            if (k[0] == 'c')
-                ax->cyclic = x.u.b;
-            else
-                ax->ist = x.u.b;
-        } else if (strcmp(k, "crossings") == 0) {
-            long m;
-            char w[96];
-            snprintf(w, sizeof w, "%s: %s.crossings", what, name);
-            if (get_int(I, x, 0, MAX_M, &m, w))
-                return -1;
-            ax->m = (int)m;
-        } else {
-            return err_at(I, NULL, ERR_VALUE, "%s: %s has no option '%s' (expected cyclic, crossings, ist)", what,
-                          name, k);
-        }
-    }
-    return 0;
+        return;
+    double x;
+    if (opt_num(I, v, "cyclic", &x) == 1)
+        ax->cyclic = x != 0;
+    if (opt_num(I, v, "ist", &x) == 1)
+        ax->ist = x != 0;
+    if (opt_num(I, v, "crossings", &x) == 1)
+        ax->m = (int)x;
 }
 
-/* wrinkly_surface(control, heights, colours, opacity, u, v, shuffle, tension, crack_band, jitter, extra, seed) */
+/* wrinkly_surface(control, heights, colours, opacity, u, v, shuffle, tension, crack_band, jitter, extra, seed, normal) */
 static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
 {
     (void)n;
     const char *W = "wrinkly_surface";
     vlist *rows = AS_LIST(a[0]);
     if (rows->n < 1 || rows->n > MAX_CONTROL || rows->items[0].k != V_LIST || AS_LIST(rows->items[0])->n < 1)
-        return err_at(I, NULL, ERR_VALUE,
-                      "wrinkly_surface: control must be a grid: a list of rows, each a list of points [x, y, z]");
+        return err_arg(I, 0, ERR_VALUE,
+                       "wrinkly_surface: control must be a grid: a list of rows, each a list of points [x, y, z]");
     size_t nu = AS_LIST(rows->items[0])->n, nv = rows->n;
     if (nu > MAX_CONTROL || (double)nu * (double)nv > 1e7)
         return err_at(I, NULL, ERR_LIMIT, "wrinkly_surface: %zu×%zu control points are too many (at most 10000000)", nu,
@@ -1032,27 +998,38 @@ static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
     for (size_t j = 0; j < nv; j++) {
         value row = rows->items[j];
         if (row.k != V_LIST || AS_LIST(row)->n != nu) {
-            err_at(I, NULL, ERR_VALUE, "wrinkly_surface: control row %zu has %zu points, but row 0 has %zu (every row needs the same number)",
-                   j, row.k == V_LIST ? AS_LIST(row)->n : 0, nu);
+            err_item(I, a[0], j, ERR_VALUE,
+                     "wrinkly_surface: control row %zu has %zu points, but row 0 has %zu (every row needs the same number)", j,
+                     row.k == V_LIST ? AS_LIST(row)->n : 0, nu);
             goto fail;
         }
         for (size_t i = 0; i < nu; i++) {
             char w[96];
             snprintf(w, sizeof w, "wrinkly_surface: control point [%zu][%zu]", j, i);
             double *p = s->pts[j * nu + i].pos;
-            if (get_vec(I, AS_LIST(row)->items[i], p, 3, w))
+            if (get_vec(I, AS_LIST(row)->items[i], p, 3, w)) /* numbers: finite (declared list) */
                 goto fail;
-            if (!isfinite(p[0] + p[1] + p[2])) {
-                err_at(I, NULL, ERR_VALUE, "%s is not finite", w);
-                goto fail;
-            }
         }
     }
     if (fill_scalar(I, a[1], s->nv, s->nu, s->pts, 0, W, "heights") ||
         fill_colours(I, a[2], s->nv, s->nu, s->pts, W) || fill_scalar(I, a[3], s->nv, s->nu, s->pts, 4, W, "opacity") ||
-        get_axis(I, a[4], &s->au, W, "u") || get_axis(I, a[5], &s->av, W, "v") ||
         get_style(I, a[7], a[6], a[8], a[9], a[10], a[11], &s->style, W))
         goto fail;
+    get_axis(I, a[4], &s->au);
+    get_axis(I, a[5], &s->av);
+    if (a[12].k != V_NIL) {
+        const char *nm = AS_STR(a[12])->s;
+        s->style.normal = strcmp(nm, "outward") == 0  ? WRINKLY_NORMAL_OUTWARD
+                          : strcmp(nm, "inward") == 0 ? WRINKLY_NORMAL_INWARD
+                                                      : WRINKLY_NORMAL_UV;
+        /* a sheet has no outward side: say so here, at the argument */
+        wrinkly_surface ws = {s->pts, s->nu, s->nv, s->au, s->av};
+        rt_error e;
+        if (!wrinkly_surface_side(&ws, &s->style, &e)) {
+            err_arg(I, 12, ERR_VALUE, "wrinkly_surface: normal \"%s\": %s", nm, e.msg);
+            goto fail;
+        }
+    }
     *out = val_obj(I, &surf_class, s);
     return out->k == V_NIL ? -1 : 0;
 fail:
@@ -1125,9 +1102,9 @@ static int get_camera_lod(interp *I, value cam, value tol, value iters, camera *
     if (!*use_cam)
         return 0;
     if (tol.k != V_NIL || iters.k != V_NIL)
-        return err_at(I, NULL, ERR_VALUE,
-                      "%s: with a camera the level of detail follows the pixels; drop tolerance and iterations (or the camera)",
-                      what);
+        return err_arg(I, tol.k != V_NIL ? 4 : 5, ERR_VALUE,
+                       "%s: with a camera the level of detail follows the pixels; drop tolerance and iterations (or the camera)",
+                       what);
     return lang_get_camera(I, cam, c, what);
 }
 
@@ -1141,10 +1118,8 @@ static int b_tessellate(interp *I, value *a, int n, value *out)
     int use_cam, w = 256, h = 256;
     lod l;
     if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || arg_size2(I, a[2], &w, &h, "tessellate: size") ||
-        get_lod(I, a[5], a[4], a[6], &l, W))
+        get_lod(I, a[5], a[4], a[6], 4, &l, W))
         return -1;
-    if (!(a[3].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "tessellate: pixel must be a positive number of pixels, got %g", a[3].u.n);
     mesh *m;
     if (surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, &m, W))
         return -1;
@@ -1200,13 +1175,13 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
     value scene = a[0];
     size_t nitems = scene.k == V_LIST ? AS_LIST(scene)->n : 1;
     if (nitems == 0)
-        return err_at(I, NULL, ERR_VALUE, "rasterize: the scene list is empty");
+        return err_arg(I, 0, ERR_VALUE, "rasterize: the scene list is empty");
     for (size_t i = 0; i < nitems; i++) {
         value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
         if (!lang_as_mesh(it) && !as_surf(it))
-            return err_at(I, NULL, ERR_TYPE,
-                          "rasterize: the scene must be a mesh, a wrinkly_surface or a list of them, but item %zu is %s",
-                          i, val_type_name(it));
+            return err_item(I, scene, i, ERR_TYPE,
+                            "rasterize: the scene must be a mesh, a wrinkly_surface or a list of them, but item %zu is %s",
+                            i, val_type_name(it));
     }
     int w, h;
     if (arg_size2(I, a[2], &w, &h, "rasterize: size"))
@@ -1220,19 +1195,14 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
         if (get_vec(I, a[4], ro.light, 3, "rasterize: light"))
             return -1;
         if (ro.light[0] == 0 && ro.light[1] == 0 && ro.light[2] == 0)
-            return err_at(I, NULL, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
+            return err_arg(I, 4, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
     }
-    if (!(a[5].u.n >= 0) || !(a[6].u.n >= 0))
-        return err_at(I, NULL, ERR_VALUE, "rasterize: ambient and diffuse must be >= 0, got %g and %g", a[5].u.n,
-                      a[6].u.n);
     ro.ambient = a[5].u.n;
     ro.diffuse = a[6].u.n;
     ro.flat = a[7].u.b;
     ro.unlit = a[8].u.b;
-    if (!(a[10].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "rasterize: pixel must be a positive number of pixels, got %g", a[10].u.n);
     lod l;
-    if (get_lod(I, val_nil(), val_nil(), a[11], &l, W))
+    if (get_lod(I, val_nil(), val_nil(), a[11], -1, &l, W))
         return -1;
     camera cam;
     if (a[1].k != V_NIL) {
@@ -1330,50 +1300,55 @@ done:
 
 /* ---- registration -------------------------------------------------------------------- */
 
-static const bparam p_ist[] = {{"intervals", "int", "nil"}, {"crossings", "int|vec", "1"},
-                               {"iterations", "int", "2"},  {"cyclic", "bool", "false"},
-                               {"bounds", "vec", "nil"},    {"method", "str", "\"auto\""}};
+/* MAX_CONTROL, MAX_M, IST_MAX_K and MAX_KMAX written out (type texts are literal). */
+#define TY_LOD_K "int[0,20]"
+#define TY_AXIS "rec{cyclic: bool, crossings: int[0,50], ist: bool}"
+#define TY_SHUFFLE "str{height,colour,color,opacity}|list"
+static const bparam p_ist[] = {{"intervals", "int[1,100000]", "nil"}, {"crossings", "int[0,1000]|vec[0,1000]", "1"},
+                               {"iterations", "int[0,60]", "2"},      {"cyclic", "bool", "false"},
+                               {"bounds", "vec", "nil"},              {"method", "str{auto,lists,closed}", "\"auto\""}};
 static const bparam p_ist_map[] = {{"ist", "ist", NULL}, {"u", "num|vec", NULL}};
 static const bparam p_ist_one[] = {{"ist", "ist", NULL}};
-static const bparam p_ist_samples[] = {{"ist", "ist", NULL}, {"levels", "int|vec", "nil"},
-                                       {"jitter", "bool", "false"}, {"seed", "num", "nil"}};
-static const bparam p_curve[] = {{"points", "list", NULL},      {"heights", "num|vec", "0"},
-                                 {"colours", "any", "nil"},     {"opacity", "num|vec", "1"},
-                                 {"crossings", "int", "1"},     {"closed", "bool", "false"},
-                                 {"ist", "bool", "true"},       {"shuffle", "str|list", "nil"},
-                                 {"tension", "num", "2/3"},     {"crack_band", "num", "0"},
-                                 {"jitter", "bool", "false"},   {"extra", "int", "0"},
-                                 {"seed", "num", "nil"}};
-static const bparam p_points[] = {{"curve", "wrinkly_curve", NULL}, {"iterations", "int", "nil"},
-                                  {"tolerance", "num", "nil"}, {"kmax", "int", "8"}};
-static const bparam p_draw[] = {{"curve", "wrinkly_curve", NULL}, {"size", "vec|num", "[256, 256]"},
-                                {"bounds", "list", "nil"},        {"width", "num", "1.5"},
-                                {"colour", "any", "nil"},         {"fill", "any", "nil"},
-                                {"background", "any", "0"},       {"onto", "image", "nil"},
-                                {"pixel", "num", "1"},            {"iterations", "int", "nil"},
-                                {"kmax", "int", "8"}};
-static const bparam p_surface[] = {{"control", "list", NULL},     {"heights", "num|list", "0"},
-                                   {"colours", "any", "nil"},     {"opacity", "num|list", "1"},
-                                   {"u", "rec", "nil"},           {"v", "rec", "nil"},
-                                   {"shuffle", "str|list", "nil"}, {"tension", "num", "2/3"},
-                                   {"crack_band", "num", "0"},    {"jitter", "bool", "false"},
-                                   {"extra", "int", "0"},         {"seed", "num", "nil"}};
-static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera", "rec", "nil"},
-                                {"size", "vec|num", "[256, 256]"},    {"pixel", "num", "1"},
-                                {"tolerance", "num", "nil"},          {"iterations", "int", "nil"},
-                                {"kmax", "int", "8"}};
+static const bparam p_ist_samples[] = {{"ist", "ist", NULL}, {"levels", "int>=0|vec[0,60]", "nil"},
+                                       {"jitter", "bool", "false"}, {"seed", "int>=0", "nil"}};
+static const bparam p_curve[] = {{"points", "list", NULL},          {"heights", "num|vec", "0"},
+                                 {"colours", "num|str|list", "nil"}, {"opacity", "num|vec", "1"},
+                                 {"crossings", "int[0,50]", "1"},   {"closed", "bool", "false"},
+                                 {"ist", "bool", "true"},           {"shuffle", TY_SHUFFLE, "nil"},
+                                 {"tension", "num(0,1]", "2/3"},    {"crack_band", "num[0,0.5]", "0"},
+                                 {"jitter", "bool", "false"},       {"extra", "int[0,8]", "0"},
+                                 {"seed", "int>=0", "nil"}};
+static const bparam p_points[] = {{"curve", "wrinkly_curve", NULL}, {"iterations", TY_LOD_K, "nil"},
+                                  {"tolerance", "num>0", "nil"}, {"kmax", TY_LOD_K, "8"}};
+static const bparam p_draw[] = {{"curve", "wrinkly_curve", NULL}, {"size", TY_SIZE, "[256, 256]"},
+                                {"bounds", "list", "nil"},        {"width", "num[0,1000]", "1.5"},
+                                {"colour", TY_COLOUR, "nil"},     {"fill", TY_COLOUR, "nil"},
+                                {"background", TY_COLOUR, "0"},   {"onto", "image", "nil"},
+                                {"pixel", "num>0", "1"},          {"iterations", TY_LOD_K, "nil"},
+                                {"kmax", TY_LOD_K, "8"}};
+static const bparam p_surface[] = {{"control", "list", NULL},            {"heights", "num|list", "0"},
+                                   {"colours", "num|str|list", "nil"},    {"opacity", "num|list", "1"},
+                                   {"u", TY_AXIS, "nil"},                {"v", TY_AXIS, "nil"},
+                                   {"shuffle", TY_SHUFFLE, "nil"},       {"tension", "num(0,1]", "2/3"},
+                                   {"crack_band", "num[0,0.5]", "0"},    {"jitter", "bool", "false"},
+                                   {"extra", "int[0,8]", "0"},           {"seed", "int>=0", "nil"},
+                                   {"normal", "str{outward,inward,uv}", "nil"}};
+static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera", TY_CAMERA, "nil"},
+                                {"size", TY_SIZE, "[256, 256]"},      {"pixel", "num>0", "1"},
+                                {"tolerance", "num>0", "nil"},        {"iterations", TY_LOD_K, "nil"},
+                                {"kmax", TY_LOD_K, "8"}};
 static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
-                                  {"camera", "rec", "nil"},
-                                  {"size", "vec|num", "[256, 256]"},
-                                  {"background", "any", "0"},
-                                  {"light", "vec", "nil"},
-                                  {"ambient", "num", "0.2"},
-                                  {"diffuse", "num", "0.8"},
+                                  {"camera", TY_CAMERA, "nil"},
+                                  {"size", TY_SIZE, "[256, 256]"},
+                                  {"background", TY_COLOUR, "0"},
+                                  {"light", "vec3", "nil"},
+                                  {"ambient", "num>=0", "0.2"},
+                                  {"diffuse", "num>=0", "0.8"},
                                   {"flat", "bool", "false"},
                                   {"unlit", "bool", "false"},
-                                  {"colour", "any", "1"},
-                                  {"pixel", "num", "1"},
-                                  {"kmax", "int", "8"}};
+                                  {"colour", TY_COLOUR, "1"},
+                                  {"pixel", "num>0", "1"},
+                                  {"kmax", TY_LOD_K, "8"}};
 
 static const builtin wrinkly_builtins[] = {
     BUILTIN("ist", b_ist, p_ist,
@@ -1392,7 +1367,7 @@ static const builtin wrinkly_builtins[] = {
     BUILTIN("wrinkly_draw", b_wrinkly_draw, p_draw,
             "Draw a wrinkly curve antialiased into an image (or over `onto`): sub-intervals adapt to `pixel` pixels unless `iterations` is given; colour nil uses the curve's own colours; fill a closed curve."),
     BUILTIN("wrinkly_surface", b_wrinkly_surface, p_surface,
-            "A wrinkly surface (eq. 11) over a grid of control points [x, y, z] (a list of rows): heights, colours, opacity per point (or one value); u and v are records {cyclic, crossings, ist}."),
+            "A wrinkly surface (eq. 11) over a grid of control points [x, y, z] (a list of rows): heights, colours, opacity per point (or one value); u and v are records {cyclic, crossings, ist}; normal: \"outward\", \"inward\" or \"uv\" orients N (default: outward for a body-like surface, else P_u × P_v)."),
     BUILTIN("tessellate", b_tessellate, p_tess,
             "Sample a wrinkly surface into a coloured mesh (§5.2): with a camera, sub-intervals project to at most `pixel` pixels of an image of `size`; else `tolerance` (world length) or fixed `iterations` (default 3)."),
     BUILTIN("rasterize", b_rasterize, p_raster,

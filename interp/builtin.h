@@ -14,7 +14,8 @@
  *                   for vec it applies to every item
  *   {8,16}          choices (num/int), {log,linear} (str, with did-you-mean)
  *   rec{k: T, …}    the keys an (option) record may have, each with its type;
- *                   any other key is an error (with did-you-mean)
+ *                   any other key is an error (with did-you-mean); "k!: T"
+ *                   marks a key the record must have ("is missing key 'k'")
  *   +inf +nan       infinities / NaN allowed; numbers are finite otherwise,
  *                   also inside lists ("list": numbers at any depth)
  * e.g. "int[1,8]", "num>0", "vec2|num>0", "str{log,linear,sqrt}",
@@ -38,7 +39,7 @@ typedef struct bparam {
 
 /* Type texts shared by several tables. */
 #define TY_COLOUR "num|vec|str"
-#define TY_CAMERA "rec{eye: vec3, target: vec3, up: vec3, fov: num(0,179)}"
+#define TY_CAMERA "rec{eye!: vec3, target!: vec3, up: vec3, fov: num(0,179)}"
 #define TY_SIZE "vec2[1,1000000]|int[1,1000000]"
 
 #define MAX_ARGS 32
@@ -112,9 +113,14 @@ int lang_join_path(interp *I, const node *at, const char *dir, const char *p, si
 /* Errors about part of an argument: item `index` (0-based) of the list
  * `container`, an argument of the builtin running. The caret goes on that
  * item (a table's row) when the argument is a literal at the call, else on
- * the argument, else on the call. */
+ * the argument, else on the call. index SIZE_MAX: the argument itself. */
 int err_item(interp *I, value container, size_t index, err_kind k, const char *fmt, ...)
     __attribute__((format(printf, 5, 6)));
+/* An error about argument `slot` of the running builtin (its index in the
+ * builtin's args) that its declaration cannot say, such as one depending on
+ * several arguments: the caret goes on that argument when it was written
+ * at the call, else on the call. */
+int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 /* Check an option record whose keys depend on the value it goes with (save
  * of an image, a mesh…) against a declared type text "rec{…}" (compiled
  * once); nil passes. Errors point at the record's key when it is written at

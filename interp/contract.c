@@ -16,6 +16,7 @@ enum { K_ANY, K_NUM, K_INT, K_STR, K_BOOL, K_LIST, K_VEC, K_REC, K_FUNC, K_NIL, 
 typedef struct ckey {
     const char *name; /* interned */
     const ctype *type;
+    int required;     /* written "name!: T" */
 } ckey;
 
 typedef struct calt {
@@ -176,6 +177,9 @@ static int tp_keys(tparser *t, calt *a)
             return -1;
         }
         keys[n].name = intern(t->I, s, (size_t)(t->p - s));
+        keys[n].required = *t->p == '!';
+        if (keys[n].required)
+            t->p++;
         skip_ws(t);
         if (*t->p != ':') {
             t->err = "':' after the key name";
@@ -690,7 +694,18 @@ static void describe_alt(const calt *a, sbuf *out)
     case K_REC: sb_printf(out, "a record"); break;
     case K_FUNC: sb_printf(out, "a function"); break;
     case K_NIL: sb_printf(out, "nil"); break;
-    default: sb_printf(out, "%s %.*s", strchr("aeiou", a->cls[0]) ? "an" : "a", (int)a->clslen, a->cls);
+    default: {
+        /* classes a script makes with a builtin of another name: say how */
+        static const struct { const char *cls, *how; } hints[] = {
+            {"order", " (order([1, 2]), order(\"W2 ∘ W1\"), …)"},
+            {"shape", " (polygon(…), polyline(…) or pointset(…))"},
+        };
+        const char *how = "";
+        for (size_t i = 0; i < sizeof hints / sizeof hints[0]; i++)
+            if (strlen(hints[i].cls) == a->clslen && memcmp(hints[i].cls, a->cls, a->clslen) == 0)
+                how = hints[i].how;
+        sb_printf(out, "%s %.*s%s", strchr("aeiou", a->cls[0]) ? "an" : "a", (int)a->clslen, a->cls, how);
+    }
     }
 }
 
@@ -843,6 +858,12 @@ static int check_alt(cctx *c, const calt *a, value v, const char *what, cpos at)
             if (contract_check_value(c->I, k->type, r->vals[i], c->who, w, key_pos(c->I, at, r->keys[i], 0)))
                 return -1;
         }
+        for (int j = 0; j < a->nkeys; j++)
+            if (a->keys[j].required && !rec_get(r, a->keys[j].name)) {
+                if (opts)
+                    return err_cpos(c->I, at, ERR_VALUE, "%s: missing option '%s'", c->who, a->keys[j].name);
+                return err_cpos(c->I, at, ERR_VALUE, "%s: %s is missing key '%s'", c->who, what, a->keys[j].name);
+            }
         return 0;
     }
     default:
@@ -1037,6 +1058,18 @@ int err_item(interp *I, value container, size_t index, err_kind k, const char *f
     const node *n = arg_node_of(I, container);
     cpos at = item_pos(pos_of(n), index);
     return err_cpos(I, at, k, "%s", msg);
+}
+
+int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...)
+{
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const bcall *c = I->bcall;
+    const node *n = c && slot >= 0 && slot < c->n ? c->nodes[slot] : NULL;
+    return err_at(I, n, k, "%s", msg);
 }
 
 int opts_check(interp *I, value opts, const char *type, const char *who)

@@ -199,59 +199,47 @@ static int push_frame(interp *I, const char *name, const node *call)
     return 0;
 }
 
-/* Call a user function with positional args and named args. */
+/* Call a user function with positional args and named args. Arguments are
+ * matched with contract_match, as the static check and builtins do, so an
+ * error about one argument puts the caret on it (anodes, may be NULL). */
 static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char **names,
-                     const value *named, int nnamed, const node *call, value *out)
+                     const value *named, int nnamed, const node *const *anodes, const node *call, value *out)
 {
     const node *l = f->lambda;
     const char *fname = f->name ? f->name : "<lambda>";
-    if (npos > l->nparams)
-        return err_at(I, call, ERR_TYPE, "%s takes %d argument%s, but %d were given", fname,
-                      l->nparams, l->nparams == 1 ? "" : "s", npos);
+    if (l->nparams > MAX_ARGS)
+        return err_at(I, call, ERR_LIMIT, "too many parameters");
+    if (npos + nnamed > MAX_ARGS)
+        return err_at(I, call, ERR_TYPE, "%s: too many arguments", fname);
+    const char *anames[MAX_ARGS];
+    int required[MAX_ARGS], slot[MAX_ARGS];
+    for (int j = 0; j < l->nparams; j++)
+        required[j] = l->kids[j] == NULL;
+    for (int i = 0; i < npos; i++)
+        anames[i] = NULL;
+    for (int k = 0; k < nnamed; k++)
+        anames[npos + k] = names[k];
+    if (contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, npos + nnamed, call, slot))
+        return -1;
+    value bound[MAX_ARGS];
+    int have[MAX_ARGS] = {0};
+    for (int i = 0; i < npos + nnamed; i++) {
+        bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
+        have[slot[i]] = 1;
+    }
     env *e = env_new(I, f->closure);
     if (!e)
         return -1;
     int rc = -1;
-    value bound[MAX_ARGS];
-    int have[MAX_ARGS] = {0};
-    if (l->nparams > MAX_ARGS) {
-        err_at(I, call, ERR_LIMIT, "too many parameters");
-        goto done;
-    }
-    for (int i = 0; i < npos; i++) {
-        bound[i] = pos[i];
-        have[i] = 1;
-    }
-    for (int k = 0; k < nnamed; k++) {
-        int j;
-        for (j = 0; j < l->nparams; j++)
-            if (l->names[j] == names[k])
-                break;
-        if (j == l->nparams) {
-            const char *s = suggest_name(names[k], l->names, (size_t)l->nparams);
-            err_at(I, call, ERR_TYPE, "%s has no parameter '%s'%s%s%s", fname, names[k],
-                   s ? " (did you mean '" : "", s ? s : "", s ? "'?)" : "");
-            goto done;
-        }
-        if (have[j]) {
-            err_at(I, call, ERR_TYPE, "%s: argument '%s' given twice", fname, names[k]);
-            goto done;
-        }
-        bound[j] = named[k];
-        have[j] = 1;
-    }
     for (int j = 0; j < l->nparams; j++) {
         value v;
         if (have[j]) {
             v = bound[j];
             val_ref(v);
-        } else if (l->kids[j]) {
+        } else {
             /* defaults are evaluated in the new scope, so they can use earlier parameters */
             if (eval_expr(I, e, l->kids[j], &v))
                 goto done;
-        } else {
-            err_at(I, call, ERR_TYPE, "%s: missing argument '%s'", fname, l->names[j]);
-            goto done;
         }
         if (env_define(I, e, l->names[j], v))
             goto done;
@@ -341,7 +329,7 @@ static int call_any(interp *I, value fn, const value *pos, int npos, const char 
     if (check_interrupt(I, call))
         return -1;
     if (fn.k == V_FUNC)
-        return call_user(I, AS_FUNC(fn), pos, npos, names, named, nnamed, call, out);
+        return call_user(I, AS_FUNC(fn), pos, npos, names, named, nnamed, anodes, call, out);
     if (fn.k == V_BUILTIN)
         return call_builtin(I, fn.u.bi, pos, npos, names, named, nnamed, anodes, call, out);
     return err_at(I, call, ERR_TYPE, "cannot call %s (it is not a function)", val_type_name(fn));
@@ -830,9 +818,9 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         if (eval_expr(I, e, n->kids[0], &def))
             return -1;
         value ov;
-        /* -D overrides the params of the script run, not those of the modules
-         * it imports (their top-level scope is the module's own) */
-        int r = e == I->globals ? apply_param_override(I, n, def, &ov) : 0;
+        /* -D overrides the params of the script run, not those of the
+         * modules it imports */
+        int r = n->src >= 0 && I->srcs[n->src].is_module ? 0 : apply_param_override(I, n, def, &ov);
         if (r < 0) {
             val_unref(I, def);
             return -1;
@@ -1014,6 +1002,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     mem_free(I, filedata);
     if (src < 0)
         return -1;
+    I->srcs[src].is_module = 1;
     if (I->nmods == I->cap_mods) {
         int nc = I->cap_mods ? I->cap_mods * 2 : 8;
         module *nm = mem_realloc(I, I->mods, (size_t)nc * sizeof *nm);

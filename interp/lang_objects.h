@@ -46,7 +46,8 @@ void lang_field_fn_done(struct field *tmp, struct field_prog *own);
 int opt_num(interp *I, value rec, const char *key, double *out);
 
 /* A camera from a record {eye: [x,y,z], target: [x,y,z], up: [0,1,0],
- * fov: 40} (what orbit() and look_at() return). */
+ * fov: 40} (what orbit() and look_at() return), an argument declared
+ * TY_CAMERA (so its keys are already checked). */
 int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */

@@ -271,6 +271,7 @@ int interp_add_source(interp *I, const char *name, const char *text, size_t len)
     s->text = dup_str(I, text, len);
     const char *slash = strrchr(name, '/');
     s->first_line = 1;
+    s->is_module = 0;
     s->dir = slash ? dup_str(I, name, (size_t)(slash - name)) : dup_str(I, ".", 1);
     if (!s->name || !s->text || !s->dir) {
         mem_free(I, s->name);

@@ -68,6 +68,7 @@ typedef struct source {
     char *text;
     char *dir;  /* directory for relative imports */
     int first_line; /* line number of the text's first line (REPL entries) */
+    int is_module;  /* an imported module (its params are not the script's: -D skips them) */
 } source;
 
 typedef struct limits {

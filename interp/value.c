@@ -595,10 +595,10 @@ void val_print(interp *I, value v, bytebuf *out, int repr)
         }
         if (n == cap) {
             size_t nc = cap * 2;
-            print_frame *ns = st == local ? malloc(nc * sizeof *ns) : realloc(st, nc * sizeof *ns);
-            if (!ns) {
-                bytebuf_append(out, "…", strlen("…"));
-                continue;
+            print_frame *ns = st == local ? rt_mallocn(nc, sizeof *ns) : rt_reallocn(st, nc, sizeof *ns);
+            if (!ns) { /* the hook refused: the caller reports out of memory */
+                out->failed = 1;
+                break;
             }
             if (st == local)
                 memcpy(ns, local, sizeof local);
@@ -609,5 +609,5 @@ void val_print(interp *I, value v, bytebuf *out, int repr)
         bytebuf_byte(out, child.k == V_LIST ? '[' : '{');
     }
     if (st != local)
-        free(st);
+        rt_free(st);
 }
