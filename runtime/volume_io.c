@@ -475,7 +475,9 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         return rt_fail(e, RT_EFORMAT, "NRRD header has no blank line before the data and no data file");
     }
     size_t at = data_at;
-    for (long l = 0; l < line_skip; l++) {
+    /* stop at the end of the data: a huge line skip must not loop on
+     * (found by the fuzzer: "line skip: 66666666674" ran for minutes) */
+    for (long l = 0; l < line_skip && at < dn; l++) {
         while (at < dn && data[at] != '\n')
             at++;
         if (at < dn)

@@ -290,8 +290,24 @@ static void test_bounds_not_finite(void)
         volume_free(&v);
 }
 
+/* Found by the fuzzer: a huge `line skip` kept looping after the end of
+ * the data (10^12 iterations here: the old reader ran for hours). */
+static void test_huge_line_skip(void)
+{
+    const char nrrd[] = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
+                        "line skip: 1000000000000\n\nA\n";
+    volume v;
+    rt_error e;
+    rt_code c = vio_nrrd_from_mem((const unsigned char *)nrrd, sizeof nrrd - 1, NULL, &v, &e);
+    CHECK(c == RT_EFORMAT && strcmp(e.msg, "NRRD data is 0 bytes, expected 1 (1×1×1 samples of 1 byte(s))") == 0,
+          "NRRD huge line skip: code %d, '%s'", (int)c, e.msg);
+    if (c == RT_OK)
+        volume_free(&v);
+}
+
 int main(void)
 {
+    test_huge_line_skip();
     test_bounds_not_finite();
     test_writers_match_references();
     test_readers_read_references();
