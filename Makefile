@@ -6,6 +6,8 @@
 #   make golden     regenerate tests/golden/ from examples/ (review the diff!)
 #   make gallery    render every example into gallery/index.html
 #   make bench      build and run the benchmarks in bench/
+#   make fuzz       libFuzzer harnesses (clang); make fuzz-smoke is the ~60 s CI run
+#                   (tests/fuzz/README.md)
 #
 # Floating point must give identical results at every optimisation level and
 # under the sanitizers (goldens are compared exactly): no -ffast-math, no
