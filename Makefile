@@ -6,6 +6,8 @@
 #   make golden     regenerate tests/golden/ from examples/ (review the diff!)
 #   make gallery    render every example into gallery/index.html
 #   make bench      build and run the benchmarks in bench/
+#   make fuzz       libFuzzer harnesses (clang); make fuzz-smoke is the ~60 s CI run
+#                   (tests/fuzz/README.md)
 #
 # Floating point must give identical results at every optimisation level and
 # under the sanitizers (goldens are compared exactly): no -ffast-math, no
@@ -30,7 +32,7 @@ RT_OBJ  := $(RT_SRC:%.c=$(BUILD)/%.o)
 IN_OBJ  := $(IN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/stdlib_gen.o
 UNIT_BIN:= $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
-.PHONY: all test asan golden gallery bench clean unit fuzz
+.PHONY: all test asan golden gallery bench clean unit
 all: $(BUILD)/frac
 
 $(BUILD)/%.o: %.c
@@ -93,17 +95,82 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/libfracrt.a
 bench: $(BUILD)/frac $(BENCH_BIN)
 	bash bench/run.sh $(BUILD)
 
-# Fuzz the whole interpreter with libFuzzer (needs clang; not part of test).
+# Fuzzing with libFuzzer (clang with libclang-rt-14-dev; not part of test).
+# See tests/fuzz/README.md. Objects are built in build-fuzz/ with ASan +
+# UBSan (UBSan errors abort) and coverage instrumentation; the harnesses
+# link them with -fsanitize=fuzzer.
+#   make fuzz              build everything, then run the script harness FUZZ_SECONDS
+#   make fuzz-NAME         run one harness (script png inflate pnm ifs nrrd vtk ply obj stl)
+#   make fuzz-smoke        build, replay tests/fuzz/regressions, run each harness briefly
+#   make fuzz-seeds        (re)make the seed corpora in build-fuzz/corpus/
 FUZZ_SECONDS ?= 60
-fuzz:
-	@mkdir -p build-fuzz /tmp/frac-fuzz-out build-fuzz/corpus
-	$(MAKE) BUILD=build-fuzz build-fuzz/stdlib_gen.c
-	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
-	    -Iruntime -Iinterp -Ibuild-fuzz $(RT_SRC) $(filter-out interp/main.c,$(IN_SRC)) \
-	    build-fuzz/stdlib_gen.c tests/fuzz/fuzz_script.c -lm -lpthread -o build-fuzz/fuzz_script
-	for f in examples/*.frac tests/lang/*/*.frac; do cp "$$f" build-fuzz/corpus/$$(echo $$f | tr / _); done
-	build-fuzz/fuzz_script -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=30 \
-	    -rss_limit_mb=4096 build-fuzz/corpus
+FUZZ_LOADERS := png inflate pnm ifs nrrd vtk ply obj stl
+FUZZ_HARNESSES := script $(FUZZ_LOADERS)
+FUZZ_SAN = -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
+           -fsanitize-coverage-ignorelist=tests/fuzz/engines.ignorelist
+FUZZ_FLAGS = -timeout=10 -rss_limit_mb=1536 -malloc_limit_mb=1024 -print_final_stats=1
+FUZZ_SCRIPT_OBJ := $(filter-out $(BUILD)/interp/main.o,$(IN_OBJ))
+FUZZ_DIR := build-fuzz
+.PHONY: fuzz fuzz-build fuzz-bins fuzz-seeds fuzz-smoke $(FUZZ_HARNESSES:%=fuzz-%)
+
+$(BUILD)/fuzz/fuzz_script: tests/fuzz/fuzz_script.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) \
+	    -Wl,--wrap=fileio_write_atomic,--wrap=fileio_read_all -o $@
+
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_loaders.c $(BUILD)/libfracrt.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fsanitize=fuzzer -DFUZZ_LOADER=$* $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+$(BUILD)/fuzzgen: tools/fuzzgen.c $(BUILD)/libfracrt.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_BASE) -O1 -Iruntime $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+fuzz-bins: $(FUZZ_HARNESSES:%=$(BUILD)/fuzz/fuzz_%)
+
+fuzz-build:
+	$(MAKE) BUILD=$(FUZZ_DIR) CC=clang OPT=-O1 SAN="$(FUZZ_SAN)" fuzz-bins
+	$(MAKE) $(BUILD)/fuzzgen
+
+# Seeds: the examples and language tests for the script harness, plus the
+# deep and wide inputs and the small valid files tools/fuzzgen writes.
+fuzz-seeds: $(BUILD)/fuzzgen
+	@mkdir -p $(FUZZ_DIR)/corpus/script
+	@for f in examples/*.frac tests/lang/*/*.frac tests/regression/*.frac; do \
+	    cp "$$f" $(FUZZ_DIR)/corpus/script/$$(echo $$f | tr / _); done
+	$(BUILD)/fuzzgen $(FUZZ_DIR)/corpus
+
+fuzz: fuzz-build fuzz-seeds
+	$(MAKE) fuzz-script
+
+$(FUZZ_HARNESSES:%=fuzz-%): fuzz-%:
+	@mkdir -p $(FUZZ_DIR)/corpus/$* $(FUZZ_DIR)/findings/$*
+	$(FUZZ_DIR)/fuzz/fuzz_$* $(FUZZ_FLAGS) -max_total_time=$(FUZZ_SECONDS) \
+	    -dict=tests/fuzz/$(if $(filter script,$*),frac,formats).dict \
+	    -artifact_prefix=$(FUZZ_DIR)/findings/$*/ $(FUZZ_DIR)/corpus/$*
+
+# CI: about 60 s in all; fails on any crash. Replays every kept finding
+# first (tests/fuzz/regressions/HARNESS/*), then fuzzes each harness from
+# its seeds for a few seconds into a scratch corpus.
+FUZZ_SMOKE_SECONDS ?= 5
+fuzz-smoke: fuzz-build fuzz-seeds
+	@for h in $(FUZZ_HARNESSES); do \
+	    if [ -n "$$(ls tests/fuzz/regressions/$$h 2>/dev/null)" ]; then \
+	        $(FUZZ_DIR)/fuzz/fuzz_$$h tests/fuzz/regressions/$$h/* > $(FUZZ_DIR)/replay-$$h.log 2>&1 \
+	        || { tail -n 40 $(FUZZ_DIR)/replay-$$h.log; echo "fuzz-smoke: a kept $$h finding fails again"; exit 1; }; \
+	        echo "fuzz-smoke: replayed $$(ls tests/fuzz/regressions/$$h | wc -l) $$h regression(s)"; fi; \
+	done
+	@for h in $(FUZZ_HARNESSES); do \
+	    t=$(FUZZ_SMOKE_SECONDS); [ $$h = script ] && t=$$((2 * $(FUZZ_SMOKE_SECONDS))); \
+	    rm -rf $(FUZZ_DIR)/smoke/$$h; mkdir -p $(FUZZ_DIR)/smoke/$$h $(FUZZ_DIR)/findings/$$h; \
+	    d=formats; [ $$h = script ] && d=frac; \
+	    $(FUZZ_DIR)/fuzz/fuzz_$$h $(FUZZ_FLAGS) -max_total_time=$$t -dict=tests/fuzz/$$d.dict \
+	        -artifact_prefix=$(FUZZ_DIR)/findings/$$h/ \
+	        $(FUZZ_DIR)/smoke/$$h $(FUZZ_DIR)/corpus/$$h > $(FUZZ_DIR)/smoke/$$h.log 2>&1; rc=$$?; \
+	    echo "fuzz-smoke $$h ($$t s): $$(grep -E '^#[0-9]+' $(FUZZ_DIR)/smoke/$$h.log | tail -n 1)"; \
+	    if [ $$rc -ne 0 ]; then tail -n 40 $(FUZZ_DIR)/smoke/$$h.log; \
+	        echo "fuzz-smoke: $$h failed (exit $$rc), see $(FUZZ_DIR)/findings/$$h/"; exit 1; fi; \
+	done
 
 clean:
 	rm -rf build build-asan build-fuzz gallery

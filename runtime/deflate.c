@@ -717,7 +717,9 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     deflater *d = rt_calloc(1, sizeof *d);
     if (!d)
         return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
-    d->in = in;
+    /* empty input may come as (NULL, 0); d->in + offset must stay defined */
+    static const unsigned char no_input[1];
+    d->in = in ? in : no_input;
     d->n = n;
     d->cfg = level_cfgs[level];
     d->w = *w;

@@ -418,7 +418,9 @@ rt_code inflate_zlib(const unsigned char *in, size_t n, size_t max_out, bytebuf 
         return rt_fail(e, RT_EFORMAT, "zlib stream is truncated (no Adler-32 checksum)");
     const unsigned char *t = in + 2 + used;
     uint32_t want = (uint32_t)t[0] << 24 | (uint32_t)t[1] << 16 | (uint32_t)t[2] << 8 | t[3];
-    uint32_t got = deflate_adler32(1, out->data + base, out->len - base);
+    /* out->data is NULL when nothing was ever appended (an empty stream):
+     * no pointer arithmetic on it */
+    uint32_t got = out->len > base ? deflate_adler32(1, out->data + base, out->len - base) : 1;
     if (want != got)
         return rt_fail(e, RT_EFORMAT, "Adler-32 mismatch (stored %08x, computed %08x)",
                        (unsigned)want, (unsigned)got);

@@ -436,10 +436,14 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     float *vn = NULL;
     int have_c = 0, lineno = 0;
     char line[4096];
+    /* initialised before the first pass too: its errors return at once and
+     * the caller mesh_frees *m (found by the fuzzer) */
+    mesh_init(m, 0, 0);
     for (int pass = 0; pass < 2; pass++) {
         size_t pos = 0;
         lineno = 0;
         if (pass == 1) {
+            mesh_free(m);
             mesh_init(m, nvn > 0, have_c);
             nv = 0;
         }

@@ -479,7 +479,9 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         return rt_fail(e, RT_EFORMAT, "NRRD header has no blank line before the data and no data file");
     }
     size_t at = data_at;
-    for (long l = 0; l < line_skip; l++) {
+    /* stop at the end of the data: a huge line skip must not loop on
+     * (found by the fuzzer: "line skip: 66666666674" ran for minutes) */
+    for (long l = 0; l < line_skip && at < dn; l++) {
         while (at < dn && data[at] != '\n')
             at++;
         if (at < dn)
@@ -505,6 +507,11 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         if (have_lo && have_hi) {
             lo[k] = flo[k];
             hi[k] = fhi[k];
+        }
+        if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k])) {
+            free(file);
+            return rt_fail(e, RT_EFORMAT, "NRRD origin and spacing give axis %d the bounds %g .. %g (not finite and increasing)",
+                           k, lo[k], hi[k]);
         }
     }
     rt_code rc = volume_init(v, (int)sizes[0], (int)sizes[1], (int)sizes[2], lo, hi, e);
@@ -621,6 +628,11 @@ rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *
     for (int k = 0; k < 3; k++) {
         lo[k] = org[k] - 0.5 * sp[k];
         hi[k] = lo[k] + sp[k] * dims[k];
+        /* a huge SPACING or ORIGIN (or nan/inf, which strtod reads) gives
+         * bounds no writer can store (found by the fuzzer) */
+        if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k]))
+            return rt_fail(e, RT_EFORMAT, "VTK ORIGIN and SPACING give axis %d the bounds %g .. %g (not finite and increasing)",
+                           k, lo[k], hi[k]);
     }
     rt_code rc = volume_init(v, (int)dims[0], (int)dims[1], (int)dims[2], lo, hi, e);
     if (rc)

@@ -330,8 +330,29 @@ static void test_corrupt(void)
     bytebuf_free(&z);
 }
 
+/* Found by the fuzzer (tests/fuzz/README.md): an empty stream into an empty
+ * buffer took the Adler-32 of out->data + 0 with out->data NULL (undefined
+ * behaviour, reported by UBSan under make asan). */
+static void test_empty_stream(void)
+{
+    rt_error e;
+    bytebuf o;
+    bytebuf_init(&o);
+    const unsigned char z[] = {0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01};
+    rt_code c = inflate_zlib(z, sizeof z, 100, &o, &e);
+    CHECK(c == RT_OK && o.len == 0, "empty zlib stream: code %d, %zu bytes", (int)c, o.len);
+    bytebuf_free(&o);
+    bytebuf_init(&o);
+    unsigned char bad[] = {0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x02};
+    c = inflate_zlib(bad, sizeof bad, 100, &o, &e);
+    CHECK(c == RT_EFORMAT && strstr(e.msg, "Adler-32 mismatch (stored 00000002, computed 00000001)"),
+          "empty stream, bad Adler-32: code %d, '%s'", (int)c, e.msg);
+    bytebuf_free(&o);
+}
+
 int main(void)
 {
+    test_empty_stream();
     test_checksums();
     test_roundtrips();
     test_known_streams();

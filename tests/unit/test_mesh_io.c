@@ -262,8 +262,28 @@ static void test_declared_size(void)
     rt_free(stl);
 }
 
+/* Found by the fuzzer: an OBJ error in the first pass (a vertex or normal
+ * with too few numbers) returned before *m was initialised, so the
+ * documented mesh_free afterwards freed garbage pointers. */
+static void test_obj_early_error_initialises(void)
+{
+    static const char *bad[] = {"v 0 0\n", "vn 0 1\nv 0 0 0\n"};
+    static const char *msg[] = {"OBJ line 1: vertex needs 3 coordinates",
+                                "OBJ line 1: normal needs 3 components"};
+    for (int i = 0; i < 2; i++) {
+        mesh m;
+        memset(&m, 0x5a, sizeof m); /* what an uninitialised local may hold */
+        rt_error e;
+        rt_code c = mio_obj_from_mem((const unsigned char *)bad[i], strlen(bad[i]), &m, &e);
+        CHECK(c == RT_EFORMAT && strcmp(e.msg, msg[i]) == 0, "OBJ '%s': code %d, '%s'", bad[i], (int)c, e.msg);
+        CHECK(m.pos == NULL && m.tri == NULL && m.nv == 0, "OBJ '%s': mesh not initialised", bad[i]);
+        mesh_free(&m);
+    }
+}
+
 int main(void)
 {
+    test_obj_early_error_initialises();
     test_writers();
     test_readers();
     test_roundtrip();

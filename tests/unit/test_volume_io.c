@@ -285,8 +285,53 @@ static void test_declared_size(void)
     check_limits_off();
 }
 
+/* Found by the fuzzer: a huge SPACING (or a nan ORIGIN) made volumes with
+ * infinite bounds that no writer can store; both readers refuse them. */
+static void test_bounds_not_finite(void)
+{
+    char vtk[512];
+    int n = snprintf(vtk, sizeof vtk, "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\n"
+                                      "DIMENSIONS 2 1 1\nORIGIN 0 0 0\nSPACING 1e308 1 1\nPOINT_DATA 2\n"
+                                      "SCALARS d float 1\nLOOKUP_TABLE default\n");
+    memset(vtk + n, 0, 8);
+    volume v;
+    rt_error e;
+    rt_code c = vio_vtk_from_mem((const unsigned char *)vtk, (size_t)n + 8, &v, &e);
+    CHECK(c == RT_EFORMAT && strcmp(e.msg, "VTK ORIGIN and SPACING give axis 0 the bounds -5e+307 .. inf "
+                                           "(not finite and increasing)") == 0,
+          "VTK huge spacing: code %d, '%s'", (int)c, e.msg);
+    if (c == RT_OK)
+        volume_free(&v);
+    char nrrd[512];
+    n = snprintf(nrrd, sizeof nrrd, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
+                                    "space origin: (nan,0,0)\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n\nA");
+    c = vio_nrrd_from_mem((const unsigned char *)nrrd, (size_t)n, NULL, &v, &e);
+    CHECK(c == RT_EFORMAT && strcmp(e.msg, "NRRD origin and spacing give axis 0 the bounds nan .. nan "
+                                           "(not finite and increasing)") == 0,
+          "NRRD nan origin: code %d, '%s'", (int)c, e.msg);
+    if (c == RT_OK)
+        volume_free(&v);
+}
+
+/* Found by the fuzzer: a huge `line skip` kept looping after the end of
+ * the data (10^12 iterations here: the old reader ran for hours). */
+static void test_huge_line_skip(void)
+{
+    const char nrrd[] = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
+                        "line skip: 1000000000000\n\nA\n";
+    volume v;
+    rt_error e;
+    rt_code c = vio_nrrd_from_mem((const unsigned char *)nrrd, sizeof nrrd - 1, NULL, &v, &e);
+    CHECK(c == RT_EFORMAT && strcmp(e.msg, "NRRD data is 0 bytes, expected 1 (1×1×1 samples of 1 byte(s))") == 0,
+          "NRRD huge line skip: code %d, '%s'", (int)c, e.msg);
+    if (c == RT_OK)
+        volume_free(&v);
+}
+
 int main(void)
 {
+    test_huge_line_skip();
+    test_bounds_not_finite();
     test_writers_match_references();
     test_readers_read_references();
     test_roundtrip();
