@@ -409,10 +409,22 @@ static void print_line_caret(interp *I, FILE *f, int src, int line, int col)
     int len = (int)(q - p);
     if (len > 0 && p[len - 1] == '\r')
         len--;
-    fprintf(f, "%5d | %.*s\n      | ", line, len, p);
+    /* A long line shows a window of about 120 bytes around the column,
+     * marked with … at the cut ends, so a 60 KB line stays one screen. */
+    int from = 0, to = len;
+    if (len > 160) {
+        from = col - 1 > 60 ? col - 1 - 60 : 0;
+        to = from + 120 < len ? from + 120 : len;
+        while (from > 0 && ((unsigned char)p[from] & 0xC0) == 0x80)
+            from--;
+        while (to < len && ((unsigned char)p[to] & 0xC0) == 0x80)
+            to++;
+    }
+    fprintf(f, "%5d | %s%.*s%s\n      | %s", line, from ? "…" : "", to - from, p + from, to < len ? "…" : "",
+            from ? " " : "");
     /* Tabs stay tabs so the caret lines up; other bytes become spaces (one
      * per UTF-8 character). */
-    for (int i = 0; i < col - 1 && i < len; i++) {
+    for (int i = from; i < col - 1 && i < to; i++) {
         unsigned char c = (unsigned char)p[i];
         if ((c & 0xC0) == 0x80)
             continue;
