@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt_alloc.h"
 #include "deflate.h"
 #include "fractint.h"
 #include "mesh.h"
