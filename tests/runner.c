@@ -271,6 +271,227 @@ static void run_unit(const char *dir)
 
 /* ---- language tests ---------------------------------------------------------------- */
 
+/* A line of stderr that echoes source: "%5d | TEXT" or the caret line "      | ^". */
+static int is_echo_line(const char *s, size_t l)
+{
+    size_t i = 0, sp, dg;
+    while (i < l && s[i] == ' ')
+        i++;
+    sp = i;
+    while (i < l && s[i] >= '0' && s[i] <= '9')
+        i++;
+    dg = i - sp;
+    if (dg)
+        return i + 1 < l && s[i] == ' ' && s[i + 1] == '|';
+    return sp > 0 && i < l && s[i] == '|';
+}
+
+/* `# stderr: TEXT`: some whole line of err equals want. */
+static int has_line(const char *err, const char *want)
+{
+    size_t wl = strlen(want);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (l == wl && memcmp(p, want, l) == 0)
+            return 1;
+        p = e ? e + 1 : p + l;
+    }
+    return 0;
+}
+
+/* `# stderr contains: TEXT`: some line of err that is not a source echo
+ * contains want. */
+static int line_contains(const char *err, const char *want)
+{
+    size_t wl = strlen(want);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (!is_echo_line(p, l))
+            for (size_t i = 0; i + wl <= l; i++)
+                if (memcmp(p + i, want, wl) == 0)
+                    return 1;
+        p = e ? e + 1 : p + l;
+    }
+    return 0;
+}
+
+/* What a `# expect [runtime] error…` comment asks for. */
+enum { AT_HERE, AT_NOPOS, AT_FILE };
+typedef struct want_diag {
+    int runtime;        /* 1: raised while running; 0: found before (so `frac check` finds it) */
+    int where;          /* AT_HERE: this file, the comment's line; AT_NOPOS; AT_FILE: file:line */
+    char file[4200];    /* AT_HERE / AT_FILE: the path frac must print (AT_FILE: normalised) */
+    int line, col;      /* col 0: any column */
+    char msg[4096];
+    int prefix;         /* the message ended in "...": it is a prefix */
+} want_diag;
+
+/* The first diagnostic of a run: the first line of stderr that is neither
+ * indented (source echo, caret, call trace) nor a warning. */
+typedef struct got_diag {
+    int found, is_error, has_pos;
+    char file[4200];
+    int line, col;
+    char msg[4096];
+    char text[4200];    /* the whole line, for messages */
+} got_diag;
+
+/* "a/./b/./c" -> "a/b/c", "./a" -> "a" */
+static void norm_path(char *s)
+{
+    char *p;
+    while ((p = strstr(s, "/./")))
+        memmove(p, p + 2, strlen(p + 2) + 1);
+    while (s[0] == '.' && s[1] == '/')
+        memmove(s, s + 2, strlen(s + 2) + 1);
+}
+
+static void first_diag(const char *err, got_diag *g)
+{
+    memset(g, 0, sizeof *g);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (l && p[0] != ' ' && p[0] != '\t' && strncmp(p, "warning: ", 9) != 0) {
+            g->found = 1;
+            snprintf(g->text, sizeof g->text, "%.*s", (int)(l < 4100 ? l : 4100), p);
+            break;
+        }
+        p = e ? e + 1 : p + l;
+    }
+    if (!g->found)
+        return;
+    if (strncmp(g->text, "frac: error: ", 13) == 0) {
+        g->is_error = 1;
+        snprintf(g->msg, sizeof g->msg, "%s", g->text + 13);
+        return;
+    }
+    char *m = strstr(g->text, ": error: ");
+    if (!m)
+        return;
+    /* FILE:LINE:COL before ": error: " (FILE may itself hold ':') */
+    char head[4200];
+    snprintf(head, sizeof head, "%.*s", (int)(m - g->text), g->text);
+    char *c2 = strrchr(head, ':');
+    if (!c2)
+        return;
+    *c2 = 0;
+    char *c1 = strrchr(head, ':');
+    if (!c1)
+        return;
+    *c1 = 0;
+    char *end1, *end2;
+    long ln = strtol(c1 + 1, &end1, 10), cl = strtol(c2 + 1, &end2, 10);
+    if (*end1 || *end2 || end1 == c1 + 1 || end2 == c2 + 1)
+        return;
+    g->is_error = g->has_pos = 1;
+    snprintf(g->file, sizeof g->file, "%s", head);
+    g->line = (int)ln;
+    g->col = (int)cl;
+    snprintf(g->msg, sizeof g->msg, "%s", m + 9);
+}
+
+/* Parse the part after "error" of a `# expect [runtime] error…` comment on
+ * line `line` of test `path`. Returns 0 if malformed. */
+static int parse_want(const char *s, const char *path, int line, int runtime, want_diag *w)
+{
+    memset(w, 0, sizeof *w);
+    w->runtime = runtime;
+    const char *msg;
+    if (strncmp(s, ": ", 2) == 0) {
+        w->where = AT_HERE;
+        msg = s + 2;
+    } else if (s[0] == '@') {
+        char *end;
+        long c = strtol(s + 1, &end, 10);
+        if (end == s + 1 || c < 1 || strncmp(end, ": ", 2) != 0)
+            return 0;
+        w->where = AT_HERE;
+        w->col = (int)c;
+        msg = end + 2;
+    } else if (strncmp(s, " (no position): ", 16) == 0) {
+        w->where = AT_NOPOS;
+        msg = s + 16;
+    } else if (strncmp(s, " at ", 4) == 0) {
+        /* " at NAME:LINE[:COL]: MSG", NAME relative to the test's folder */
+        const char *sep = strstr(s + 4, ": ");
+        if (!sep)
+            return 0;
+        char spec[4096];
+        snprintf(spec, sizeof spec, "%.*s", (int)(sep - s - 4), s + 4);
+        char *c1 = strchr(spec, ':');
+        if (!c1 || c1 == spec)
+            return 0;
+        *c1 = 0;
+        char *end;
+        long ln = strtol(c1 + 1, &end, 10), cl = 0;
+        if (end == c1 + 1 || ln < 1)
+            return 0;
+        if (*end == ':') {
+            char *e2;
+            cl = strtol(end + 1, &e2, 10);
+            if (e2 == end + 1 || cl < 1 || *e2)
+                return 0;
+        } else if (*end) {
+            return 0;
+        }
+        const char *slash = strrchr(path, '/');
+        snprintf(w->file, sizeof w->file, "%.*s%s", slash ? (int)(slash - path + 1) : 0, path, spec);
+        norm_path(w->file);
+        w->where = AT_FILE;
+        w->line = (int)ln;
+        w->col = (int)cl;
+        msg = sep + 2;
+    } else {
+        return 0;
+    }
+    snprintf(w->msg, sizeof w->msg, "%s", msg);
+    size_t ml = strlen(w->msg);
+    if (ml >= 3 && strcmp(w->msg + ml - 3, "...") == 0) {
+        w->msg[ml - 3] = 0;
+        w->prefix = 1;
+    }
+    if (w->where == AT_HERE) {
+        snprintf(w->file, sizeof w->file, "%s", path);
+        w->line = line;
+    }
+    return 1;
+}
+
+static void want_text(buf *b, const want_diag *w)
+{
+    if (w->where == AT_NOPOS)
+        buf_fmt(b, "frac: error: ");
+    else if (w->col)
+        buf_fmt(b, "%s:%d:%d: error: ", w->file, w->line, w->col);
+    else
+        buf_fmt(b, "%s:%d:(any column): error: ", w->file, w->line);
+    buf_fmt(b, "%s%s", w->msg, w->prefix ? "..." : "");
+}
+
+/* Does the first diagnostic g satisfy w? */
+static int diag_matches(const want_diag *w, const got_diag *g)
+{
+    if (!g->found || !g->is_error)
+        return 0;
+    if (w->where == AT_NOPOS) {
+        if (g->has_pos)
+            return 0;
+    } else {
+        if (!g->has_pos || g->line != w->line || (w->col && g->col != w->col))
+            return 0;
+        char f[4200];
+        snprintf(f, sizeof f, "%s", g->file);
+        if (w->where == AT_FILE)
+            norm_path(f);
+        if (strcmp(f, w->file) != 0)
+            return 0;
+    }
+    return w->prefix ? strncmp(g->msg, w->msg, strlen(w->msg)) == 0 : strcmp(g->msg, w->msg) == 0;
+}
+
 static void run_lang_file(const char *frac, const char *path)
 {
     size_t len;
@@ -278,8 +499,10 @@ static void run_lang_file(const char *frac, const char *path)
     if (!text)
         return;
     buf expect_out = {0}, in = {0}, why = {0};
-    char *errs[64], *rterrs[64], *stderrs[64];
-    int nerr = 0, nrt = 0, nst = 0, exit_code = -1;
+    char *stderrs[64];
+    int st_contains[64];
+    int nst = 0, exit_code = -1, nwant = 0, ok = 1;
+    want_diag want;
     char *args[64];
     int nargs = 0;
     int line = 1;
@@ -289,18 +512,26 @@ static void run_lang_file(const char *frac, const char *path)
         char ln[4096];
         snprintf(ln, sizeof ln, "%.*s", (int)(l < sizeof ln - 1 ? l : sizeof ln - 1), p);
         char *c = strstr(ln, "# expect: ");
+        char *ce = strstr(ln, "# expect error"), *cr = strstr(ln, "# expect runtime error");
         if (c) {
             buf_add(&expect_out, c + 10, strlen(c + 10));
             buf_add(&expect_out, "\n", 1);
-        } else if ((c = strstr(ln, "# expect error: ")) && nerr < 64) {
-            char m[4200];
-            snprintf(m, sizeof m, "%s:%d:", path, line);
-            errs[nerr] = malloc(strlen(m) + strlen(c + 16) + 16);
-            sprintf(errs[nerr++], "%s\x01%s", m, c + 16);
-        } else if ((c = strstr(ln, "# expect runtime error: ")) && nrt < 64) {
-            rterrs[nrt++] = strdup(c + 24);
+        } else if (ce || cr) {
+            if (nwant++) {
+                ok = 0;
+                buf_fmt(&why, "  line %d: a second error expectation (a script stops at its first error)\n", line);
+            } else if (!parse_want(ce ? ce + 14 : cr + 22, path, line, cr != NULL, &want)) {
+                ok = 0;
+                buf_fmt(&why, "  line %d: malformed expectation (forms: `# expect [runtime] error: MSG`, "
+                              "`…error@COL: MSG`, `…error (no position): MSG`, `…error at FILE:LINE[:COL]: MSG`):\n  %s\n",
+                        line, ce ? ce : cr);
+            }
         } else if ((c = strstr(ln, "# stderr: ")) && nst < 64) {
+            st_contains[nst] = 0;
             stderrs[nst++] = strdup(c + 10);
+        } else if ((c = strstr(ln, "# stderr contains: ")) && nst < 64) {
+            st_contains[nst] = 1;
+            stderrs[nst++] = strdup(c + 19);
         } else if ((c = strstr(ln, "# exit: "))) {
             exit_code = atoi(c + 8);
         } else if ((c = strstr(ln, "# stdin: "))) {
@@ -316,8 +547,9 @@ static void run_lang_file(const char *frac, const char *path)
         line++;
         p = e ? e + 1 : p + l;
     }
+    int have_want = nwant == 1 && ok;
     if (exit_code < 0)
-        exit_code = (nerr || nrt) ? 65 : 0;
+        exit_code = nwant ? 65 : 0;
     char *argv[72];
     int k = 0;
     argv[k++] = (char *)frac;
@@ -328,7 +560,6 @@ static void run_lang_file(const char *frac, const char *path)
     argv[k] = NULL;
     buf out = {0}, err = {0};
     int rc = run(argv, in.d, &out, &err, 60);
-    int ok = 1;
     if (rc != exit_code) {
         ok = 0;
         buf_fmt(&why, "  exit code %d, expected %d%s\n", rc, exit_code, rc < 0 ? " (timeout)" : "");
@@ -338,41 +569,48 @@ static void run_lang_file(const char *frac, const char *path)
         ok = 0;
         buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, eo);
     }
-    for (int i = 0; i < nerr; i++) {
-        char *sep = strchr(errs[i], '\x01');
-        *sep = 0;
-        const char *msg = sep + 1;
-        /* find a line starting with the position prefix and containing the message */
-        int found = 0;
-        for (char *q = strstr(err.d, errs[i]); q; q = strstr(q + 1, errs[i])) {
-            char *eol = strchr(q, '\n');
-            size_t l = eol ? (size_t)(eol - q) : strlen(q);
-            char tmp[4096];
-            snprintf(tmp, sizeof tmp, "%.*s", (int)(l < 4000 ? l : 4000), q);
-            char want[4200];
-            snprintf(want, sizeof want, "error: %s", msg);
-            if (strstr(tmp, want))
-                found = 1;
-        }
-        if (!found) {
+    if (have_want) {
+        got_diag g;
+        first_diag(err.d, &g);
+        if (!diag_matches(&want, &g)) {
             ok = 0;
-            buf_fmt(&why, "  missing error at %sCOL: error: %s\n", errs[i], msg);
+            buf_fmt(&why, "  first diagnostic: %s\n  expected:         ", g.found ? g.text : "(none: stderr is empty)");
+            want_text(&why, &want);
+            buf_fmt(&why, "\n");
         }
-        free(errs[i]);
-    }
-    for (int i = 0; i < nrt; i++) {
-        char want[4200];
-        snprintf(want, sizeof want, "error: %s", rterrs[i]);
-        if (!strstr(err.d, want)) {
+        /* The two kinds: an error found before the script runs is what
+         * `frac check` reports too; a runtime error passes `frac check`. */
+        char *cargv[72];
+        int ck = 0;
+        cargv[ck++] = (char *)frac;
+        cargv[ck++] = "check";
+        for (int i = 1; i < k; i++)
+            cargv[ck++] = argv[i];
+        cargv[ck] = NULL;
+        buf cout = {0}, cerr = {0};
+        int crc = run(cargv, NULL, &cout, &cerr, 60);
+        got_diag cg;
+        first_diag(cerr.d, &cg);
+        if (want.runtime && crc != 0) {
             ok = 0;
-            buf_fmt(&why, "  missing runtime error: %s\n", rterrs[i]);
+            buf_fmt(&why, "  `frac check` fails (exit %d), so this is not a runtime error: write `# expect error…`\n"
+                          "  frac check said: %s\n", crc, cg.found ? cg.text : "(nothing)");
+        } else if (!want.runtime && (crc == 0 || !diag_matches(&want, &cg))) {
+            ok = 0;
+            if (crc == 0)
+                buf_fmt(&why, "  `frac check` passes, so this error is raised at run time: write `# expect runtime error…`\n");
+            else
+                buf_fmt(&why, "  `frac check` (exit %d) reports another first diagnostic: %s\n", crc,
+                        cg.found ? cg.text : "(none)");
         }
-        free(rterrs[i]);
+        free(cout.d);
+        free(cerr.d);
     }
     for (int i = 0; i < nst; i++) {
-        if (!strstr(err.d, stderrs[i])) {
+        if (!(st_contains[i] ? line_contains(err.d, stderrs[i]) : has_line(err.d, stderrs[i]))) {
             ok = 0;
-            buf_fmt(&why, "  stderr lacks: %s\n", stderrs[i]);
+            buf_fmt(&why, st_contains[i] ? "  no stderr line (outside source echoes) contains: %s\n"
+                                         : "  no whole stderr line equals: %s\n", stderrs[i]);
         }
         free(stderrs[i]);
     }
