@@ -703,7 +703,8 @@ static void run_cli_dir(const char *frac)
         if (!matches_filter(path))
             continue;
         char *text = read_file(path, NULL);
-        buf in = {0}, why = {0}, argb = {0};
+        buf in = {0}, why = {0}, argb = {0}, want_out = {0};
+        int err_contains[32];
         char *outs[32], *errs[32], *files[32], stdout_to[4096] = "", exec_path[4096] = "";
         int nout = 0, nerr = 0, nfile = 0, exit_code = 0;
         char tmpl[] = "/tmp/frac-cli-XXXXXX";
@@ -723,13 +724,28 @@ static void run_cli_dir(const char *frac)
                 buf_add(&in, "\n", 1);
             } else if (strncmp(p, "# exit: ", 8) == 0)
                 exit_code = atoi(p + 8);
-            else if ((strncmp(p, "# stdout: ", 10) == 0 && nout < 32) || (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)) {
+            else if ((strncmp(p, "# stdout:", 9) == 0 && (l == 9 || p[9] == ' ')) || strncmp(p, "# stdout contains: ", 19) == 0) {
+                int contains = strncmp(p, "# stdout contains: ", 19) == 0;
+                size_t skip = contains ? 19 : l == 9 ? 9 : 10;
                 buf b = {0};
-                add_subst(&b, p + 10, l - 10, tmp);
-                if (strncmp(p, "# stdout: ", 10) == 0)
-                    outs[nout++] = b.d;
-                else
-                    errs[nerr++] = b.d;
+                add_subst(&b, p + skip, l - skip, tmp);
+                if (contains) {
+                    if (nout < 32)
+                        outs[nout++] = b.d;
+                    else
+                        free(b.d);
+                } else {
+                    buf_add(&want_out, b.d, b.n);
+                    buf_add(&want_out, "\n", 1);
+                    free(b.d);
+                }
+            } else if ((strncmp(p, "# stderr: ", 10) == 0 || strncmp(p, "# stderr contains: ", 19) == 0) && nerr < 32) {
+                int contains = strncmp(p, "# stderr contains: ", 19) == 0;
+                size_t skip = contains ? 19 : 10;
+                buf b = {0};
+                add_subst(&b, p + skip, l - skip, tmp);
+                err_contains[nerr] = contains;
+                errs[nerr++] = b.d;
             } else if (strncmp(p, "# file: ", 8) == 0 && nfile < 32)
                 files[nfile++] = strndup(p + 8, l - 8);
             p = e ? e + 1 : p + l;
@@ -751,17 +767,26 @@ static void run_cli_dir(const char *frac)
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
+        if (!nout && strcmp(out.d, want_out.d ? want_out.d : "") != 0) {
+            ok = 0;
+            buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, want_out.d ? want_out.d : "");
+        }
+        if (nout && want_out.d) {
+            ok = 0;
+            buf_fmt(&why, "  `# stdout:` and `# stdout contains:` in one test: use one form\n");
+        }
         for (int j = 0; j < nout; j++) {
             if (!strstr(out.d, outs[j])) {
                 ok = 0;
-                buf_fmt(&why, "  stdout lacks: %s\n", outs[j]);
+                buf_fmt(&why, "  stdout does not contain: %s\n", outs[j]);
             }
             free(outs[j]);
         }
         for (int j = 0; j < nerr; j++) {
-            if (!strstr(err.d, errs[j])) {
+            if (!(err_contains[j] ? line_contains(err.d, errs[j]) : has_line(err.d, errs[j]))) {
                 ok = 0;
-                buf_fmt(&why, "  stderr lacks: %s\n", errs[j]);
+                buf_fmt(&why, err_contains[j] ? "  no stderr line (outside source echoes) contains: %s\n"
+                                              : "  no whole stderr line equals: %s\n", errs[j]);
             }
             free(errs[j]);
         }
@@ -784,7 +809,7 @@ static void run_cli_dir(const char *frac)
         result(path, ok, &why);
         if (tmp)
             rm_tree(tmp);
-        free(text); free(in.d); free(out.d); free(err.d); free(why.d); free(argb.d);
+        free(text); free(in.d); free(out.d); free(err.d); free(why.d); free(argb.d); free(want_out.d);
     }
     free(names);
 }
