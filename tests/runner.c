@@ -5,12 +5,26 @@
  *   runner --frac build/frac [--unit build/tests] [--ptyrun build/ptyrun] [--update-golden] [FILTER]
  *
  * Language tests (.frac files under tests/lang/ and tests/regression/) carry their
- * expectations as comments:
+ * expectations as comments (tests/README.md has the full guide):
  *   # expect: TEXT                 next line of stdout, exactly
- *   # expect error: MESSAGE        a compile-time error at THIS line:
- *                                  stderr has "FILE:LINE:COL: error: MESSAGE"
- *   # expect runtime error: MESSAGE  stderr has "error: MESSAGE" (any line)
- *   # stderr: TEXT                 stderr contains TEXT
+ *   # expect error: MESSAGE        stderr's first diagnostic (its first line that is
+ *                                  neither indented nor a warning) is exactly
+ *                                  "FILE:LINE:COL: error: MESSAGE", FILE this script,
+ *                                  LINE this comment's line, any COL; the error is
+ *                                  found before the script runs: `frac check` reports
+ *                                  the same first diagnostic
+ *   # expect runtime error: MESSAGE  the same, for an error raised while running:
+ *                                  `frac check` passes
+ *   …error@COL: MESSAGE            also pins the column (the caret), e.g.
+ *                                  `# expect runtime error@9: MESSAGE`
+ *   …error (no position): MESSAGE  the first diagnostic is "frac: error: MESSAGE"
+ *                                  (command-line errors: nothing in a script to point at)
+ *   …error at NAME:LINE[:COL]: MESSAGE  raised in another file (an import), NAME
+ *                                  relative to this script's folder
+ *   A MESSAGE ending in "..." is a prefix (for a part that varies, e.g. a depth).
+ *   A script stops at its first error: one error expectation per file.
+ *   # stderr: TEXT                 a whole line of stderr equals TEXT
+ *   # stderr contains: TEXT        a line of stderr, not a source echo, contains TEXT
  *   # exit: N                      exit code (default 0; 65 with an error)
  *   # args: ARGS…                  extra command-line arguments before the script
  *   # stdin: TEXT                  a line of standard input
@@ -646,7 +660,11 @@ static void run_lang_dir(const char *frac, const char *dir)
 /* ---- command-line tests --------------------------------------------------------------
  * tests/cli/NAME.cli: "# args: A B C" (the whole command line after frac;
  * quoted 'single words' keep their spaces), "# stdin: TEXT" lines,
- * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings),
+ * "# exit: N", "# stdout: TEXT" lines (the whole stdout, in order, exactly;
+ * "# stdout:" alone is an empty line; none: stdout is empty), or instead
+ * "# stdout contains: TEXT" (substrings, e.g. of the help text),
+ * "# stderr: TEXT" (a whole line of stderr), "# stderr contains: TEXT" (a
+ * substring of a line that is not a source echo),
  * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
  * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
  * folder first on PATH; the args follow it), "# file: NAME: TEXT" (the file
