@@ -244,7 +244,7 @@ static int b_ist(interp *I, value *a, int n, value *out)
             est = (double)IST_MAX_ENTRIES;
         int closed = uniform && equal && s.method != IST_LISTS && pow(2.0 * mmax + 1, (double)s.k) <= 4503599627370496.0;
         if (!closed) {
-            if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST lists")) {
+            if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST list evaluator")) {
                 mem_free(I, o);
                 goto done;
             }
@@ -309,7 +309,7 @@ static int b_ist_lists(interp *I, value *a, int n, value *out)
                       t->k);
     if (t->closed && !t->x) {
         double est = ist_list_estimate(t);
-        if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST lists"))
+        if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST list evaluator"))
             return -1;
     }
     bytebuf b;

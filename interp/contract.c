@@ -623,7 +623,12 @@ static cpos key_pos(interp *I, cpos at, const char *key, int want_key)
                 return p;
             }
     cpos p = at;
-    p.n = NULL; /* not a literal: no finer position inside it */
+    if (p.src < 0 && p.n) { /* not a literal: the value's whole node */
+        p.src = p.n->src;
+        p.line = p.n->line;
+        p.col = p.n->col;
+    }
+    p.n = NULL; /* no finer position inside it */
     return p;
 }
 

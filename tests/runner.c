@@ -5,12 +5,26 @@
  *   runner --frac build/frac [--unit build/tests] [--ptyrun build/ptyrun] [--update-golden] [FILTER]
  *
  * Language tests (.frac files under tests/lang/ and tests/regression/) carry their
- * expectations as comments:
+ * expectations as comments (tests/README.md has the full guide):
  *   # expect: TEXT                 next line of stdout, exactly
- *   # expect error: MESSAGE        a compile-time error at THIS line:
- *                                  stderr has "FILE:LINE:COL: error: MESSAGE"
- *   # expect runtime error: MESSAGE  stderr has "error: MESSAGE" (any line)
- *   # stderr: TEXT                 stderr contains TEXT
+ *   # expect error: MESSAGE        stderr's first diagnostic (its first line that is
+ *                                  neither indented nor a warning) is exactly
+ *                                  "FILE:LINE:COL: error: MESSAGE", FILE this script,
+ *                                  LINE this comment's line, any COL; the error is
+ *                                  found before the script runs: `frac check` reports
+ *                                  the same first diagnostic
+ *   # expect runtime error: MESSAGE  the same, for an error raised while running:
+ *                                  `frac check` passes
+ *   …error@COL: MESSAGE            also pins the column (the caret), e.g.
+ *                                  `# expect runtime error@9: MESSAGE`
+ *   …error (no position): MESSAGE  the first diagnostic is "frac: error: MESSAGE"
+ *                                  (command-line errors: nothing in a script to point at)
+ *   …error at NAME:LINE[:COL]: MESSAGE  raised in another file (an import), NAME
+ *                                  relative to this script's folder
+ *   A MESSAGE ending in "..." is a prefix (for a part that varies, e.g. a depth).
+ *   A script stops at its first error: one error expectation per file.
+ *   # stderr: TEXT                 a whole line of stderr equals TEXT
+ *   # stderr contains: TEXT        a line of stderr, not a source echo, contains TEXT
  *   # exit: N                      exit code (default 0; 65 with an error)
  *   # args: ARGS…                  extra command-line arguments before the script
  *   # stdin: TEXT                  a line of standard input
@@ -271,6 +285,227 @@ static void run_unit(const char *dir)
 
 /* ---- language tests ---------------------------------------------------------------- */
 
+/* A line of stderr that echoes source: "%5d | TEXT" or the caret line "      | ^". */
+static int is_echo_line(const char *s, size_t l)
+{
+    size_t i = 0, sp, dg;
+    while (i < l && s[i] == ' ')
+        i++;
+    sp = i;
+    while (i < l && s[i] >= '0' && s[i] <= '9')
+        i++;
+    dg = i - sp;
+    if (dg)
+        return i + 1 < l && s[i] == ' ' && s[i + 1] == '|';
+    return sp > 0 && i < l && s[i] == '|';
+}
+
+/* `# stderr: TEXT`: some whole line of err equals want. */
+static int has_line(const char *err, const char *want)
+{
+    size_t wl = strlen(want);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (l == wl && memcmp(p, want, l) == 0)
+            return 1;
+        p = e ? e + 1 : p + l;
+    }
+    return 0;
+}
+
+/* `# stderr contains: TEXT`: some line of err that is not a source echo
+ * contains want. */
+static int line_contains(const char *err, const char *want)
+{
+    size_t wl = strlen(want);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (!is_echo_line(p, l))
+            for (size_t i = 0; i + wl <= l; i++)
+                if (memcmp(p + i, want, wl) == 0)
+                    return 1;
+        p = e ? e + 1 : p + l;
+    }
+    return 0;
+}
+
+/* What a `# expect [runtime] error…` comment asks for. */
+enum { AT_HERE, AT_NOPOS, AT_FILE };
+typedef struct want_diag {
+    int runtime;        /* 1: raised while running; 0: found before (so `frac check` finds it) */
+    int where;          /* AT_HERE: this file, the comment's line; AT_NOPOS; AT_FILE: file:line */
+    char file[4200];    /* AT_HERE / AT_FILE: the path frac must print (AT_FILE: normalised) */
+    int line, col;      /* col 0: any column */
+    char msg[4096];
+    int prefix;         /* the message ended in "...": it is a prefix */
+} want_diag;
+
+/* The first diagnostic of a run: the first line of stderr that is neither
+ * indented (source echo, caret, call trace) nor a warning. */
+typedef struct got_diag {
+    int found, is_error, has_pos;
+    char file[4200];
+    int line, col;
+    char msg[4096];
+    char text[4200];    /* the whole line, for messages */
+} got_diag;
+
+/* "a/./b/./c" -> "a/b/c", "./a" -> "a" */
+static void norm_path(char *s)
+{
+    char *p;
+    while ((p = strstr(s, "/./")))
+        memmove(p, p + 2, strlen(p + 2) + 1);
+    while (s[0] == '.' && s[1] == '/')
+        memmove(s, s + 2, strlen(s + 2) + 1);
+}
+
+static void first_diag(const char *err, got_diag *g)
+{
+    memset(g, 0, sizeof *g);
+    for (const char *p = err; *p;) {
+        const char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (l && p[0] != ' ' && p[0] != '\t' && strncmp(p, "warning: ", 9) != 0) {
+            g->found = 1;
+            snprintf(g->text, sizeof g->text, "%.*s", (int)(l < 4100 ? l : 4100), p);
+            break;
+        }
+        p = e ? e + 1 : p + l;
+    }
+    if (!g->found)
+        return;
+    if (strncmp(g->text, "frac: error: ", 13) == 0) {
+        g->is_error = 1;
+        snprintf(g->msg, sizeof g->msg, "%s", g->text + 13);
+        return;
+    }
+    char *m = strstr(g->text, ": error: ");
+    if (!m)
+        return;
+    /* FILE:LINE:COL before ": error: " (FILE may itself hold ':') */
+    char head[4200];
+    snprintf(head, sizeof head, "%.*s", (int)(m - g->text), g->text);
+    char *c2 = strrchr(head, ':');
+    if (!c2)
+        return;
+    *c2 = 0;
+    char *c1 = strrchr(head, ':');
+    if (!c1)
+        return;
+    *c1 = 0;
+    char *end1, *end2;
+    long ln = strtol(c1 + 1, &end1, 10), cl = strtol(c2 + 1, &end2, 10);
+    if (*end1 || *end2 || end1 == c1 + 1 || end2 == c2 + 1)
+        return;
+    g->is_error = g->has_pos = 1;
+    snprintf(g->file, sizeof g->file, "%s", head);
+    g->line = (int)ln;
+    g->col = (int)cl;
+    snprintf(g->msg, sizeof g->msg, "%s", m + 9);
+}
+
+/* Parse the part after "error" of a `# expect [runtime] error…` comment on
+ * line `line` of test `path`. Returns 0 if malformed. */
+static int parse_want(const char *s, const char *path, int line, int runtime, want_diag *w)
+{
+    memset(w, 0, sizeof *w);
+    w->runtime = runtime;
+    const char *msg;
+    if (strncmp(s, ": ", 2) == 0) {
+        w->where = AT_HERE;
+        msg = s + 2;
+    } else if (s[0] == '@') {
+        char *end;
+        long c = strtol(s + 1, &end, 10);
+        if (end == s + 1 || c < 1 || strncmp(end, ": ", 2) != 0)
+            return 0;
+        w->where = AT_HERE;
+        w->col = (int)c;
+        msg = end + 2;
+    } else if (strncmp(s, " (no position): ", 16) == 0) {
+        w->where = AT_NOPOS;
+        msg = s + 16;
+    } else if (strncmp(s, " at ", 4) == 0) {
+        /* " at NAME:LINE[:COL]: MSG", NAME relative to the test's folder */
+        const char *sep = strstr(s + 4, ": ");
+        if (!sep)
+            return 0;
+        char spec[4096];
+        snprintf(spec, sizeof spec, "%.*s", (int)(sep - s - 4), s + 4);
+        char *c1 = strchr(spec, ':');
+        if (!c1 || c1 == spec)
+            return 0;
+        *c1 = 0;
+        char *end;
+        long ln = strtol(c1 + 1, &end, 10), cl = 0;
+        if (end == c1 + 1 || ln < 1)
+            return 0;
+        if (*end == ':') {
+            char *e2;
+            cl = strtol(end + 1, &e2, 10);
+            if (e2 == end + 1 || cl < 1 || *e2)
+                return 0;
+        } else if (*end) {
+            return 0;
+        }
+        const char *slash = strrchr(path, '/');
+        snprintf(w->file, sizeof w->file, "%.*s%s", slash ? (int)(slash - path + 1) : 0, path, spec);
+        norm_path(w->file);
+        w->where = AT_FILE;
+        w->line = (int)ln;
+        w->col = (int)cl;
+        msg = sep + 2;
+    } else {
+        return 0;
+    }
+    snprintf(w->msg, sizeof w->msg, "%s", msg);
+    size_t ml = strlen(w->msg);
+    if (ml >= 3 && strcmp(w->msg + ml - 3, "...") == 0) {
+        w->msg[ml - 3] = 0;
+        w->prefix = 1;
+    }
+    if (w->where == AT_HERE) {
+        snprintf(w->file, sizeof w->file, "%s", path);
+        w->line = line;
+    }
+    return 1;
+}
+
+static void want_text(buf *b, const want_diag *w)
+{
+    if (w->where == AT_NOPOS)
+        buf_fmt(b, "frac: error: ");
+    else if (w->col)
+        buf_fmt(b, "%s:%d:%d: error: ", w->file, w->line, w->col);
+    else
+        buf_fmt(b, "%s:%d:(any column): error: ", w->file, w->line);
+    buf_fmt(b, "%s%s", w->msg, w->prefix ? "..." : "");
+}
+
+/* Does the first diagnostic g satisfy w? */
+static int diag_matches(const want_diag *w, const got_diag *g)
+{
+    if (!g->found || !g->is_error)
+        return 0;
+    if (w->where == AT_NOPOS) {
+        if (g->has_pos)
+            return 0;
+    } else {
+        if (!g->has_pos || g->line != w->line || (w->col && g->col != w->col))
+            return 0;
+        char f[4200];
+        snprintf(f, sizeof f, "%s", g->file);
+        if (w->where == AT_FILE)
+            norm_path(f);
+        if (strcmp(f, w->file) != 0)
+            return 0;
+    }
+    return w->prefix ? strncmp(g->msg, w->msg, strlen(w->msg)) == 0 : strcmp(g->msg, w->msg) == 0;
+}
+
 static void run_lang_file(const char *frac, const char *path)
 {
     size_t len;
@@ -278,8 +513,10 @@ static void run_lang_file(const char *frac, const char *path)
     if (!text)
         return;
     buf expect_out = {0}, in = {0}, why = {0};
-    char *errs[64], *rterrs[64], *stderrs[64];
-    int nerr = 0, nrt = 0, nst = 0, exit_code = -1;
+    char *stderrs[64];
+    int st_contains[64];
+    int nst = 0, exit_code = -1, nwant = 0, ok = 1;
+    want_diag want;
     char *args[64];
     int nargs = 0;
     int line = 1;
@@ -289,18 +526,26 @@ static void run_lang_file(const char *frac, const char *path)
         char ln[4096];
         snprintf(ln, sizeof ln, "%.*s", (int)(l < sizeof ln - 1 ? l : sizeof ln - 1), p);
         char *c = strstr(ln, "# expect: ");
+        char *ce = strstr(ln, "# expect error"), *cr = strstr(ln, "# expect runtime error");
         if (c) {
             buf_add(&expect_out, c + 10, strlen(c + 10));
             buf_add(&expect_out, "\n", 1);
-        } else if ((c = strstr(ln, "# expect error: ")) && nerr < 64) {
-            char m[4200];
-            snprintf(m, sizeof m, "%s:%d:", path, line);
-            errs[nerr] = malloc(strlen(m) + strlen(c + 16) + 16);
-            sprintf(errs[nerr++], "%s\x01%s", m, c + 16);
-        } else if ((c = strstr(ln, "# expect runtime error: ")) && nrt < 64) {
-            rterrs[nrt++] = strdup(c + 24);
+        } else if (ce || cr) {
+            if (nwant++) {
+                ok = 0;
+                buf_fmt(&why, "  line %d: a second error expectation (a script stops at its first error)\n", line);
+            } else if (!parse_want(ce ? ce + 14 : cr + 22, path, line, cr != NULL, &want)) {
+                ok = 0;
+                buf_fmt(&why, "  line %d: malformed expectation (forms: `# expect [runtime] error: MSG`, "
+                              "`…error@COL: MSG`, `…error (no position): MSG`, `…error at FILE:LINE[:COL]: MSG`):\n  %s\n",
+                        line, ce ? ce : cr);
+            }
         } else if ((c = strstr(ln, "# stderr: ")) && nst < 64) {
+            st_contains[nst] = 0;
             stderrs[nst++] = strdup(c + 10);
+        } else if ((c = strstr(ln, "# stderr contains: ")) && nst < 64) {
+            st_contains[nst] = 1;
+            stderrs[nst++] = strdup(c + 19);
         } else if ((c = strstr(ln, "# exit: "))) {
             exit_code = atoi(c + 8);
         } else if ((c = strstr(ln, "# stdin: "))) {
@@ -316,8 +561,9 @@ static void run_lang_file(const char *frac, const char *path)
         line++;
         p = e ? e + 1 : p + l;
     }
+    int have_want = nwant == 1 && ok;
     if (exit_code < 0)
-        exit_code = (nerr || nrt) ? 65 : 0;
+        exit_code = nwant ? 65 : 0;
     char *argv[72];
     int k = 0;
     argv[k++] = (char *)frac;
@@ -328,7 +574,6 @@ static void run_lang_file(const char *frac, const char *path)
     argv[k] = NULL;
     buf out = {0}, err = {0};
     int rc = run(argv, in.d, &out, &err, 60);
-    int ok = 1;
     if (rc != exit_code) {
         ok = 0;
         buf_fmt(&why, "  exit code %d, expected %d%s\n", rc, exit_code, rc < 0 ? " (timeout)" : "");
@@ -338,57 +583,48 @@ static void run_lang_file(const char *frac, const char *path)
         ok = 0;
         buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, eo);
     }
-    for (int i = 0; i < nerr; i++) {
-        char *sep = strchr(errs[i], '\x01');
-        *sep = 0;
-        const char *msg = sep + 1;
-        /* find a line starting with the position prefix and containing the message */
-        int found = 0;
-        for (char *q = strstr(err.d, errs[i]); q; q = strstr(q + 1, errs[i])) {
-            char *eol = strchr(q, '\n');
-            size_t l = eol ? (size_t)(eol - q) : strlen(q);
-            char tmp[4096];
-            snprintf(tmp, sizeof tmp, "%.*s", (int)(l < 4000 ? l : 4000), q);
-            char want[4200];
-            snprintf(want, sizeof want, "error: %s", msg);
-            if (strstr(tmp, want))
-                found = 1;
-        }
-        if (!found) {
+    if (have_want) {
+        got_diag g;
+        first_diag(err.d, &g);
+        if (!diag_matches(&want, &g)) {
             ok = 0;
-            buf_fmt(&why, "  missing error at %sCOL: error: %s\n", errs[i], msg);
+            buf_fmt(&why, "  first diagnostic: %s\n  expected:         ", g.found ? g.text : "(none: stderr is empty)");
+            want_text(&why, &want);
+            buf_fmt(&why, "\n");
         }
-        free(errs[i]);
-    }
-    for (int i = 0; i < nrt; i++) {
-        char want[4200];
-        snprintf(want, sizeof want, "error: %s", rterrs[i]);
-        /* only in a message line: the echoed source line ("  12 | …") holds
-         * the expectation comment itself and must not satisfy it */
-        int found = 0;
-        for (const char *q = err.d; q && *q && !found;) {
-            const char *eol = strchr(q, '\n');
-            size_t l = eol ? (size_t)(eol - q) : strlen(q);
-            const char *t = q;
-            while (t < q + l && (*t == ' ' || (*t >= '0' && *t <= '9')))
-                t++;
-            if (!(t < q + l && *t == '|')) {
-                char tmp[4096];
-                snprintf(tmp, sizeof tmp, "%.*s", (int)(l < 4000 ? l : 4000), q);
-                found = strstr(tmp, want) != NULL;
-            }
-            q = eol ? eol + 1 : NULL;
-        }
-        if (!found) {
+        /* The two kinds: an error found before the script runs is what
+         * `frac check` reports too; a runtime error passes `frac check`. */
+        char *cargv[72];
+        int ck = 0;
+        cargv[ck++] = (char *)frac;
+        cargv[ck++] = "check";
+        for (int i = 1; i < k; i++)
+            cargv[ck++] = argv[i];
+        cargv[ck] = NULL;
+        buf cout = {0}, cerr = {0};
+        int crc = run(cargv, NULL, &cout, &cerr, 60);
+        got_diag cg;
+        first_diag(cerr.d, &cg);
+        if (want.runtime && crc != 0) {
             ok = 0;
-            buf_fmt(&why, "  missing runtime error: %s\n", rterrs[i]);
+            buf_fmt(&why, "  `frac check` fails (exit %d), so this is not a runtime error: write `# expect error…`\n"
+                          "  frac check said: %s\n", crc, cg.found ? cg.text : "(nothing)");
+        } else if (!want.runtime && (crc == 0 || !diag_matches(&want, &cg))) {
+            ok = 0;
+            if (crc == 0)
+                buf_fmt(&why, "  `frac check` passes, so this error is raised at run time: write `# expect runtime error…`\n");
+            else
+                buf_fmt(&why, "  `frac check` (exit %d) reports another first diagnostic: %s\n", crc,
+                        cg.found ? cg.text : "(none)");
         }
-        free(rterrs[i]);
+        free(cout.d);
+        free(cerr.d);
     }
     for (int i = 0; i < nst; i++) {
-        if (!strstr(err.d, stderrs[i])) {
+        if (!(st_contains[i] ? line_contains(err.d, stderrs[i]) : has_line(err.d, stderrs[i]))) {
             ok = 0;
-            buf_fmt(&why, "  stderr lacks: %s\n", stderrs[i]);
+            buf_fmt(&why, st_contains[i] ? "  no stderr line (outside source echoes) contains: %s\n"
+                                         : "  no whole stderr line equals: %s\n", stderrs[i]);
         }
         free(stderrs[i]);
     }
@@ -424,7 +660,11 @@ static void run_lang_dir(const char *frac, const char *dir)
 /* ---- command-line tests --------------------------------------------------------------
  * tests/cli/NAME.cli: "# args: A B C" (the whole command line after frac;
  * quoted 'single words' keep their spaces), "# stdin: TEXT" lines,
- * "# exit: N", "# stdout: TEXT" / "# stderr: TEXT" (substrings),
+ * "# exit: N", "# stdout: TEXT" lines (the whole stdout, in order, exactly;
+ * "# stdout:" alone is an empty line; none: stdout is empty), or instead
+ * "# stdout contains: TEXT" (substrings, e.g. of the help text),
+ * "# stderr: TEXT" (a whole line of stderr), "# stderr contains: TEXT" (a
+ * substring of a line that is not a source echo),
  * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
  * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
  * folder first on PATH; the args follow it), "# file: NAME: TEXT" (the file
@@ -481,7 +721,8 @@ static void run_cli_dir(const char *frac)
         if (!matches_filter(path))
             continue;
         char *text = read_file(path, NULL);
-        buf in = {0}, why = {0}, argb = {0};
+        buf in = {0}, why = {0}, argb = {0}, want_out = {0};
+        int err_contains[32];
         char *outs[32], *errs[32], *files[32], stdout_to[4096] = "", exec_path[4096] = "";
         int nout = 0, nerr = 0, nfile = 0, exit_code = 0;
         char tmpl[] = "/tmp/frac-cli-XXXXXX";
@@ -501,13 +742,28 @@ static void run_cli_dir(const char *frac)
                 buf_add(&in, "\n", 1);
             } else if (strncmp(p, "# exit: ", 8) == 0)
                 exit_code = atoi(p + 8);
-            else if ((strncmp(p, "# stdout: ", 10) == 0 && nout < 32) || (strncmp(p, "# stderr: ", 10) == 0 && nerr < 32)) {
+            else if ((strncmp(p, "# stdout:", 9) == 0 && (l == 9 || p[9] == ' ')) || strncmp(p, "# stdout contains: ", 19) == 0) {
+                int contains = strncmp(p, "# stdout contains: ", 19) == 0;
+                size_t skip = contains ? 19 : l == 9 ? 9 : 10;
                 buf b = {0};
-                add_subst(&b, p + 10, l - 10, tmp);
-                if (strncmp(p, "# stdout: ", 10) == 0)
-                    outs[nout++] = b.d;
-                else
-                    errs[nerr++] = b.d;
+                add_subst(&b, p + skip, l - skip, tmp);
+                if (contains) {
+                    if (nout < 32)
+                        outs[nout++] = b.d;
+                    else
+                        free(b.d);
+                } else {
+                    buf_add(&want_out, b.d, b.n);
+                    buf_add(&want_out, "\n", 1);
+                    free(b.d);
+                }
+            } else if ((strncmp(p, "# stderr: ", 10) == 0 || strncmp(p, "# stderr contains: ", 19) == 0) && nerr < 32) {
+                int contains = strncmp(p, "# stderr contains: ", 19) == 0;
+                size_t skip = contains ? 19 : 10;
+                buf b = {0};
+                add_subst(&b, p + skip, l - skip, tmp);
+                err_contains[nerr] = contains;
+                errs[nerr++] = b.d;
             } else if (strncmp(p, "# file: ", 8) == 0 && nfile < 32)
                 files[nfile++] = strndup(p + 8, l - 8);
             p = e ? e + 1 : p + l;
@@ -529,17 +785,26 @@ static void run_cli_dir(const char *frac)
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);
+        if (!nout && strcmp(out.d, want_out.d ? want_out.d : "") != 0) {
+            ok = 0;
+            buf_fmt(&why, "  stdout:\n%s  expected:\n%s", out.d, want_out.d ? want_out.d : "");
+        }
+        if (nout && want_out.d) {
+            ok = 0;
+            buf_fmt(&why, "  `# stdout:` and `# stdout contains:` in one test: use one form\n");
+        }
         for (int j = 0; j < nout; j++) {
             if (!strstr(out.d, outs[j])) {
                 ok = 0;
-                buf_fmt(&why, "  stdout lacks: %s\n", outs[j]);
+                buf_fmt(&why, "  stdout does not contain: %s\n", outs[j]);
             }
             free(outs[j]);
         }
         for (int j = 0; j < nerr; j++) {
-            if (!strstr(err.d, errs[j])) {
+            if (!(err_contains[j] ? line_contains(err.d, errs[j]) : has_line(err.d, errs[j]))) {
                 ok = 0;
-                buf_fmt(&why, "  stderr lacks: %s\n", errs[j]);
+                buf_fmt(&why, err_contains[j] ? "  no stderr line (outside source echoes) contains: %s\n"
+                                              : "  no whole stderr line equals: %s\n", errs[j]);
             }
             free(errs[j]);
         }
@@ -562,7 +827,7 @@ static void run_cli_dir(const char *frac)
         result(path, ok, &why);
         if (tmp)
             rm_tree(tmp);
-        free(text); free(in.d); free(out.d); free(err.d); free(why.d); free(argb.d);
+        free(text); free(in.d); free(out.d); free(err.d); free(why.d); free(argb.d); free(want_out.d);
     }
     free(names);
 }
