@@ -157,6 +157,10 @@ typedef struct wrinkly_surface {
 /* Base surface P(u, v) and its unit normal (zero if undefined). */
 void wrinkly_surface_base(const wrinkly_surface *s, double tension, double u, double v, double p[3],
                           double n[3]);
+/* Attribute function of a surface built like H (eq. 8), unshuffled, at
+ * (u, v): which = 0 height, 1..3 rgb, 4 opacity (R uses it at
+ * (F_u^{-1}(u), F_v^{-1}(v)) for the shuffled attributes). */
+double wrinkly_surface_attr(const wrinkly_surface *s, double tension, int which, double u, double v);
 
 /* Φ and ρ of the base surface (above), by the midpoint rule on 5×5 cells
  * per patch. */
