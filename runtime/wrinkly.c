@@ -163,6 +163,10 @@ static rt_code check_axis(const char *what, int n, const wrinkly_axis *ax, rt_er
         return rt_fail(e, RT_EINVAL, "wrinkly %s needs at least 1 control point, got %d", what, n);
     if (ax->m < 0 || ax->m > 50)
         return rt_fail(e, RT_EINVAL, "wrinkly %s crossing count M = %d; expected 0..50", what, ax->m);
+    if (ax->cyclic && ax->ist && 2 * ax->m + 1 > n)
+        return rt_fail(e, RT_EINVAL,
+                       "wrinkly %s is closed with M = %d, which needs at least 2M+1 = %d control points, got %d (lower crossings, or ist: false)",
+                       what, ax->m, 2 * ax->m + 1, n);
     return RT_OK;
 }
 
@@ -177,7 +181,9 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
         k = ki[i] > k ? ki[i] : k;
     *kout = k;
     ist samp;
-    ist_spec sp = {.n = n, .m = ax->m, .k = k, .axis = ax->cyclic ? IST_CYCLIC : IST_TRANSLATION};
+    /* without ist the map is never used: the sample positions are the same
+     * for both axis types, so a cyclic axis with 2M+1 > N is fine then */
+    ist_spec sp = {.n = n, .m = ax->m, .k = k, .axis = ax->cyclic && ax->ist ? IST_CYCLIC : IST_TRANSLATION};
     rt_code rc = ist_init(&samp, &sp, e);
     if (rc)
         return rc;
@@ -197,15 +203,9 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
     }
     ist_free(&samp);
     sp.k = k + (o->extra > 0 ? o->extra : 0);
-    int bb = 2 * ax->m + 1;
-    uint64_t s = 1; /* keep the closed form exact */
-    for (int q = 0; q < sp.k; q++) {
-        if (s > ((uint64_t)1 << 50) / (uint64_t)bb) {
-            sp.k = q;
-            break;
-        }
-        s *= (uint64_t)bb;
-    }
+    int klim = ist_k_limit(&sp); /* extra rounds stop where double precision does (wrinkly.h) */
+    if (sp.k > klim)
+        sp.k = klim > k ? klim : k;
     rc = ist_init(map, &sp, e);
     if (rc) {
         rt_free(pos);
