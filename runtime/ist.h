@@ -26,8 +26,13 @@
  *  - Linear correspondence. A_i is cut into consecutive destination slots of
  *    lengths proportional to the (source) lengths of the entries of L_i^K, so
  *    on A_i the map F^{-1} has slope (Σ entry lengths)/|A_i|. With equal base
- *    lengths and one M all slots are |A_i|/(2M+1)^K. With unequal lengths the
- *    centres are fixed only where the neighbourhood is symmetric.
+ *    lengths and one M all slots are |A_i|/(2M+1)^K and every base
+ *    interval's centre is fixed. With unequal lengths or several M the
+ *    centres are fixed only where the neighbourhood is symmetric (tests:
+ *    test_general).
+ *  - Cyclic axes need 2M_i+1 <= N for every interval: the 2M+1 pieces of an
+ *    interval go to 2M+1 different intervals. A larger M would deal several
+ *    pieces of one interval to the same list; ist_init refuses it.
  *  - Cyclic axes wrap with period b - a: F^{-1}(u + P) = F^{-1}(u) + P.
  *    Translation axes are the identity outside [a, b).
  *

@@ -242,6 +242,21 @@ static void test_general(void)
     rt_error e;
     CHECK(ist_init(&t, &s, &e) == RT_OK, "init: %s", e.msg);
     CHECK_NEAR(ist_inv(&t, 4.0), 4.0, 1e-12, "centre of a symmetric neighbourhood is fixed");
+    /* ...but unequal lengths move the others: the centre 1 of [0, 2), whose
+     * neighbours are 3 and 1 long, goes to 0.63 (the docs' condition for
+     * fixed centres: equal lengths and one M) */
+    CHECK_NEAR(ist_inv(&t, 1.0), 0.63, 1e-12, "unequal lengths: centre of [0, 2) moves");
+    CHECK_NEAR(ist_inv(&t, 2.5), 2.6415, 1e-12, "unequal lengths: centre of [2, 3) moves");
+    ist_free(&t);
+    /* equal lengths but several M: centres move too (interval 0 to 1.12) */
+    int ms2[5] = {1, 1, 2, 1, 1};
+    ist_spec s2 = {.n = 5, .m_each = ms2, .k = 2, .axis = IST_CYCLIC};
+    CHECK(ist_init(&t, &s2, &e) == RT_OK, "init: %s", e.msg);
+    int moved = 0;
+    for (int i = 0; i < 5; i++)
+        moved += fabs(ist_inv(&t, i + 0.5) - (i + 0.5)) > 1e-9;
+    CHECK(moved == 4, "several M: %d centres move", moved);
+    CHECK_NEAR(ist_inv(&t, 0.5), 1.12, 1e-12, "several M: centre of interval 0");
     ist_free(&t);
 }
 
