@@ -1300,12 +1300,15 @@ done:
 
 /* ---- registration -------------------------------------------------------------------- */
 
-/* MAX_CONTROL, MAX_M, IST_MAX_K and MAX_KMAX written out (type texts are literal). */
+/* MAX_CONTROL, MAX_M and MAX_KMAX written out (type texts are literal);
+ * IST_MAX_K is a plain number in ist.h, so its text comes from the macro. */
+#define TY_STR_(x) #x
+#define TY_STR(x) TY_STR_(x)
 #define TY_LOD_K "int[0,20]"
 #define TY_AXIS "rec{cyclic: bool, crossings: int[0,50], ist: bool}"
 #define TY_SHUFFLE "str{height,colour,color,opacity}|list"
 static const bparam p_ist[] = {{"intervals", "int[1,100000]", "nil"}, {"crossings", "int[0,1000]|vec[0,1000]", "1"},
-                               {"iterations", "int[0,60]", "2"},      {"cyclic", "bool", "false"},
+                               {"iterations", "int[0," TY_STR(IST_MAX_K) "]", "2"},      {"cyclic", "bool", "false"},
                                {"bounds", "vec", "nil"},              {"method", "str{auto,lists,closed}", "\"auto\""}};
 static const bparam p_ist_map[] = {{"ist", "ist", NULL}, {"u", "num|vec", NULL}};
 static const bparam p_ist_one[] = {{"ist", "ist", NULL}};

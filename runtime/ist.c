@@ -44,7 +44,64 @@ static rt_code validate(const ist_spec *s, rt_error *e)
             return rt_fail(e, RT_EINVAL, "IST crossing count M of interval %d is %d; expected 0..1000",
                            i, m);
     }
+    /* on a cyclic axis the 2M+1 pieces of an interval must go to 2M+1
+     * different intervals (ist.h) */
+    if (s->axis == IST_CYCLIC)
+        for (int i = 0; i < s->n; i++) {
+            int m = s->m_each ? s->m_each[i] : s->m;
+            if (2 * m + 1 > s->n) {
+                if (s->m_each)
+                    return rt_fail(e, RT_EINVAL,
+                                   "IST on a cyclic axis needs 2M+1 <= N, but interval %d has M = %d with N = %d (its pieces would wrap onto one interval twice)",
+                                   i, m, s->n);
+                return rt_fail(e, RT_EINVAL,
+                               "IST on a cyclic axis needs 2M+1 <= N, got M = %d with N = %d (the pieces would wrap onto one interval twice)",
+                               m, s->n);
+            }
+        }
     return RT_OK;
+}
+
+/* Largest |coordinate| of the axis and one ulp there. */
+static double axis_ulp(const ist_spec *s, double *big)
+{
+    double a = s->bounds ? s->bounds[0] : 0, b = s->bounds ? s->bounds[s->n] : (double)s->n;
+    double x = fmax(fabs(a), fabs(b));
+    *big = x;
+    return nextafter(x, INFINITY) - x;
+}
+
+int ist_k_limit(const ist_spec *s)
+{
+    int mmax = 0;
+    double hmin = INFINITY, big;
+    for (int i = 0; i < s->n; i++) {
+        int m = s->m_each ? s->m_each[i] : s->m;
+        mmax = m > mmax ? m : mmax;
+        double h = s->bounds ? s->bounds[i + 1] - s->bounds[i] : 1.0;
+        hmin = h < hmin ? h : hmin;
+    }
+    if (mmax == 0 || s->n < 1)
+        return IST_MAX_K;
+    double floor_w = IST_MIN_ULPS * axis_ulp(s, &big), w = hmin;
+    int k = 0;
+    while (k < IST_MAX_K && w / (2 * mmax + 1) >= floor_w) {
+        w /= 2 * mmax + 1;
+        k++;
+    }
+    return k;
+}
+
+/* Sub-intervals narrower than IST_MIN_ULPS ulps cannot be told apart in
+ * double precision, so F^{-1} would stop being one-to-one (ist.h). */
+static rt_code check_width(const ist_spec *s, double w, rt_error *e)
+{
+    double big, ulp = axis_ulp(s, &big);
+    if (w >= IST_MIN_ULPS * ulp)
+        return RT_OK;
+    return rt_fail(e, RT_EINVAL,
+                   "IST iterations K = %d make sub-intervals %.3g wide, under %d ulps (%.3g) of coordinates up to %g, so double precision cannot keep F one-to-one; at most K = %d for this axis",
+                   s->k, w, IST_MIN_ULPS, IST_MIN_ULPS * ulp, big, ist_k_limit(s));
 }
 
 /* B^K if it is at most 2^52 (so sub-interval indices are exact in a double),
@@ -111,6 +168,13 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
     for (int i = 0; i <= s->n; i++)
         if (t->bounds[i] != a0 + (double)i * h)
             equal = 0;
+    if (one_m && equal && t->ms[0] > 0) { /* every sub-interval is h/B^K wide */
+        rc = check_width(s, h / pow(2 * t->ms[0] + 1, s->k), e);
+        if (rc) {
+            ist_free(t);
+            return rc;
+        }
+    }
     uint64_t sk = pow_small(2 * t->ms[0] + 1, s->k);
     int can_close = one_m && equal && sk != 0;
     if ((s->method == IST_CLOSED || s->method == IST_CLOSED_DIGITS) && !can_close) {
@@ -130,6 +194,15 @@ rt_code ist_init(ist *t, const ist_spec *s, rt_error *e)
         return RT_OK;
     }
     rc = ist_build_lists(t, e);
+    if (!rc && !(one_m && equal)) { /* the narrowest source piece and destination slot */
+        double w = INFINITY;
+        for (int i = 0; i < t->n; i++)
+            for (size_t r = t->start[i]; r < t->start[i + 1]; r++) {
+                double d = t->len[r] * ((t->bounds[i + 1] - t->bounds[i]) / t->total[i]);
+                w = fmin(w, fmin(t->len[r], d));
+            }
+        rc = check_width(s, w, e);
+    }
     if (rc)
         ist_free(t);
     return rc;

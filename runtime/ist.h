@@ -26,8 +26,13 @@
  *  - Linear correspondence. A_i is cut into consecutive destination slots of
  *    lengths proportional to the (source) lengths of the entries of L_i^K, so
  *    on A_i the map F^{-1} has slope (Σ entry lengths)/|A_i|. With equal base
- *    lengths and one M all slots are |A_i|/(2M+1)^K. With unequal lengths the
- *    centres are fixed only where the neighbourhood is symmetric.
+ *    lengths and one M all slots are |A_i|/(2M+1)^K and every base
+ *    interval's centre is fixed. With unequal lengths or several M the
+ *    centres are fixed only where the neighbourhood is symmetric (tests:
+ *    test_general).
+ *  - Cyclic axes need 2M_i+1 <= N for every interval: the 2M+1 pieces of an
+ *    interval go to 2M+1 different intervals. A larger M would deal several
+ *    pieces of one interval to the same list; ist_init refuses it.
  *  - Cyclic axes wrap with period b - a: F^{-1}(u + P) = F^{-1}(u) + P.
  *    Translation axes are the identity outside [a, b).
  *
@@ -65,7 +70,15 @@
 #include "rt.h"
 
 #define IST_MAX_ENTRIES ((size_t)1 << 24) /* cap on Σ|L_i^K| for the list evaluator */
-#define IST_MAX_K 60
+/* K's range. Double precision bounds it: a sub-interval narrower than
+ * IST_MIN_ULPS ulps of the axis's largest |coordinate| X cannot be kept
+ * apart from its neighbours (with (2M+1)^K near 2^52 the sub-intervals near
+ * u = N are narrower than one ulp of u), so ist_init refuses such a K with
+ * a message naming the largest K that works (ist_k_limit). No axis with
+ * M >= 1 passes above K = 29: h/X <= 2 (up to rounding), so
+ * 3^K <= 2^53/64 = 2^47 and 3^29 < 2^47 < 3^30. */
+#define IST_MAX_K 29
+#define IST_MIN_ULPS 64
 
 typedef enum ist_axis_type { IST_TRANSLATION = 0, IST_CYCLIC = 1 } ist_axis_type;
 /* IST_CLOSED_DIGITS: the closed form evaluated one base-B digit at a time,
@@ -125,6 +138,11 @@ typedef struct ist {
  * Errors: RT_EINVAL with a message naming the offending value, RT_ENOMEM. */
 rt_code ist_init(ist *t, const ist_spec *spec, rt_error *e);
 void ist_free(ist *t);
+/* The largest K (<= IST_MAX_K) that keeps sub-intervals IST_MIN_ULPS ulps
+ * wide for spec's axis: exact for equal lengths and one M (the narrowest
+ * base interval and the largest M otherwise, where ist_init also checks the
+ * pieces the lists actually hold). IST_MAX_K when every M is 0. */
+int ist_k_limit(const ist_spec *spec);
 
 /* F^{-1}(u): the source coordinate whose attributes appear at u (eq. 9). */
 double ist_inv(const ist *t, double u);

@@ -157,23 +157,16 @@ void wrinkly_polyline_free(wrinkly_polyline *p)
     memset(p, 0, sizeof *p);
 }
 
-static int level_for(double len, double target, int b, int kmax)
-{
-    int k = 0;
-    double l = len;
-    while (l > target && k < kmax) {
-        l /= b;
-        k++;
-    }
-    return k;
-}
-
 static rt_code check_axis(const char *what, int n, const wrinkly_axis *ax, rt_error *e)
 {
     if (n < 1)
         return rt_fail(e, RT_EINVAL, "wrinkly %s needs at least 1 control point, got %d", what, n);
     if (ax->m < 0 || ax->m > 50)
         return rt_fail(e, RT_EINVAL, "wrinkly %s crossing count M = %d; expected 0..50", what, ax->m);
+    if (ax->cyclic && ax->ist && 2 * ax->m + 1 > n)
+        return rt_fail(e, RT_EINVAL,
+                       "wrinkly %s is closed with M = %d, which needs at least 2M+1 = %d control points, got %d (lower crossings, or ist: false)",
+                       what, ax->m, 2 * ax->m + 1, n);
     return RT_OK;
 }
 
@@ -188,7 +181,9 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
         k = ki[i] > k ? ki[i] : k;
     *kout = k;
     ist samp;
-    ist_spec sp = {.n = n, .m = ax->m, .k = k, .axis = ax->cyclic ? IST_CYCLIC : IST_TRANSLATION};
+    /* without ist the map is never used: the sample positions are the same
+     * for both axis types, so a cyclic axis with 2M+1 > N is fine then */
+    ist_spec sp = {.n = n, .m = ax->m, .k = k, .axis = ax->cyclic && ax->ist ? IST_CYCLIC : IST_TRANSLATION};
     rt_code rc = ist_init(&samp, &sp, e);
     if (rc)
         return rc;
@@ -208,15 +203,9 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
     }
     ist_free(&samp);
     sp.k = k + (o->extra > 0 ? o->extra : 0);
-    int bb = 2 * ax->m + 1;
-    uint64_t s = 1; /* keep the closed form exact */
-    for (int q = 0; q < sp.k; q++) {
-        if (s > ((uint64_t)1 << 50) / (uint64_t)bb) {
-            sp.k = q;
-            break;
-        }
-        s *= (uint64_t)bb;
-    }
+    int klim = ist_k_limit(&sp); /* extra rounds stop where double precision does (wrinkly.h) */
+    if (sp.k > klim)
+        sp.k = klim > k ? klim : k;
     rc = ist_init(map, &sp, e);
     if (rc) {
         rt_free(pos);
@@ -225,27 +214,6 @@ static rt_code axis_samples(int n, const wrinkly_axis *ax, const int *ki, const 
     *out = pos;
     *count = tot;
     return RT_OK;
-}
-
-void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki)
-{
-    double lam = lam_of(o->tension);
-    int b = 2 * c->ax.m + 1;
-    int kmax = o->kmax > 0 ? o->kmax : 8;
-    for (int i = 0; i < c->n; i++) {
-        if (o->tol > 0 && b > 1) {
-            double len = 0, p0[2], p1[2], d[2];
-            wrinkly_curve_base(c, lam, i, p0, d);
-            for (int q = 1; q <= 16; q++) {
-                wrinkly_curve_base(c, lam, i + q / 16.0, p1, d);
-                len += hypot(p1[0] - p0[0], p1[1] - p0[1]);
-                p0[0] = p1[0], p0[1] = p1[1];
-            }
-            ki[i] = level_for(len, o->tol, b, kmax);
-        } else {
-            ki[i] = o->k < 0 ? 0 : o->k > kmax ? kmax : o->k;
-        }
-    }
 }
 
 rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrinkly_polyline *out,
@@ -491,18 +459,269 @@ static void surf_normals(void *ctx, size_t j, int worker)
     }
 }
 
-static double proj_len(const wrinkly_opts *o, const double a[3], const double b[3], int *ok)
+/* ---- level of detail (§5.2, wrinkly.h "Adaptive sampling") ------------------ */
+
+/* |J(x)·v|: how fast the picture of x moves when x moves with velocity v —
+ * pixels with a camera (the exact Jacobian of camera_project; 0 behind the
+ * camera, where nothing is drawn), world units without one. */
+static double lod_rate(const wrinkly_opts *o, const double x[3], const double v[3])
 {
-    if (o->cam) {
-        double ax, ay, az, bx, by, bz;
-        if (camera_project(o->cam, o->width, o->height, a, &ax, &ay, &az) ||
-            camera_project(o->cam, o->width, o->height, b, &bx, &by, &bz)) {
-            *ok = 0;
-            return 0;
-        }
-        return hypot(ax - bx, ay - by);
+    if (!o->cam)
+        return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    const camera *c = o->cam;
+    double d[3] = {x[0] - c->eye[0], x[1] - c->eye[1], x[2] - c->eye[2]};
+    double z = d[0] * c->fwd[0] + d[1] * c->fwd[1] + d[2] * c->fwd[2];
+    if (z <= 1e-9)
+        return 0;
+    double xr = d[0] * c->right[0] + d[1] * c->right[1] + d[2] * c->right[2];
+    double yu = d[0] * c->upv[0] + d[1] * c->upv[1] + d[2] * c->upv[2];
+    double vz = v[0] * c->fwd[0] + v[1] * c->fwd[1] + v[2] * c->fwd[2];
+    double vr = v[0] * c->right[0] + v[1] * c->right[1] + v[2] * c->right[2];
+    double vu = v[0] * c->upv[0] + v[1] * c->upv[1] + v[2] * c->upv[2];
+    /* sx = xr/z · h/(2 tan) + w/2, sy = -yu/z · h/(2 tan) + h/2 */
+    double f = (double)o->height / (2 * c->tan_half * z * z);
+    return f * hypot(vr * z - xr * vz, vu * z - yu * vz);
+}
+
+/* Bounds of an attribute on one Bézier segment (interval) of one axis from
+ * its four Bézier control values c (convex hull and hodograph): the values
+ * lie in [lo, hi], |d/du| <= d. */
+typedef struct hbound {
+    double d, lo, hi;
+} hbound;
+
+/* The Bézier control values of the segment of interval i as weights of the
+ * three points p_{i-1}, p_i, p_{i+1} (axis_weights, wrinkly.h). */
+static void bez_rows(double lam, double E[4][3])
+{
+    double r[4][3] = {{0.5, 0.5, 0}, {0.5 * (1 - lam), 0.5 * (1 + lam), 0},
+                      {0, 0.5 * (1 + lam), 0.5 * (1 - lam)}, {0, 0.5, 0.5}};
+    memcpy(E, r, sizeof r);
+}
+
+/* Intervals whose attributes can appear in interval i after k IST rounds
+ * (|j - i| <= kM, wrapped or clipped): *lo..*hi, indices taken mod n on a
+ * cyclic axis. */
+static void src_range(int n, const wrinkly_axis *ax, int shuffled, int i, int k, int *lo, int *hi)
+{
+    long r = shuffled && ax->ist ? (long)k * ax->m : 0;
+    if (ax->cyclic && 2 * r + 1 >= n) {
+        *lo = 0, *hi = n - 1;
+        return;
     }
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    long a = i - r, b = i + r;
+    if (!ax->cyclic) {
+        a = a < 0 ? 0 : a;
+        b = b > n - 1 ? n - 1 : b;
+    }
+    *lo = (int)a, *hi = (int)b;
+}
+
+static void hb_join(hbound *a, const hbound *b)
+{
+    a->d = b->d > a->d ? b->d : a->d;
+    a->lo = b->lo < a->lo ? b->lo : a->lo;
+    a->hi = b->hi > a->hi ? b->hi : a->hi;
+}
+
+static const hbound hb_empty = {0, INFINITY, -INFINITY};
+
+/* One sample of the base for the bound: where it is, and the rates of P',
+ * N and N' there (at the base point and at the base point displaced by
+ * ±hg·N, hg = max |h|: the picture of R lies between them). */
+enum { LOD_X = 3 };
+typedef struct lodpt {
+    double dp[LOD_X], n[LOD_X], dn[LOD_X];
+} lodpt;
+
+static void lod_point(const wrinkly_opts *o, const double p[3], const double dp[3], const double n[3],
+                      const double dn[3], double hg, lodpt *q)
+{
+    for (int x = 0; x < LOD_X; x++) {
+        double h = (x - 1) * hg, at[3];
+        for (int d = 0; d < 3; d++)
+            at[d] = p[d] + h * n[d];
+        q->dp[x] = lod_rate(o, at, dp);
+        q->n[x] = lod_rate(o, at, n);
+        q->dn[x] = lod_rate(o, at, dn);
+    }
+}
+
+/* The bound on the projected length of R over a sub-interval of width 1
+ * (divide by B^k): max over the samples of |J P'| + |H'|max |J N| + |H|max |J N'|. */
+static double lod_density(const lodpt *q, size_t nq, double hd, double habs)
+{
+    double g = 0;
+    for (size_t s = 0; s < nq; s++)
+        for (int x = 0; x < LOD_X; x++) {
+            double v = q[s].dp[x] + hd * q[s].n[x] + habs * q[s].dn[x];
+            g = v > g ? v : g;
+        }
+    return g;
+}
+
+/* |d/du| of the height that R uses, from the bound of the attribute: the
+ * crack blend adds |s'| |H_shuffled - H_plain| <= (1.5/w)(hi - lo). */
+static double lod_hd(const wrinkly_opts *o, const wrinkly_axis *ax, const hbound *b)
+{
+    double d = b->d;
+    if (ax->ist && (o->shuffle & WRINKLY_HEIGHT) && o->crack_band > 0 && b->hi > b->lo)
+        d += 1.5 / o->crack_band * (b->hi - b->lo);
+    return d;
+}
+
+static double lod_target(const wrinkly_opts *o) { return o->cam ? (o->pixel > 0 ? o->pixel : 1.0) : o->tol; }
+
+/* Samples per base interval along the axis being measured. */
+enum { LOD_G = 17, LOD_GS = 7 };
+#define LOD_EDGE 1e-4 /* samples stay this far inside the segment (P'' jumps at joints) */
+#define LOD_FD 1e-5   /* central difference step for N' */
+
+static double lod_u(int i, int q, int g) { return i + LOD_EDGE + (1 - 2 * LOD_EDGE) * q / (double)(g - 1); }
+
+static void curve_frame(const wrinkly_curve *c, double lam, double u, double p[3], double dp[3], double n[3])
+{
+    double pp[2], d[2];
+    wrinkly_curve_base(c, lam, u, pp, d);
+    double l = hypot(d[0], d[1]);
+    p[0] = pp[0], p[1] = pp[1], p[2] = 0;
+    dp[0] = d[0], dp[1] = d[1], dp[2] = 0;
+    n[0] = l > 0 ? -d[1] / l : 0, n[1] = l > 0 ? d[0] / l : 0, n[2] = 0;
+}
+
+void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki)
+{
+    double lam = lam_of(o->tension);
+    int n = c->n, b = 2 * c->ax.m + 1;
+    int kmax = o->kmax > 0 ? o->kmax : 8;
+    int kf = o->k < 0 ? 0 : o->k > kmax ? kmax : o->k;
+    int adaptive = (o->cam || o->tol > 0) && b > 1;
+    for (int i = 0; i < n; i++)
+        ki[i] = o->cam || o->tol > 0 ? 0 : kf;
+    if (!adaptive)
+        return;
+    double E[4][3], hg = 0;
+    bez_rows(lam, E);
+    for (int i = 0; i < n; i++)
+        hg = fabs(c->pts[i].h) > hg ? fabs(c->pts[i].h) : hg;
+    /* per interval: the height's Bézier bounds */
+    hbound *hb = rt_malloc(sizeof *hb * (size_t)n);
+    if (!hb) { /* no memory for the bound: the finest level is always safe */
+        for (int i = 0; i < n; i++)
+            ki[i] = kmax;
+        return;
+    }
+    for (int i = 0; i < n; i++) {
+        axw a;
+        axis_weights(n, c->ax.cyclic, lam, 0, i + 0.5, &a);
+        double cv[4];
+        for (int r = 0; r < 4; r++) {
+            cv[r] = 0;
+            for (int q = 0; q < 3; q++)
+                cv[r] += E[r][q] * c->pts[a.idx[q]].h;
+        }
+        hb[i] = hb_empty;
+        for (int r = 0; r < 4; r++) {
+            hb[i].lo = cv[r] < hb[i].lo ? cv[r] : hb[i].lo;
+            hb[i].hi = cv[r] > hb[i].hi ? cv[r] : hb[i].hi;
+            if (r < 3 && 3 * fabs(cv[r + 1] - cv[r]) > hb[i].d)
+                hb[i].d = 3 * fabs(cv[r + 1] - cv[r]);
+        }
+    }
+    double target = lod_target(o);
+    int shuf = (o->shuffle & WRINKLY_HEIGHT) != 0;
+    for (int i = 0; i < n; i++) {
+        lodpt q[LOD_G];
+        for (int s = 0; s < LOD_G; s++) {
+            double u = lod_u(i, s, LOD_G), p[3], dp[3], nn[3], p1[3], d1[3], n1[3], p0[3], d0[3], n0[3], dn[3];
+            curve_frame(c, lam, u, p, dp, nn);
+            curve_frame(c, lam, u + LOD_FD, p1, d1, n1);
+            curve_frame(c, lam, u - LOD_FD, p0, d0, n0);
+            for (int d = 0; d < 3; d++)
+                dn[d] = (n1[d] - n0[d]) / (2 * LOD_FD);
+            lod_point(o, p, dp, nn, dn, hg, &q[s]);
+        }
+        int k = 0;
+        for (;; k++) {
+            int lo, hi;
+            src_range(n, &c->ax, shuf, i, k, &lo, &hi);
+            hbound h = hb_empty;
+            for (int j = lo; j <= hi; j++)
+                hb_join(&h, &hb[((j % n) + n) % n]);
+            double habs = fmax(fabs(h.lo), fabs(h.hi));
+            double g = lod_density(q, LOD_G, lod_hd(o, &c->ax, &h), habs);
+            if (k >= kmax || g / pow(b, k) <= target)
+                break;
+        }
+        ki[i] = k;
+    }
+    rt_free(hb);
+}
+
+double wrinkly_surface_attr(const wrinkly_surface *s, double tension, int which, double u, double v)
+{
+    axw au, av;
+    double lam = lam_of(tension);
+    axis_weights(s->nu, s->au.cyclic, lam, 0, u, &au);
+    axis_weights(s->nv, s->av.cyclic, lam, 0, v, &av);
+    return attr2(s, &au, &av, which);
+}
+
+/* Height bounds of one patch: d = |H_u| (axis 0) or |H_v| (axis 1). */
+typedef struct patchb {
+    hbound u, v;
+} patchb;
+
+static void patch_bounds(const wrinkly_surface *s, double lam, int i, int j, patchb *pb)
+{
+    double E[4][3], C[4][4];
+    bez_rows(lam, E);
+    axw au, av;
+    axis_weights(s->nu, s->au.cyclic, lam, 0, i + 0.5, &au);
+    axis_weights(s->nv, s->av.cyclic, lam, 0, j + 0.5, &av);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int b = 0; b < 4; b++)
+        for (int a = 0; a < 4; a++) {
+            double x = 0;
+            for (int r = 0; r < 3; r++)
+                for (int q = 0; q < 3; q++)
+                    x += E[a][q] * E[b][r] * s->pts[(size_t)av.idx[r] * (size_t)s->nu + (size_t)au.idx[q]].h;
+            C[b][a] = x;
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+        }
+    double du = 0, dv = 0;
+    for (int b = 0; b < 4; b++)
+        for (int a = 0; a < 3; a++) {
+            du = fmax(du, 3 * fabs(C[b][a + 1] - C[b][a]));
+            dv = fmax(dv, 3 * fabs(C[a + 1][b] - C[a][b]));
+        }
+    pb->u = (hbound){du, lo, hi};
+    pb->v = (hbound){dv, lo, hi};
+}
+
+/* Samples of patch (i, j) for the bound along axis `ax` (0 u, 1 v). */
+static void patch_samples(const wrinkly_surface *s, const wrinkly_opts *o, double lam, double hg, int i, int j,
+                          int ax, lodpt *q)
+{
+    for (int b = 0; b < LOD_GS; b++)
+        for (int a = 0; a < LOD_GS; a++) {
+            double u = lod_u(i, a, LOD_GS), v = lod_u(j, b, LOD_GS);
+            axw wu, wv;
+            axis_weights(s->nu, s->au.cyclic, lam, 1, u, &wu);
+            axis_weights(s->nv, s->av.cyclic, lam, 1, v, &wv);
+            double p[3], pu[3], pv[3], nn[3], n0[3], n1[3], dn[3], x[3];
+            surf_eval(s, &wu, &wv, p, pu, pv);
+            cross_norm(pu, pv, nn);
+            for (int sgn = -1; sgn <= 1; sgn += 2) {
+                double uu = u + (ax == 0 ? sgn * LOD_FD : 0), vv = v + (ax == 1 ? sgn * LOD_FD : 0);
+                double *nd = sgn < 0 ? n0 : n1;
+                wrinkly_surface_base(s, lam, uu, vv, x, nd);
+            }
+            for (int d = 0; d < 3; d++)
+                dn[d] = (n1[d] - n0[d]) / (2 * LOD_FD);
+            lod_point(o, p, ax == 0 ? pu : pv, nn, dn, hg, &q[b * LOD_GS + a]);
+        }
 }
 
 /* K_i per base interval of both axes (§5.2, wrinkly.h). */
@@ -510,39 +729,81 @@ void wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int
 {
     double lam = lam_of(o->tension);
     int kmax = o->kmax > 0 ? o->kmax : 8;
-    int bu = 2 * s->au.m + 1, bv = 2 * s->av.m + 1;
+    int nu = s->nu, nv = s->nv;
     int adaptive = o->cam || o->tol > 0;
-    double target = o->cam ? (o->pixel > 0 ? o->pixel : 1.0) : o->tol;
     int kf = o->k < 0 ? 0 : o->k > kmax ? kmax : o->k;
-    for (int i = 0; i < s->nu; i++)
+    for (int i = 0; i < nu; i++)
         ku[i] = adaptive ? 0 : kf;
-    for (int j = 0; j < s->nv; j++)
+    for (int j = 0; j < nv; j++)
         kv[j] = adaptive ? 0 : kf;
     if (!adaptive)
         return;
-    enum { G = 5 };
-    for (int j = 0; j < s->nv; j++)
-        for (int i = 0; i < s->nu; i++) {
-            double g[G][G][3], nn[3];
-            for (int b = 0; b < G; b++)
-                for (int a = 0; a < G; a++)
-                    wrinkly_surface_base(s, lam, i + a / (double)(G - 1), j + b / (double)(G - 1), g[b][a], nn);
-            double lu = 0, lv = 0;
-            for (int r = 0; r < G; r++) {
-                double su = 0, sv = 0;
-                for (int q = 0; q + 1 < G; q++) {
-                    int ok = 1;
-                    su += proj_len(o, g[r][q], g[r][q + 1], &ok);
-                    sv += proj_len(o, g[q][r], g[q + 1][r], &ok);
+    size_t np = (size_t)nu * (size_t)nv, nmax = (size_t)(nu > nv ? nu : nv);
+    patchb *pb = rt_malloc(sizeof *pb * np);
+    patchb *win = rt_malloc(sizeof *win * np);
+    lodpt *q = rt_malloc(sizeof *q * nmax * LOD_GS * LOD_GS);
+    if (!pb || !win || !q) { /* no memory for the bound: the finest level is always safe */
+        for (int i = 0; i < nu; i++)
+            ku[i] = 2 * s->au.m + 1 > 1 ? kmax : 0;
+        for (int j = 0; j < nv; j++)
+            kv[j] = 2 * s->av.m + 1 > 1 ? kmax : 0;
+        goto done;
+    }
+    double hg = 0;
+    for (size_t t = 0; t < np; t++)
+        hg = fabs(s->pts[t].h) > hg ? fabs(s->pts[t].h) : hg;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++)
+            patch_bounds(s, lam, i, j, &pb[(size_t)j * nu + i]);
+    double target = lod_target(o);
+    int shuf = (o->shuffle & WRINKLY_HEIGHT) != 0;
+    for (int ax = 0; ax < 2; ax++) {
+        const wrinkly_axis *A = ax == 0 ? &s->au : &s->av, *O = ax == 0 ? &s->av : &s->au;
+        int na = ax == 0 ? nu : nv, no = ax == 0 ? nv : nu, b = 2 * A->m + 1;
+        int *kk = ax == 0 ? ku : kv;
+        if (b == 1)
+            continue; /* subdividing a base-1 axis changes nothing: level 0 */
+        /* win[(a, c)] joins the patches (a, c') over the sources c' of c on
+         * the other axis (any level up to kmax) */
+        for (int c = 0; c < no; c++) {
+            int lo, hi;
+            src_range(no, O, shuf, c, kmax, &lo, &hi);
+            for (int a = 0; a < na; a++) {
+                hbound h = hb_empty;
+                for (int cc = lo; cc <= hi; cc++) {
+                    int w = ((cc % no) + no) % no;
+                    const patchb *p = ax == 0 ? &pb[(size_t)w * nu + a] : &pb[(size_t)a * nu + w];
+                    hb_join(&h, ax == 0 ? &p->u : &p->v);
                 }
-                lu = su > lu ? su : lu;
-                lv = sv > lv ? sv : lv;
+                win[(size_t)c * na + a] = (patchb){h, h};
             }
-            int a = bu > 1 ? level_for(lu, target, bu, kmax) : 0;
-            int c = bv > 1 ? level_for(lv, target, bv, kmax) : 0;
-            ku[i] = a > ku[i] ? a : ku[i];
-            kv[j] = c > kv[j] ? c : kv[j];
         }
+        for (int a = 0; a < na; a++) {
+            for (int c = 0; c < no; c++)
+                patch_samples(s, o, lam, hg, ax == 0 ? a : c, ax == 0 ? c : a, ax,
+                              q + (size_t)c * LOD_GS * LOD_GS);
+            int k = 0;
+            for (;; k++) {
+                int lo, hi, ok = 1;
+                src_range(na, A, shuf, a, k, &lo, &hi);
+                for (int c = 0; c < no && ok; c++) {
+                    hbound h = hb_empty;
+                    for (int aa = lo; aa <= hi; aa++)
+                        hb_join(&h, &win[(size_t)c * na + ((aa % na) + na) % na].u);
+                    double g = lod_density(q + (size_t)c * LOD_GS * LOD_GS, LOD_GS * LOD_GS, lod_hd(o, A, &h),
+                                           fmax(fabs(h.lo), fabs(h.hi)));
+                    ok = g / pow(b, k) <= target;
+                }
+                if (ok || k >= kmax)
+                    break;
+            }
+            kk[a] = k;
+        }
+    }
+done:
+    rt_free(pb);
+    rt_free(win);
+    rt_free(q);
 }
 
 static rt_code make_axis(int n, const wrinkly_axis *ax, const int *ki, const wrinkly_opts *o,

@@ -31,14 +31,29 @@
  * (Fig. 10 e, f). N is the unit normal of the base: (-P'_y, P'_x)/|P'| for
  * curves, P_u × P_v/|P_u × P_v| for surfaces.
  *
- * Adaptive sampling (§5.2). For each base interval of each axis a level K_i:
- *  - with a camera: the smallest K_i with (projected length of the interval)
- *    / (2M+1)^{K_i} <= `pixel` pixels. On a surface the length is measured on
- *    a 5×5 grid of base points of every patch along the axis and the maximum
- *    over the patches of the strip is taken, so all rows share one set of u
- *    samples: the mesh is a conforming tensor grid, no T-junctions;
- *  - else with tol > 0 the same with world length and tol;
- *  - else K_i = k for every interval.
+ * Adaptive sampling (§5.2). For each base interval A_i of each axis a level
+ * K_i: the smallest K_i at which EVERY level-K_i sub-interval of A_i, its
+ * heights included, projects to at most the target — `pixel` pixels with a
+ * camera (curves lie in z = 0 then), `tol` world units without one (else
+ * K_i = k for every interval). With K_i rounds F^{-1} is a rigid shift on
+ * each level-K_i sub-interval (width w = 1/B^{K_i}, B = 2M+1), so over one
+ * R = P + H(F^{-1}(u))·N has length at most
+ *     w · max (|J P'| + |H'|max |J N| + |H|max |J N'|)
+ * with J the projection's Jacobian (the identity without a camera). The
+ * max runs over 17 samples per curve interval (7×7 per surface patch, per
+ * axis), J taken exactly at the base point and at it displaced by ±max|h|
+ * along N (0 behind the camera); N' by central differences. |H'|max and
+ * |H|max are the hodograph and convex-hull bounds of the height's Bézier
+ * values over every interval that can feed A_i after K_i rounds (|j - i|
+ * <= K_i·M; on a surface, every patch of the other axis within kmax·M);
+ * a crack band w_c adds 1.5/w_c · (max H - min H) to |H'|. So the choice
+ * is from the maximum, never the mean, and the measured longest
+ * sub-interval is typically 1/3 to 1/2 of the target (tests/unit/
+ * test_wrinkly.c, test_lod). On a surface K_i of a u interval is the
+ * largest over its column of patches, so all rows share one set of u
+ * samples: the mesh is a conforming tensor grid, no T-junctions. Jitter
+ * and `extra` do not change the levels; extra rounds stop where double
+ * precision does (ist_k_limit). An axis with M = 0 stays at level 0.
  * K = max K_i (eq. 12), capped by kmax. Samples: ist_sample_positions (the
  * ((S/S_i+1)/2)-th sub-interval and every (S/S_i)-th after it), at the
  * centre or, with jitter, at a seeded random point inside it (Fig. 8b);
@@ -157,6 +172,10 @@ typedef struct wrinkly_surface {
 /* Base surface P(u, v) and its unit normal (zero if undefined). */
 void wrinkly_surface_base(const wrinkly_surface *s, double tension, double u, double v, double p[3],
                           double n[3]);
+/* Attribute function of a surface built like H (eq. 8), unshuffled, at
+ * (u, v): which = 0 height, 1..3 rgb, 4 opacity (R uses it at
+ * (F_u^{-1}(u), F_v^{-1}(v)) for the shuffled attributes). */
+double wrinkly_surface_attr(const wrinkly_surface *s, double tension, int which, double u, double v);
 
 /* Φ and ρ of the base surface (above), by the midpoint rule on 5×5 cells
  * per patch. */

@@ -107,12 +107,44 @@ static void test_bijective(void)
  * separate code). A wrong digit moves a point by whole sub-intervals. */
 static void test_large_k(void)
 {
-    /* S·n stays below 2^40, so a sub-interval is thousands of doubles wide;
-     * at S near 2^52 sub-intervals near u = n are narrower than one ulp of u,
-     * so no double-precision F^{-1} can be one-to-one there (open: issue 13) */
-    static const int mk[4][2] = {{1, 21}, {1, 24}, {2, 14}, {3, 12}};
+    /* at S near 2^52 sub-intervals near u = n are narrower than one ulp of
+     * u, so no double-precision F^{-1} can be one-to-one there: K stops
+     * where sub-intervals are IST_MIN_ULPS = 64 ulps of 7 = 2^-44 wide.
+     * With n = 7 that is 3^27 <= 2^44 < 3^28, 5^18 <= 2^44 < 5^19 and
+     * 7^15 <= 2^44 < 7^16; the limit itself round-trips, one more is refused. */
+    static const int mk[7][2] = {{1, 21}, {1, 24}, {2, 14}, {3, 12}, {1, 27}, {2, 18}, {3, 15}};
+    static const int lim[3] = {27, 18, 15};
+    for (int m = 1; m <= 3; m++) {
+        ist_spec s = {.n = 7, .m = m, .k = lim[m - 1] + 1, .axis = IST_CYCLIC};
+        CHECK(ist_k_limit(&s) == lim[m - 1], "M %d: limit %d", m, ist_k_limit(&s));
+        ist t;
+        rt_error e;
+        CHECK(ist_init(&t, &s, &e) == RT_EINVAL, "M %d: K = limit + 1 refused", m);
+        char want[300];
+        snprintf(want, sizeof want,
+                 "IST iterations K = %d make sub-intervals %.3g wide, under 64 ulps (5.68e-14) of coordinates up to 7, so double precision cannot keep F one-to-one; at most K = %d for this axis",
+                 lim[m - 1] + 1, 1 / pow(2 * m + 1, lim[m - 1] + 1), lim[m - 1]);
+        CHECK(strcmp(e.msg, want) == 0, "message: %s", e.msg);
+    }
+    {   /* M = 0 never narrows; no axis with M >= 1 passes K = 30 */
+        ist_spec s = {.n = 1, .m = 0, .k = IST_MAX_K};
+        CHECK(ist_k_limit(&s) == IST_MAX_K, "M = 0: any K");
+        s.m = 1;
+        CHECK(ist_k_limit(&s) == 29 && IST_MAX_K == 29, "n = 1, M = 1: K up to 29, the global cap");
+        double b[2] = {0, 1.99};
+        s.bounds = b;
+        CHECK(ist_k_limit(&s) == 29, "[0, 1.99]: 29");
+        ist t;
+        rt_error e;
+        s.k = 29;
+        CHECK(ist_init(&t, &s, &e) == RT_OK, "K = 29 on [0, 1.99): %s", e.msg);
+        ist_free(&t);
+        s.k = 30;
+        CHECK(ist_init(&t, &s, &e) == RT_EINVAL && strcmp(e.msg, "IST iterations K = 30; expected 0..29") == 0,
+              "K = 30: %s", e.msg);
+    }
     for (int axis = 0; axis < 2; axis++)
-        for (int c = 0; c < 4; c++) {
+        for (int c = 0; c < 7; c++) {
             int n = 7, m = mk[c][0], k = mk[c][1];
             ist t;
             ist_spec s = {.n = n, .m = m, .k = k, .axis = (ist_axis_type)axis};
@@ -178,8 +210,10 @@ static void test_lists_vs_closed(void)
 static void test_general(void)
 {
     double bounds[7] = {0, 1, 3, 3.5, 4.5, 6.5, 7};
-    int ms[6] = {1, 2, 0, 1, 3, 1};
     for (int axis = 0; axis < 2; axis++) {
+        /* M = 3 on a translation axis (pieces held back at the ends); a
+         * cyclic axis of 6 intervals takes at most M = 2 (2M+1 <= N) */
+        int ms[6] = {1, 2, 0, 1, axis ? 2 : 3, 1};
         ist t;
         ist_spec s = {.n = 6, .bounds = bounds, .m_each = ms, .k = 3, .axis = (ist_axis_type)axis};
         rt_error e;
@@ -208,6 +242,21 @@ static void test_general(void)
     rt_error e;
     CHECK(ist_init(&t, &s, &e) == RT_OK, "init: %s", e.msg);
     CHECK_NEAR(ist_inv(&t, 4.0), 4.0, 1e-12, "centre of a symmetric neighbourhood is fixed");
+    /* ...but unequal lengths move the others: the centre 1 of [0, 2), whose
+     * neighbours are 3 and 1 long, goes to 0.63 (the docs' condition for
+     * fixed centres: equal lengths and one M) */
+    CHECK_NEAR(ist_inv(&t, 1.0), 0.63, 1e-12, "unequal lengths: centre of [0, 2) moves");
+    CHECK_NEAR(ist_inv(&t, 2.5), 2.6415, 1e-12, "unequal lengths: centre of [2, 3) moves");
+    ist_free(&t);
+    /* equal lengths but several M: centres move too (interval 0 to 1.12) */
+    int ms2[5] = {1, 1, 2, 1, 1};
+    ist_spec s2 = {.n = 5, .m_each = ms2, .k = 2, .axis = IST_CYCLIC};
+    CHECK(ist_init(&t, &s2, &e) == RT_OK, "init: %s", e.msg);
+    int moved = 0;
+    for (int i = 0; i < 5; i++)
+        moved += fabs(ist_inv(&t, i + 0.5) - (i + 0.5)) > 1e-9;
+    CHECK(moved == 4, "several M: %d centres move", moved);
+    CHECK_NEAR(ist_inv(&t, 0.5), 1.12, 1e-12, "several M: centre of interval 0");
     ist_free(&t);
 }
 
@@ -231,6 +280,27 @@ static void test_validation(void)
     CHECK(ist_init(&t, &s4, &e) == RT_EINVAL, "huge lists refused: %s", e.msg);
     ist_spec s5 = {.n = 0, .m = 1, .k = 1};
     CHECK(ist_init(&t, &s5, &e) == RT_EINVAL && strstr(e.msg, "at least 1 base interval"), "n = 0");
+    /* a cyclic axis needs 2M+1 <= N (a translation axis holds pieces back instead) */
+    ist_spec s6 = {.n = 4, .m = 2, .k = 1, .axis = IST_CYCLIC};
+    CHECK(ist_init(&t, &s6, &e) == RT_EINVAL, "cyclic 2M+1 > N refused");
+    CHECK(strcmp(e.msg, "IST on a cyclic axis needs 2M+1 <= N, got M = 2 with N = 4 (the pieces would wrap onto one interval twice)") == 0,
+          "message: %s", e.msg);
+    int ms7[3] = {0, 1, 2};
+    ist_spec s7 = {.n = 3, .m_each = ms7, .k = 1, .axis = IST_CYCLIC};
+    CHECK(ist_init(&t, &s7, &e) == RT_EINVAL, "cyclic 2M_i+1 > N refused");
+    CHECK(strcmp(e.msg, "IST on a cyclic axis needs 2M+1 <= N, but interval 2 has M = 2 with N = 3 (its pieces would wrap onto one interval twice)") == 0,
+          "message: %s", e.msg);
+    ist_spec s8 = {.n = 5, .m = 2, .k = 2, .axis = IST_CYCLIC};
+    CHECK(ist_init(&t, &s8, &e) == RT_OK, "cyclic 2M+1 = N accepted: %s", e.msg);
+    ist_free(&t);
+    s8.axis = IST_TRANSLATION, s8.n = 2;
+    CHECK(ist_init(&t, &s8, &e) == RT_OK, "translation 2M+1 > N accepted: %s", e.msg);
+    ist_free(&t);
+    /* unequal lengths: the lists' narrowest piece is checked too */
+    double tiny[4] = {0, 1e-13, 1, 2};
+    ist_spec s9 = {.n = 3, .bounds = tiny, .m = 1, .k = 3};
+    CHECK(ist_init(&t, &s9, &e) == RT_EINVAL && strstr(e.msg, "so double precision cannot keep F one-to-one"),
+          "a 1e-13 interval cut 27 ways is refused: %s", e.msg);
 }
 
 /* §5.2: Σ S_i samples at the sub-intervals the formula names (indices
@@ -313,6 +383,8 @@ static void test_fast_bits(void)
                     /* 64, 43, 22 intervals: ends and interior, K·M > N/2; M + 2 and 1:
                      * pieces held back at both ends */
                     int n = g < 3 ? 64 - 21 * g : g == 3 ? m + 2 : 1;
+                    if (axis == IST_CYCLIC && 2 * m + 1 > n)
+                        continue; /* refused (test_validation) */
                     double bounds[65];
                     for (int i = 0; i <= n; i++)
                         bounds[i] = a0s[g] + (double)i * hs[g];

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "ist.h"
 #include "rt_alloc.h"
 #include "mesh.h"
 #include "rng.h"
@@ -210,7 +211,11 @@ static void test_surface(void)
         rt_error e;
         CHECK(wrinkly_surface_mesh(&s, &o, NULL, &m, &info, &e) == RT_OK, "lod: %s", e.msg);
         CHECK(m.nt < prev, "distance %g: %zu triangles, fewer than %zu", dist, m.nt, prev);
-        CHECK(m.nt <= 40 * 200 * 200, "distance %g: %zu triangles within 40× the pixel count", dist, m.nt);
+        /* sub-intervals end between 1/(2M+1) and 1 pixel on each axis, and the
+         * far side of the torus is tessellated too: tens of triangles per
+         * pixel at the closest view (47× here since K_i bounds every
+         * sub-interval with its heights, 24× with the old mean-length rule) */
+        CHECK(m.nt <= 60 * 200 * 200, "distance %g: %zu triangles within 60× the pixel count", dist, m.nt);
         if (getenv("WRINKLY_VERBOSE"))
             printf("distance %g: K %d,%d, %zu triangles\n", dist, info.k[0], info.k[1], m.nt);
         prev = m.nt;
@@ -319,10 +324,185 @@ static void test_orientation(void)
     rt_free(q);
 }
 
+/* ---- §5.2 LOD, measured independently -------------------------------------
+ * The rule (wrinkly.h): K_i is the smallest level at which every level-K_i
+ * sub-interval of A_i, heights included, projects to at most the target.
+ * With K_i rounds F^{-1} is a rigid shift on each level-K_i sub-interval, so
+ * the picture of R over one is a smooth arc: evaluate it densely with an
+ * IST of K_i rounds, project, sum the segments, take the longest. */
+
+/* World point → picture: pixels with a camera, the point itself without. */
+static void lod_proj(const camera *cam, int w, int h, const double x[3], double out[2], int *ok)
+{
+    if (!cam) {
+        out[0] = x[0], out[1] = x[1];
+        return;
+    }
+    double z;
+    if (camera_project(cam, w, h, x, &out[0], &out[1], &z))
+        *ok = 0;
+}
+
+static double lod_dist3(const camera *cam, int w, int h, const double a[3], const double b[3])
+{
+    if (!cam)
+        return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    double pa[2], pb[2];
+    int ok = 1;
+    lod_proj(cam, w, h, a, pa, &ok);
+    lod_proj(cam, w, h, b, pb, &ok);
+    return ok ? hypot(pa[0] - pb[0], pa[1] - pb[1]) : 0;
+}
+
+enum { LOD_DENSE = 24 };
+
+/* Longest projected level-k sub-interval of interval i of a curve. */
+static double curve_longest(const wrinkly_curve *c, const camera *cam, int w, int h, int i, int k)
+{
+    ist t;
+    ist_spec sp = {.n = c->n, .m = c->ax.m, .k = k, .axis = c->ax.cyclic ? IST_CYCLIC : IST_TRANSLATION};
+    rt_error e;
+    if (ist_init(&t, &sp, &e))
+        return INFINITY;
+    double S = pow(2 * c->ax.m + 1, k), best = 0;
+    for (long s = 0; s < (long)S; s++) {
+        double len = 0, prev[3];
+        for (int q = 0; q <= LOD_DENSE; q++) {
+            double f = 1e-7 + (1 - 2e-7) * q / LOD_DENSE, u = i + (s + f) / S, p[2], d[2];
+            wrinkly_curve_base(c, 2.0 / 3, u, p, d);
+            double l = hypot(d[0], d[1]), H = wrinkly_curve_attr(c, 2.0 / 3, 0, ist_inv(&t, u));
+            double x[3] = {p[0] - H * d[1] / l, p[1] + H * d[0] / l, 0};
+            if (q)
+                len += lod_dist3(cam, w, h, prev, x);
+            memcpy(prev, x, sizeof prev);
+        }
+        best = len > best ? len : best;
+    }
+    ist_free(&t);
+    return best;
+}
+
+/* Longest projected level-k sub-interval along axis ax (0 u, 1 v) of base
+ * interval i of a surface, over 8 rows per base interval of the other axis
+ * (whose F^{-1} has ko rounds). */
+static double surf_longest(const wrinkly_surface *s, const camera *cam, int w, int h, int ax, int i, int k, int ko)
+{
+    const wrinkly_axis *A = ax ? &s->av : &s->au, *O = ax ? &s->au : &s->av;
+    int na = ax ? s->nv : s->nu, no = ax ? s->nu : s->nv;
+    ist t, to;
+    ist_spec sp = {.n = na, .m = A->m, .k = k, .axis = A->cyclic ? IST_CYCLIC : IST_TRANSLATION};
+    ist_spec so = {.n = no, .m = O->m, .k = ko, .axis = O->cyclic ? IST_CYCLIC : IST_TRANSLATION};
+    rt_error e;
+    if (ist_init(&t, &sp, &e))
+        return INFINITY;
+    if (ist_init(&to, &so, &e)) {
+        ist_free(&t);
+        return INFINITY;
+    }
+    double S = pow(2 * A->m + 1, k), best = 0;
+    for (int r = 0; r < 8 * no; r++) {
+        double ov = (r + 0.37) / 8, osrc = ist_inv(&to, ov);
+        for (long sub = 0; sub < (long)S; sub++) {
+            double len = 0, prev[3];
+            for (int q = 0; q <= LOD_DENSE; q++) {
+                double f = 1e-7 + (1 - 2e-7) * q / LOD_DENSE, a = i + (sub + f) / S, src = ist_inv(&t, a);
+                double u = ax ? ov : a, v = ax ? a : ov, p[3], n[3];
+                wrinkly_surface_base(s, 2.0 / 3, u, v, p, n);
+                double H = wrinkly_surface_attr(s, 2.0 / 3, 0, ax ? osrc : src, ax ? src : osrc);
+                double x[3] = {p[0] + H * n[0], p[1] + H * n[1], p[2] + H * n[2]};
+                if (q)
+                    len += lod_dist3(cam, w, h, prev, x);
+                memcpy(prev, x, sizeof prev);
+            }
+            best = len > best ? len : best;
+        }
+    }
+    ist_free(&t);
+    ist_free(&to);
+    return best;
+}
+
+static void test_lod(void)
+{
+    /* a curve: world tolerance, then a camera looking at its plane */
+    enum { N = 7 };
+    wrinkly_point p[N];
+    make_curve_pts(p, N, 2.0);
+    for (int i = 0; i < N; i++)
+        p[i].h *= 2; /* heights up to 0.4: they dominate some intervals */
+    camera cc;
+    camera_orbit(&cc, (double[3]){0, 0, 0}, 9, 0, 0, 40);
+    for (int cyc = 0; cyc < 2; cyc++)
+        for (int mode = 0; mode < 2; mode++) {
+            wrinkly_curve c = {p, N, {cyc, 1, 1}};
+            wrinkly_opts o;
+            wrinkly_opts_default(&o);
+            o.kmax = 8;
+            if (mode == 0)
+                o.tol = 0.02;
+            else
+                o.cam = &cc, o.width = o.height = 300, o.pixel = 1;
+            double target = mode == 0 ? o.tol : o.pixel;
+            int ki[N], wasteful = 0, kmaxed = 0;
+            wrinkly_curve_levels(&c, &o, ki);
+            for (int i = 0; i < N; i++) {
+                double l = curve_longest(&c, o.cam, o.width, o.height, i, ki[i]);
+                CHECK(l <= target, "curve cyc %d mode %d interval %d: K_i %d, longest %g > %g", cyc, mode, i, ki[i], l, target);
+                kmaxed += ki[i] == o.kmax;
+                if (ki[i] > 0 && curve_longest(&c, o.cam, o.width, o.height, i, ki[i] - 1) > target)
+                    wasteful++;
+                if (getenv("WRINKLY_VERBOSE"))
+                    printf("curve cyc %d mode %d i %d: K %d longest %g, at K-1 %g\n", cyc, mode, i, ki[i], l,
+                           ki[i] ? curve_longest(&c, o.cam, o.width, o.height, i, ki[i] - 1) : 0);
+            }
+            CHECK(kmaxed == 0, "curve cyc %d mode %d: no interval hits kmax", cyc, mode);
+            CHECK(wasteful > 0, "curve cyc %d mode %d: K_i - 1 fails somewhere (minimal)", cyc, mode);
+        }
+    /* a torus with heights: world tolerance, then a camera */
+    int nu = 8, nv = 6;
+    wrinkly_point *tp = torus(nu, nv, 5);
+    wrinkly_surface s = {tp, nu, nv, {1, 1, 1}, {1, 1, 1}};
+    camera cam;
+    camera_orbit(&cam, (double[3]){0, 0, 0}, 24, 20, 30, 40);
+    for (int mode = 0; mode < 2; mode++) {
+        wrinkly_opts o;
+        wrinkly_opts_default(&o);
+        o.kmax = 6;
+        if (mode == 0)
+            o.tol = 0.1;
+        else
+            o.cam = &cam, o.width = o.height = 200;
+        double target = mode == 0 ? o.tol : o.pixel;
+        int ku[8], kv[6], kx[2] = {0, 0};
+        wrinkly_surface_levels(&s, &o, ku, kv);
+        for (int i = 0; i < nu; i++)
+            kx[0] = ku[i] > kx[0] ? ku[i] : kx[0];
+        for (int j = 0; j < nv; j++)
+            kx[1] = kv[j] > kx[1] ? kv[j] : kx[1];
+        for (int ax = 0; ax < 2; ax++) {
+            int wasteful = 0, na = ax ? nv : nu;
+            for (int i = 0; i < na; i++) {
+                int k = ax ? kv[i] : ku[i];
+                double l = surf_longest(&s, o.cam, o.width, o.height, ax, i, k, kx[!ax]);
+                CHECK(l <= target, "surface mode %d axis %d interval %d: K_i %d, longest %g > %g", mode, ax, i, k, l,
+                      target);
+                CHECK(k < o.kmax, "surface mode %d axis %d interval %d below kmax", mode, ax, i);
+                double l1 = k > 0 ? surf_longest(&s, o.cam, o.width, o.height, ax, i, k - 1, kx[!ax]) : 0;
+                wasteful += l1 > target;
+                if (getenv("WRINKLY_VERBOSE"))
+                    printf("surface mode %d axis %d i %d: K %d longest %g, at K-1 %g\n", mode, ax, i, k, l, l1);
+            }
+            CHECK(wasteful > 0, "surface mode %d axis %d: K_i - 1 fails somewhere (minimal)", mode, ax);
+        }
+    }
+    rt_free(tp);
+}
+
 int main(void)
 {
     test_curve();
     test_surface();
     test_orientation();
+    test_lod();
     return check_done("test_wrinkly");
 }
