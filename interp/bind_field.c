@@ -669,7 +669,13 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
             lang_field_fn_done(ctmp, cown);
             return -1;
         }
-        c = iso_from_field(field_prog_fn, prog, lo, hi, g, &o, &run, m, &e);
+        field_prog *sdf = NULL; /* the exact surface of hard shapes, if the field has one */
+        c = field_prog_level_sdf(prog, o.level, &sdf, NULL, &e);
+        o.sdf = sdf ? field_prog_fn : NULL;
+        o.sdf_ctx = sdf;
+        if (!c)
+            c = iso_from_field(field_prog_fn, prog, lo, hi, g, &o, &run, m, &e);
+        field_prog_free(sdf);
         lang_field_fn_done(tmp, own);
     }
     lang_field_fn_done(ctmp, cown);

@@ -538,7 +538,8 @@ static int b_mesh_stats(interp *I, value *a, int n, value *out)
              {"degenerate", (double)st.degenerate},
              {"euler", (double)st.euler},
              {"area", st.area},
-             {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0}};
+             {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0},
+             {"volume", st.volume}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
         const char *k = intern(I, f[i].k, strlen(f[i].k));
         value v = i == 8 ? val_bool(f[i].v != 0) : val_num(f[i].v);
@@ -618,7 +619,7 @@ static const builtin volume_builtins[] = {
             "Load a volume from .nrrd, .nhdr, .vtk or .vdb (relative to the script); grid: the .vdb grid (default \"density\")."),
     BUILTIN("load_mesh", b_load_mesh, p_path, "Load a mesh from .ply, .obj or .stl (relative to the script)."),
     BUILTIN("mesh_stats", b_mesh_stats, p_mesh,
-            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight}."),
+            "Topology of a mesh: {vertices, triangles, edges, boundary_edges, nonmanifold_edges, degenerate, euler, area, watertight, volume} (volume: signed, positive for a closed outward mesh)."),
     BUILTIN("slice", b_slice, p_slice,
             "An axis-aligned slice of a volume as an image: axis \"x\", \"y\" or \"z\", index (default: the middle), values lo..hi (default: the volume's range) through a palette."),
 };

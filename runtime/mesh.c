@@ -120,6 +120,10 @@ rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e)
             if (ar == 0)
                 st->degenerate++;
             st->area += ar;
+            st->volume += ((double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) +
+                           (double)a[1] * ((double)b[2] * c[0] - (double)b[0] * c[2]) +
+                           (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) /
+                          6;
         }
         for (int k = 0; k < 3; k++) {
             uint32_t a = v[k], b = v[(k + 1) % 3];

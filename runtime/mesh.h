@@ -33,12 +33,16 @@ void mesh_add_tri(mesh *m, uint32_t a, uint32_t b, uint32_t c);
 
 /* Topology statistics: edges shared by 1 triangle (boundary), by > 2
  * (non-manifold), Euler characteristic V - E + F (counting only vertices
- * used by triangles), degenerate triangles (repeated index or zero area). */
+ * used by triangles), degenerate triangles (repeated index or zero area),
+ * total area, and the signed volume sum over triangles of a . (b x c) / 6
+ * (positive for a closed mesh wound counter-clockwise seen from outside;
+ * meaningful only for a closed mesh). */
 typedef struct mesh_stats {
     size_t vertices, triangles, edges;
     size_t boundary_edges, nonmanifold_edges, degenerate;
     long euler;
     double area;
+    double volume;
 } mesh_stats;
 
 rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e);
