@@ -203,8 +203,6 @@ static void test_values_and_print(void)
     field_prog_free(pf);
     field_prog_free(pg);
     field_unref(g);
-    CHECK(field_hard_support(field_ref(f), &g, &e) == RT_OK, "again");
-    field_unref(g);
     field_unref(f);
     f = fsh(DENSITY_SPHERE, 0.3);
     g = (field *)1;
