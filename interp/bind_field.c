@@ -669,7 +669,13 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
             lang_field_fn_done(ctmp, cown);
             return -1;
         }
-        c = iso_from_field(field_prog_fn, prog, lo, hi, g, &o, &run, m, &e);
+        field_prog *sdf = NULL; /* the exact surface of hard shapes, if the field has one */
+        c = field_prog_level_sdf(prog, o.level, &sdf, NULL, &e);
+        o.sdf = sdf ? field_prog_fn : NULL;
+        o.sdf_ctx = sdf;
+        if (!c)
+            c = iso_from_field(field_prog_fn, prog, lo, hi, g, &o, &run, m, &e);
+        field_prog_free(sdf);
         lang_field_fn_done(tmp, own);
     }
     lang_field_fn_done(ctmp, cown);
@@ -749,7 +755,14 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
             val_unref(I, res);
             return -1;
         }
-        c = rm_render(field_prog_fn, prog, &cam, &o, &run, im, &e);
+        field_prog *sdf = NULL; /* exact boundaries of hard shapes, if the field has them */
+        c = o.mode == RM_SOLID ? field_prog_level_sdf(prog, o.threshold, &sdf, NULL, &e)
+                               : field_prog_hard_support(prog, &sdf, &e);
+        o.sdf = o.support = sdf ? field_prog_fn : NULL;
+        o.sdf_ctx = o.support_ctx = sdf;
+        if (!c)
+            c = rm_render(field_prog_fn, prog, &cam, &o, &run, im, &e);
+        field_prog_free(sdf);
         lang_field_fn_done(tmp, own);
     }
     if (c) {

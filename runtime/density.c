@@ -84,6 +84,25 @@ static inline double radii(double r, double s, double *r0sq)
     return r1 * r1;
 }
 
+/* Signed distance to an axis-aligned box / capped z cylinder (relative
+ * coordinates): |max(q, 0)| + min(max_i q_i, 0). */
+static inline double box_sd(const density_shape *d, double dx, double dy, double dz)
+{
+    double qx = fabs(dx) - d->h[0], qy = fabs(dy) - d->h[1], qz = fabs(dz) - d->h[2];
+    double mx = qx > 0 ? qx : 0, my = qy > 0 ? qy : 0, mz = qz > 0 ? qz : 0;
+    double in = qx > qy ? qx : qy;
+    in = in > qz ? in : qz;
+    return sqrt(mx * mx + my * my + mz * mz) + (in < 0 ? in : 0);
+}
+
+static inline double cyl_sd(const density_shape *d, double dx, double dy, double dz)
+{
+    double qr = sqrt(dx * dx + dy * dy) - d->r, qz = fabs(dz) - d->h[2];
+    double mr = qr > 0 ? qr : 0, mz = qz > 0 ? qz : 0;
+    double in = qr > qz ? qr : qz;
+    return sqrt(mr * mr + mz * mz) + (in < 0 ? in : 0);
+}
+
 static inline double eval_one(const density_shape *d, double r1sq, double r0sq, double x, double y,
                               double z)
 {
@@ -94,21 +113,8 @@ static inline double eval_one(const density_shape *d, double r1sq, double r0sq, 
         double q = sqrt(dx * dx + dy * dy) - d->R;
         return soft_d2(q * q + dz * dz, r1sq, r0sq);
     }
-    case DENSITY_BOX: {
-        double qx = fabs(dx) - d->h[0], qy = fabs(dy) - d->h[1], qz = fabs(dz) - d->h[2];
-        double mx = qx > 0 ? qx : 0, my = qy > 0 ? qy : 0, mz = qz > 0 ? qz : 0;
-        double in = qx > qy ? qx : qy;
-        in = in > qz ? in : qz;
-        double sd = sqrt(mx * mx + my * my + mz * mz) + (in < 0 ? in : 0);
-        return soft_sd(sd, d->s);
-    }
-    case DENSITY_CYLINDER: {
-        double qr = sqrt(dx * dx + dy * dy) - d->r, qz = fabs(dz) - d->h[2];
-        double mr = qr > 0 ? qr : 0, mz = qz > 0 ? qz : 0;
-        double in = qr > qz ? qr : qz;
-        double sd = sqrt(mr * mr + mz * mz) + (in < 0 ? in : 0);
-        return soft_sd(sd, d->s);
-    }
+    case DENSITY_BOX: return soft_sd(box_sd(d, dx, dy, dz), d->s);
+    case DENSITY_CYLINDER: return soft_sd(cyl_sd(d, dx, dy, dz), d->s);
     }
     return 0;
 }
@@ -133,6 +139,54 @@ void density_eval_block(const density_shape *d, size_t n, const double *x, const
     }
     for (size_t i = 0; i < n; i++)
         out[i] = eval_one(d, r1sq, r0sq, x[i], y[i], z[i]);
+}
+
+/* The radius (sphere, torus) or offset (box, cylinder) of the level surface:
+ * {D >= level} is {d^2 <= rho^2} or {sd <= offset}. */
+static double level_param(const density_shape *d, double level)
+{
+    if (d->kind == DENSITY_BOX || d->kind == DENSITY_CYLINDER)
+        return d->s * (0.5 - level);
+    if (d->s == 0)
+        return d->r; /* the hard shape: the same surface for every level */
+    double r0sq, r1sq = radii(d->r, d->s, &r0sq);
+    double rho2 = r0sq - level * (r0sq - r1sq);
+    return rho2 > 0 ? sqrt(rho2) : 0;
+}
+
+static inline double sdf_one(const density_shape *d, double p, double x, double y, double z)
+{
+    double dx = x - d->c[0], dy = y - d->c[1], dz = z - d->c[2];
+    switch (d->kind) {
+    case DENSITY_SPHERE: return sqrt(dx * dx + dy * dy + dz * dz) - p;
+    case DENSITY_TORUS: {
+        double q = sqrt(dx * dx + dy * dy) - d->R;
+        return sqrt(q * q + dz * dz) - p;
+    }
+    case DENSITY_BOX: return box_sd(d, dx, dy, dz) - p;
+    case DENSITY_CYLINDER: return cyl_sd(d, dx, dy, dz) - p;
+    }
+    return NAN;
+}
+
+double density_sdf(const density_shape *d, double level, double x, double y, double z)
+{
+    return sdf_one(d, level_param(d, level), x, y, z);
+}
+
+void density_sdf_block(const density_shape *d, double level, size_t n, const double *x,
+                       const double *y, const double *z, double *out)
+{
+    double p = level_param(d, level);
+    for (size_t i = 0; i < n; i++)
+        out[i] = sdf_one(d, p, x[i], y[i], z[i]);
+}
+
+int density_sdf_exact(const density_shape *d, double level)
+{
+    if (d->s == 0 || d->kind == DENSITY_SPHERE || d->kind == DENSITY_TORUS)
+        return 1;
+    return level <= 0.5; /* an outward offset of a convex shape's distance is exact */
 }
 
 double density_smooth_union(double a, double b, double k)

@@ -29,6 +29,21 @@
  *            and a shell of width s centred on the surface, linear in sd:
  *              D = 1 if sd <= -s/2, 0 if sd >= s/2, else (s/2 - sd) / s.
  *
+ * Signed distance (density_sdf): the distance from x to the surface
+ * {D = level} of a shape, negative where D >= level (inside), for
+ * 0 < level <= 1. A hard shape (s = 0) is a 0/1 density and its surface is
+ * the same for every such level: the shape's own boundary. The distance is
+ *   sphere:   |x - c| - rho,          rho^2 = r0^2 - level (r0^2 - r1^2)
+ *   torus:    sqrt(q^2 + dz^2) - rho, q = sqrt(dx^2 + dy^2) - R, same rho
+ *   box, cylinder: sd - s (1/2 - level), sd as above.
+ * It is exact (the Euclidean distance to the surface, with sign) for every
+ * hard shape and for soft spheres and tori; for a soft box or cylinder it is
+ * exact outside the level surface and a lower bound inside it when
+ * level > 1/2 (an inward offset of a box by a constant is not its distance
+ * inside). Its zero set is the surface exactly in every case, and its
+ * gradient is the outward unit normal wherever the surface is smooth.
+ * density_eval is unchanged by this: the density values stay the seed's.
+ *
  * Combinations of densities: product, min, max are plain field ops;
  * density_smooth_union(a, b, k) is the polynomial smooth maximum
  *     h = max(k - |a - b|, 0) / k,  max(a, b) + h^2 k / 4,
@@ -82,6 +97,13 @@ rt_code density_check(const density_shape *d, rt_error *e);
 double density_eval(const density_shape *d, double x, double y, double z);
 void density_eval_block(const density_shape *d, size_t n, const double *x, const double *y,
                         const double *z, double *out);
+
+/* The signed distance to {D = level}; 0 < level <= 1 (callers check). */
+double density_sdf(const density_shape *d, double level, double x, double y, double z);
+void density_sdf_block(const density_shape *d, double level, size_t n, const double *x,
+                       const double *y, const double *z, double *out);
+/* 1 if density_sdf is the exact distance for this shape at this level. */
+int density_sdf_exact(const density_shape *d, double level);
 
 double density_smooth_union(double a, double b, double k);
 

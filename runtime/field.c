@@ -10,45 +10,7 @@
 
 #include "noise.h"
 
-enum {
-    FK_CONST,
-    FK_COORD,
-    FK_UNARY,
-    FK_BINARY,
-    FK_SELECT,
-    FK_CLAMP,
-    FK_LERP,
-    FK_WARP,
-    FK_EXTERNAL,
-    FK_PERLIN,
-    FK_FBM,
-    FK_TURB,
-    FK_DENSITY,
-    FK_SUNION,
-    FK_BIAS,
-    FK_GAIN,
-    FK_SMOOTHSTEP,
-    FK_STEP,
-    FK_AFFINE,
-};
-
-struct field {
-    int refs;
-    int kind;
-    int op;      /* unop/binop, or coordinate axis */
-    int nkids;
-    field *kid[4];
-    double k[2]; /* constant value; DMF / noise parameters */
-    int octaves;
-    uint64_t seed;
-    noise_perm *perm;      /* noise nodes */
-    density_shape shape;   /* FK_DENSITY */
-    rt_field_fn fn;        /* FK_EXTERNAL */
-    void *ctx;
-    void (*release)(void *ctx);
-    char name[32];
-    field *next; /* work list of field_unref */
-};
+#include "field_node.h"
 
 /* ---- names */
 
@@ -241,6 +203,16 @@ field *field_density(const density_shape *shape)
     return f;
 }
 
+field *field_shape_sdf(const density_shape *shape, double level)
+{
+    field *f = node_new(FK_SDF, 0, 0, NULL, NULL, NULL, NULL);
+    if (f) {
+        f->shape = *shape;
+        f->k[0] = level;
+    }
+    return f;
+}
+
 static field *param_node(int kind, field *t, field *u, double k0, double k1)
 {
     field *f = node_new(kind, 0, u ? 2 : 1, t, u, NULL, NULL);
@@ -358,8 +330,11 @@ static void print_rec(const field *f, bytebuf *b, size_t maxlen, int top)
         bytebuf_printf(b, "turbulence(seed: %llu, octaves: %d)", (unsigned long long)f->seed,
                        f->octaves);
         return;
+    case FK_SDF:
     case FK_DENSITY: {
         const density_shape *s = &f->shape;
+        if (f->kind == FK_SDF)
+            bytebuf_printf(b, "sdf(");
         bytebuf_printf(b, "%s(centre: [%g, %g, %g]", density_name(s->kind), s->c[0], s->c[1],
                        s->c[2]);
         if (s->kind == DENSITY_BOX)
@@ -371,6 +346,8 @@ static void print_rec(const field *f, bytebuf *b, size_t maxlen, int top)
         if (s->kind == DENSITY_CYLINDER)
             bytebuf_printf(b, ", half height: %g", s->h[2]);
         bytebuf_printf(b, ", soft: %g)", s->s);
+        if (f->kind == FK_SDF)
+            bytebuf_printf(b, ", level: %g)", f->k[0]);
         return;
     }
     default: break;
@@ -652,14 +629,16 @@ static int cnode(comp *c, const field *f, int fr, int depth)
     case FK_FBM:
     case FK_TURB:
     case FK_DENSITY:
+    case FK_SDF:
         in.op = f->kind == FK_EXTERNAL  ? FOP_EXTERNAL
+                : f->kind == FK_SDF     ? FOP_SDF
                 : f->kind == FK_PERLIN  ? FOP_PERLIN
                 : f->kind == FK_FBM     ? FOP_FBM
                 : f->kind == FK_TURB    ? FOP_TURB
                                         : FOP_DENSITY;
         in.a = co[0], in.b = co[1], in.c = co[2];
         in.ptr = f->kind == FK_EXTERNAL  ? (const void *)f->ctx
-                 : f->kind == FK_DENSITY ? (const void *)&f->shape
+                 : f->kind == FK_DENSITY || f->kind == FK_SDF ? (const void *)&f->shape
                                          : (const void *)f->perm;
         in.fn = f->fn;
         break;

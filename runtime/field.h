@@ -82,6 +82,45 @@
  * field_prog_scratch_size doubles instead (no allocation at all).
  * field_prog_fn has the exact rt_field_fn signature (ctx = the field_prog).
  *
+ * Distances (field_sdf.c). Where a field's solid {f >= level} is bounded
+ * by shapes, the runtime derives a second field g, its signed distance:
+ * g <= 0 exactly on the solid (up to the boundary itself), g = 0 on the
+ * surface, and |g| the Euclidean distance to the surface (exact) or a lower
+ * bound on it. The density values are not touched; g is a separate graph.
+ *   field_shape_sdf(&shape, level)  the distance to {D = level} of a shape
+ *                                  (density.h density_sdf; 0 < level <= 1)
+ *   field_level_sdf(f, level, &g, &exact)
+ *                                  g for {f >= level}, or *g = NULL when none
+ *                                  can be derived. What survives:
+ *     shape                     sdf (exact: hard shapes, soft sphere/torus)
+ *     translate/rotate/scale, and any warp whose x, y, z are affine in the
+ *       point, M P + t          g(M P + t) / sigma_max(M) (exact when M is a
+ *                               rotation times a positive scale; a lower
+ *                               bound otherwise)
+ *     c * f, f * c, f / c (c > 0), f + c, c + f, f - c, affine(f, a, b)
+ *                               the level moves (exactness kept)
+ *     c - f, -f, affine with a < 0, f < c, f <= c, c > f ...
+ *                               -g of the moved level (the complement)
+ *     f >= c, f > c, c <= f, step(f, c)   g of f at level c
+ *     clamp(f, lo, hi), bias, gain, smoothstep(e0 < e1)
+ *                               g of f at the inverse of the level
+ *     min(a, b) -> max(ga, gb), max(a, b) -> min(ga, gb) (a bound)
+ *     a * b, a and b, a or b, not a   for 0/1 fields ("indicators": hard
+ *                               shapes, comparisons, steps, and these)
+ *   Anything else (noise, smooth_union, a non-affine warp, a product with a
+ *   field that is not 0/1, numbers) gives none: the engines then use the
+ *   density alone, as before.
+ *   field_hard_support(f, &g)      g with f = 0 (or NaN) wherever g > 0, for
+ *                                  fields that vanish outside a hard region:
+ *                                  0/1 fields, and products, quotients,
+ *                                  maxima, affine(f, a, 0), bias and gain of
+ *                                  them, through affine warps. *g = NULL if
+ *                                  none.
+ *   field_prog_level_sdf / field_prog_hard_support: the same for a compiled
+ *   program's root, compiled (NULL when none).
+ * Analysis errors are only out-of-memory (RT_ENOMEM); a graph too large or
+ * too deep for it (over FIELD_SDF_BUDGET node visits) has no distance.
+ *
  * field_sample_volume fills an initialised volume (its nx, ny, nz, lo, hi
  * and v) with any rt_field_fn at the sample centres given in volume.h,
  * with par_for over z-slabs (one chunk per slice): the result does not
@@ -186,6 +225,12 @@ field *field_scale(field *child, double s);
  * inverse of the map that moves the object. */
 field *field_transform(field *child, const double m[12]);
 
+field *field_shape_sdf(const density_shape *shape, double level);
+
+#define FIELD_SDF_BUDGET 100000
+rt_code field_level_sdf(const field *f, double level, field **g, int *exact, rt_error *e);
+rt_code field_hard_support(const field *f, field **g, rt_error *e);
+
 /* 1 and *v = the value if f is a constant node. */
 int field_is_const(const field *f, double *v);
 
@@ -205,6 +250,10 @@ double field_prog_eval1(const field_prog *p, double x, double y, double z);
 size_t field_prog_scratch_size(const field_prog *p); /* in doubles */
 void field_prog_eval_scratch(const field_prog *p, double *scratch, size_t n, const double *x,
                              const double *y, const double *z, double *out);
+
+rt_code field_prog_level_sdf(const field_prog *p, double level, field_prog **g, int *exact,
+                             rt_error *e);
+rt_code field_prog_hard_support(const field_prog *p, field_prog **g, rt_error *e);
 
 /* Number of instructions and of registers (for tests and the REPL). */
 void field_prog_stats(const field_prog *p, size_t *ninstr, size_t *nregs);
@@ -231,6 +280,7 @@ enum {
     FOP_SMOOTHSTEP,                          /* k[0], k[1] = e0, e1 */
     FOP_STEP,                                /* k[0] = edge */
     FOP_AFFINE,                              /* k[0] a + k[1] */
+    FOP_SDF,                                 /* ptr = density_shape, k[0] = level */
     FOP_COUNT
 };
 

@@ -91,6 +91,7 @@ void field_run(const field_instr *code, size_t ncode, double *const *reg, size_t
             break;
         case FOP_TURB: noise_turbulence3_block(in->ptr, in->octaves, n, a, b, c, d); break;
         case FOP_DENSITY: density_eval_block(in->ptr, n, a, b, c, d); break;
+        case FOP_SDF: density_sdf_block(in->ptr, in->k[0], n, a, b, c, d); break;
         case FOP_SUNION: {
             double k = in->k[0];
             LOOP2(density_smooth_union(A, B, k));

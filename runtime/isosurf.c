@@ -157,6 +157,7 @@ typedef struct iso_job {
     uint32_t *tri_out; /* the mesh's triangle array */
     size_t *tri_at;    /* first triangle of each chunk in it */
     int *failed;     /* per chunk: allocation failure */
+    int32_t *edges;  /* with an sdf: each vertex's lattice edge (x, y, z, d) */
 } iso_job;
 
 static int in_range(const iso_job *j, int i, int k, int l)
@@ -261,6 +262,10 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         for (int a = 0; a < 3; a++)
             nv[a] = pad[a] < 0 ? -1.0 : pad[a] >= j->n[a] ? 1.0 : 0.0;
         j->cap[id] = 1;
+    }
+    if (j->edges) {
+        int32_t *E = j->edges + 4 * (size_t)id;
+        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
     }
     float *P = j->pos + 3 * (size_t)id;
     for (int a = 0; a < 3; a++) {
@@ -523,6 +528,113 @@ static void pass_attr(void *ctx, size_t c, int worker)
     }
 }
 
+/* Pass 2b (with an sdf): move each vertex to the root of g on its edge. */
+typedef struct root_job {
+    rt_field_fn g;
+    const void *ctx;
+    const iso_job *j;
+    mesh *m;
+} root_job;
+
+#define ROOT_ITERS 40
+
+static void pass_root(void *ctx, size_t c, int worker)
+{
+    (void)worker;
+    root_job *R = ctx;
+    const iso_job *j = R->j;
+    mesh *m = R->m;
+    size_t v0 = c * VCHUNK, v1 = v0 + VCHUNK < m->nv ? v0 + VCHUNK : m->nv;
+    double p[3][RT_BLOCK], q[3][RT_BLOCK], x[3][RT_BLOCK], gv[RT_BLOCK];
+    double sa[RT_BLOCK], sb[RT_BLOCK], ga[RT_BLOCK], gb[RT_BLOCK], s[RT_BLOCK];
+    int side[RT_BLOCK], live[RT_BLOCK];
+    size_t id[RT_BLOCK];
+    double tol = 1e-12 * fmin(j->cell[0], fmin(j->cell[1], j->cell[2]));
+    for (size_t b = v0; b < v1;) {
+        size_t n = 0;
+        for (; b < v1 && n < RT_BLOCK; b++) {
+            if (j->cap[b])
+                continue;
+            const int32_t *E = j->edges + 4 * b;
+            int d = E[3], qi[3] = {E[0] + (d & 1), E[1] + (d >> 1 & 1), E[2] + (d >> 2 & 1)};
+            for (int a = 0; a < 3; a++) {
+                p[a][n] = coord(j, a, E[a]);
+                q[a][n] = coord(j, a, qi[a]);
+            }
+            id[n++] = b;
+        }
+        if (!n)
+            continue;
+        R->g(R->ctx, n, p[0], p[1], p[2], ga);
+        R->g(R->ctx, n, q[0], q[1], q[2], gb);
+        size_t nl = 0;
+        for (size_t i = 0; i < n; i++) {
+            sa[i] = 0, sb[i] = 1, side[i] = 0;
+            /* a bracket in double precision, or keep the grid's vertex */
+            live[i] = isfinite(ga[i]) && isfinite(gb[i]) && (ga[i] <= 0) != (gb[i] <= 0);
+            s[i] = -1;
+            nl += (size_t)live[i];
+        }
+        for (int it = 0; it < ROOT_ITERS && nl; it++) {
+            for (size_t i = 0; i < n; i++) {
+                if (live[i]) {
+                    double t = (sa[i] * gb[i] - sb[i] * ga[i]) / (gb[i] - ga[i]);
+                    if (!(t > sa[i] && t < sb[i]))
+                        t = 0.5 * (sa[i] + sb[i]);
+                    s[i] = t;
+                }
+                double t = s[i] < 0 ? 0.5 : s[i]; /* finished rays are re-evaluated harmlessly */
+                for (int a = 0; a < 3; a++)
+                    x[a][i] = p[a][i] + t * (q[a][i] - p[a][i]);
+            }
+            R->g(R->ctx, n, x[0], x[1], x[2], gv);
+            for (size_t i = 0; i < n; i++) {
+                if (!live[i])
+                    continue;
+                double g = gv[i];
+                if (!isfinite(g) || fabs(g) <= tol || sb[i] - sa[i] <= 1e-15) {
+                    live[i] = 0, nl--;
+                    continue;
+                }
+                /* Illinois: halve the value kept twice on one side */
+                if ((g <= 0) == (ga[i] <= 0)) {
+                    sa[i] = s[i], ga[i] = g;
+                    if (side[i] == -1)
+                        gb[i] *= 0.5;
+                    side[i] = -1;
+                } else {
+                    sb[i] = s[i], gb[i] = g;
+                    if (side[i] == 1)
+                        ga[i] *= 0.5;
+                    side[i] = 1;
+                }
+            }
+        }
+        for (size_t i = 0; i < n; i++) {
+            if (s[i] < 0)
+                continue;
+            double t = s[i] < S_EPS ? S_EPS : s[i] > 1 - S_EPS ? 1 - S_EPS : s[i];
+            float *P = m->pos + 3 * id[i];
+            for (int a = 0; a < 3; a++)
+                P[a] = (float)(p[a][i] + t * (q[a][i] - p[a][i]));
+        }
+    }
+}
+
+typedef struct neg_ctx {
+    rt_field_fn f;
+    const void *ctx;
+} neg_ctx;
+
+static void neg_fn(const void *ctx, size_t n, const double *x, const double *y, const double *z,
+                   double *out)
+{
+    const neg_ctx *c = ctx;
+    c->f(c->ctx, n, x, y, z, out);
+    for (size_t i = 0; i < n; i++)
+        out[i] = -out[i];
+}
+
 static rt_code check_opts(const iso_opts *o, rt_error *e)
 {
     if (!isfinite(o->level))
@@ -537,7 +649,7 @@ static rt_code check_opts(const iso_opts *o, rt_error *e)
 }
 
 static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, const void *gctx,
-                       const rt_run *run, mesh *out, rt_error *e)
+                       const neg_ctx *sdf, const rt_run *run, mesh *out, rt_error *e)
 {
     int colours = o->colour_mode != ISO_COLOUR_NONE;
     mesh_init(out, o->normals, colours);
@@ -559,7 +671,7 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     if (!j)
         return rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
     j->vol = vol;
-    j->level = o->level;
+    j->level = sdf ? 0 : o->level; /* with an sdf, vol holds -g: inside is -g >= 0 */
     j->want_normals = o->normals != 0;
     for (int a = 0; a < 3; a++) {
         j->n[a] = nn[a];
@@ -600,7 +712,9 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     j->cap = rt_malloc(nv ? nv : 1);
     if (j->want_normals)
         j->nrm = rt_malloc((nv ? nv : 1) * 3 * sizeof(float));
-    if (!j->pos || !j->cap || (j->want_normals && !j->nrm)) {
+    if (sdf)
+        j->edges = rt_malloc((nv ? nv : 1) * 4 * sizeof(int32_t));
+    if (!j->pos || !j->cap || (j->want_normals && !j->nrm) || (sdf && !j->edges)) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface vertices", nv);
         goto done;
     }
@@ -651,6 +765,12 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     rc = par_for(run, "isosurface", j->nchunks, pass_concat, j);
     if (rc)
         goto fail_par;
+    if (sdf) {
+        root_job R = {sdf->f, sdf->ctx, j, out};
+        rc = par_for(run, "isosurface", (nv + VCHUNK - 1) / VCHUNK, pass_root, &R);
+        if (rc)
+            goto fail_par;
+    }
     if ((gf && j->want_normals) || colours) {
         attr_job aj;
         memset(&aj, 0, sizeof aj);
@@ -681,6 +801,7 @@ done:
     rt_free(j->pos);
     rt_free(j->nrm);
     rt_free(j->cap);
+    rt_free(j->edges);
     rt_free(j);
     return rc;
 }
@@ -688,7 +809,7 @@ done:
 rt_code iso_from_volume(const volume *vol, const iso_opts *opts, const rt_run *run, mesh *out,
                         rt_error *e)
 {
-    return run_iso(vol, opts, NULL, NULL, run, out, e);
+    return run_iso(vol, opts, NULL, NULL, NULL, run, out, e);
 }
 
 typedef struct sample_job {
@@ -748,10 +869,15 @@ rt_code iso_from_field(rt_field_fn f, const void *ctx, const double lo[3], const
     rt_code rc = volume_init(&vol, res[0], res[1], res[2], lo, hi, e);
     if (rc)
         return rc;
+    neg_ctx sd = {opts->sdf, opts->sdf_ctx};
+    if (opts->sdf) { /* sample -g: the solid is -g >= 0, normals -grad(-g) */
+        f = neg_fn;
+        ctx = &sd;
+    }
     rc = iso_sample_field(f, ctx, &vol, run, e);
     if (!rc) {
         mesh_free(out);
-        rc = run_iso(&vol, opts, f, ctx, run, out, e);
+        rc = run_iso(&vol, opts, f, ctx, opts->sdf ? &sd : NULL, run, out, e);
     }
     volume_free(&vol);
     return rc;

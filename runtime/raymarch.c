@@ -50,6 +50,9 @@ void rm_volume_field(const void *ctx, size_t n, const double *x, const double *y
 typedef struct rm_job {
     rt_field_fn f;
     const void *ctx;
+    double thr;            /* solid mode: inside when f >= thr */
+    rt_field_fn g;         /* emission: the hard support, or NULL */
+    const void *gctx;
     const camera *cam;
     const rm_opts *o;
     image *im;
@@ -69,6 +72,7 @@ typedef struct rays {
     double px[RT_BLOCK], py[RT_BLOCK], pz[RT_BLOCK], v[RT_BLOCK];
     double qx[RT_BLOCK], qy[RT_BLOCK], qz[RT_BLOCK];
     double g[3][RT_BLOCK], tmp[RT_BLOCK], tmp2[RT_BLOCK];
+    double gprev[RT_BLOCK], seg[RT_BLOCK], tm[RT_BLOCK]; /* emission with a support */
 } rays;
 
 /* Slab intersection of eye + t·dir with the box; returns 0 on a miss. */
@@ -140,19 +144,145 @@ static void point_at(const rm_job *j, const rays *r, size_t i, double t, double 
     *z = eye[2] + t * r->dir[i][2];
 }
 
+/* g at one point of ray i; not a number counts as far outside. */
+static double g_at(const rm_job *j, const rays *r, size_t i, double t)
+{
+    double x, y, z, v;
+    point_at(j, r, i, t, &x, &y, &z);
+    j->g(j->gctx, 1, &x, &y, &z, &v);
+    return v <= 0 || v > 0 ? v : INFINITY;
+}
+
+/* The root of g on [a, b] (ga, gb of opposite signs): Illinois. */
+static double g_root(const rm_job *j, const rays *r, size_t i, double a, double b, double ga,
+                     double gb)
+{
+    double tol = 1e-12 * j->o->step;
+    int side = 0;
+    double t = 0.5 * (a + b);
+    for (int it = 0; it < 60 && b - a > tol; it++) {
+        t = (a * gb - b * ga) / (gb - ga);
+        if (!(t > a && t < b))
+            t = 0.5 * (a + b);
+        double gt = g_at(j, r, i, t);
+        if (fabs(gt) <= tol)
+            break;
+        if ((gt <= 0) == (ga <= 0)) {
+            a = t, ga = gt;
+            if (side == -1)
+                gb *= 0.5;
+            side = -1;
+        } else {
+            b = t, gb = gt;
+            if (side == 1)
+                ga *= 0.5;
+            side = 1;
+        }
+    }
+    return t;
+}
+
+static void add_piece(rays *r, size_t i, double a, double b, double *best)
+{
+    r->seg[i] += b - a;
+    if (b - a > *best) {
+        *best = b - a;
+        r->tm[i] = 0.5 * (a + b);
+    }
+}
+
+/* The inside length of [a, b] on ray i into r->seg[i] (see raymarch.h). */
+static void seg_inside(const rm_job *j, rays *r, size_t i, double a, double b, double ga, double gb,
+                       int depth, double *best)
+{
+    double L = b - a; /* rays have unit direction: t is length */
+    if (ga > 0 && gb > 0 && ga + gb >= L)
+        return;
+    if (ga <= 0 && gb <= 0 && ga + gb <= -L) {
+        add_piece(r, i, a, b, best);
+        return;
+    }
+    if (depth >= 6) {
+        if ((ga <= 0) == (gb <= 0)) {
+            if (ga <= 0)
+                add_piece(r, i, a, b, best);
+            return;
+        }
+        double t = g_root(j, r, i, a, b, ga, gb);
+        if (ga <= 0)
+            add_piece(r, i, a, t, best);
+        else
+            add_piece(r, i, t, b, best);
+        return;
+    }
+    double m = 0.5 * (a + b), gm = g_at(j, r, i, m);
+    seg_inside(j, r, i, a, m, ga, gm, depth + 1, best);
+    seg_inside(j, r, i, m, b, gm, gb, depth + 1, best);
+}
+
+/* With a support: g at the end of step k of each active ray (in a block),
+ * then each ray's inside length and sample point for the step. */
+static void support_step(const rm_job *j, rays *r, size_t n, long k)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (r->done[i] || k >= r->nstep[i])
+            continue;
+        point_at(j, r, i, r->t0[i] + (k + 1) * r->dt[i], &r->px[m], &r->py[m], &r->pz[m]);
+        r->idx[m++] = i;
+    }
+    if (!m)
+        return;
+    j->g(j->gctx, m, r->px, r->py, r->pz, r->v);
+    for (size_t s = 0; s < m; s++) {
+        size_t i = r->idx[s];
+        double gb = r->v[s] <= 0 || r->v[s] > 0 ? r->v[s] : INFINITY, best = 0;
+        double a = r->t0[i] + k * r->dt[i], b = r->t0[i] + (k + 1) * r->dt[i];
+        r->seg[i] = 0;
+        seg_inside(j, r, i, a, b, r->gprev[i], gb, 0, &best);
+        r->gprev[i] = gb;
+    }
+}
+
 static void march_emission(const rm_job *j, rays *r, size_t n)
 {
     const rm_opts *o = j->o;
+    if (j->g) { /* g at each ray's entry */
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (r->done[i])
+                continue;
+            point_at(j, r, i, r->t0[i], &r->px[m], &r->py[m], &r->pz[m]);
+            r->idx[m++] = i;
+        }
+        if (m)
+            j->g(j->gctx, m, r->px, r->py, r->pz, r->v);
+        for (size_t s = 0; s < m; s++)
+            r->gprev[r->idx[s]] = r->v[s] <= 0 || r->v[s] > 0 ? r->v[s] : INFINITY;
+    }
     for (long k = 0;; k++) {
-        size_t na = 0;
+        size_t na = 0, live = 0;
+        if (j->g)
+            support_step(j, r, n, k);
         for (size_t i = 0; i < n; i++) {
             if (r->done[i] || k >= r->nstep[i])
                 continue;
-            point_at(j, r, i, r->t0[i] + (k + 0.5) * r->dt[i], &r->px[na], &r->py[na], &r->pz[na]);
+            live++;
+            double t = r->t0[i] + (k + 0.5) * r->dt[i];
+            if (j->g) {
+                if (!(r->seg[i] > 0))
+                    continue; /* wholly outside the support: no density */
+                t = r->tm[i];
+            } else {
+                r->seg[i] = r->dt[i];
+            }
+            point_at(j, r, i, t, &r->px[na], &r->py[na], &r->pz[na]);
             r->idx[na++] = i;
         }
-        if (!na)
+        if (!live)
             break;
+        if (!na)
+            continue;
         j->f(j->ctx, na, r->px, r->py, r->pz, r->v);
         size_t nl = 0; /* samples needing a normal */
         if (o->lighting) {
@@ -172,7 +302,7 @@ static void march_emission(const rm_job *j, rays *r, size_t n)
             double rho = r->v[s] > 0 ? r->v[s] : 0; /* NaN -> 0 */
             if (rho == 0)
                 continue;
-            double alpha = 1 - exp(-o->sigma * rho * r->dt[i]);
+            double alpha = 1 - exp(-o->sigma * rho * r->seg[i]);
             float c[4];
             if (o->emission_ramp)
                 ramp_eval(o->emission_ramp, rho, c);
@@ -196,7 +326,7 @@ static void march_emission(const rm_job *j, rays *r, size_t n)
 static void march_solid(const rm_job *j, rays *r, size_t n)
 {
     const rm_opts *o = j->o;
-    double thr = o->threshold;
+    double thr = j->thr;
     for (long k = 0;; k++) {
         size_t na = 0;
         for (size_t i = 0; i < n; i++) {
@@ -293,6 +423,20 @@ static void row_fn(void *ctx, size_t chunk, int worker)
     }
 }
 
+typedef struct rm_neg {
+    rt_field_fn f;
+    const void *ctx;
+} rm_neg;
+
+static void neg_fn(const void *ctx, size_t n, const double *x, const double *y, const double *z,
+                   double *out)
+{
+    const rm_neg *c = ctx;
+    c->f(c->ctx, n, x, y, z, out);
+    for (size_t i = 0; i < n; i++)
+        out[i] = -out[i];
+}
+
 rt_code rm_render(rt_field_fn f, const void *ctx, const camera *cam, const rm_opts *o,
                   const rt_run *run, image *im, rt_error *e)
 {
@@ -331,6 +475,15 @@ rt_code rm_render(rt_field_fn f, const void *ctx, const camera *cam, const rm_op
     rm_job j;
     j.f = f;
     j.ctx = ctx;
+    j.thr = o->threshold;
+    j.g = o->mode == RM_EMISSION ? o->support : NULL;
+    j.gctx = o->support_ctx;
+    rm_neg neg = {o->sdf, o->sdf_ctx};
+    if (o->mode == RM_SOLID && o->sdf) { /* march -g against 0: inside is g <= 0 */
+        j.f = neg_fn;
+        j.ctx = &neg;
+        j.thr = 0;
+    }
     j.cam = cam;
     j.o = o;
     j.im = im;
