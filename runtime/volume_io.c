@@ -509,7 +509,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
             hi[k] = fhi[k];
         }
         if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k])) {
-            free(file);
+            rt_free(file);
             return rt_fail(e, RT_EFORMAT, "NRRD origin and spacing give axis %d the bounds %g .. %g (not finite and increasing)",
                            k, lo[k], hi[k]);
         }
