@@ -50,20 +50,6 @@ int num_list_value(interp *I, const double *x, size_t n, value *out)
     return 0;
 }
 
-err_kind lang_rt_kind(rt_code c)
-{
-    switch (c) {
-    case RT_ENOMEM: return ERR_MEMORY;
-    case RT_EIO: return ERR_IO;
-    case RT_ECANCEL: return ERR_INTERRUPT;
-    case RT_ELIMIT: return ERR_LIMIT;
-    case RT_OK: /* not a failure; callers never pass it */
-    case RT_EFORMAT:
-    case RT_EINVAL: break;
-    }
-    return ERR_VALUE;
-}
-
 int lang_join_path(interp *I, const node *at, const char *dir, const char *p, size_t plen, char *buf, size_t n,
                    const char *what)
 {

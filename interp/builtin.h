@@ -71,7 +71,7 @@ typedef struct builtin {
 #define BUILTIN(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 0, doc}
 #define BUILTIN_VAR(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 1, doc}
 
-/* Register a table of builtins (static storage) as globals. */
+/* The registry (builtin.c). Register a table of builtins (static storage) as globals. */
 int builtins_register(interp *I, const builtin *b, int n);
 /* All modules' registration functions, called by interp setup. */
 int builtins_core_init(interp *I);
@@ -82,9 +82,15 @@ int bind_volume_init(interp *I);
 int bind_field_init(interp *I);
 int bind_ifs_init(interp *I);
 int bind_solid_init(interp *I);
+int bind_ist_init(interp *I);
 int bind_wrinkly_init(interp *I);
+int bind_raster_init(interp *I);
 int bind_show_init(interp *I);
 int bind_fset_init(interp *I);
+int bind_shape_init(interp *I);
+int bind_tops_init(interp *I);
+int bind_superifs_init(interp *I);
+int bind_tiles_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
 int call_value(interp *I, value fn, const value *args, int nargs, value *out);

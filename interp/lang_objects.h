@@ -52,7 +52,7 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
-/* The one map from runtime codes to error kinds (args.c): RT_ENOMEM ->
+/* The one map from runtime codes to error kinds (lang_objects.c): RT_ENOMEM ->
  * ERR_MEMORY (exit 70), RT_EIO -> ERR_IO (74), RT_ECANCEL -> ERR_INTERRUPT
  * (130), RT_ELIMIT -> ERR_LIMIT (65), RT_EFORMAT and RT_EINVAL -> ERR_VALUE (65). */
 err_kind lang_rt_kind(rt_code c);
