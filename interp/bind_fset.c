@@ -143,7 +143,7 @@ int lang_get_fset(interp *I, value v, int list_is_sets, value *out, const char *
     if (!one && v.k == V_LIST && AS_LIST(v)->n > 0) {
         value f0 = AS_LIST(v)->items[0];
         if ((f0.k == V_LIST && AS_LIST(f0)->n > 0 && AS_LIST(f0)->items[0].k == V_NUM) ||
-            (f0.k == V_OBJ && AS_OBJ(f0)->cls == &map_class))
+            (f0.k == V_OBJ && AS_OBJ(f0)->cls == &lang_map_class))
             one = 1;
     }
     if (!one && v.k != V_LIST)
@@ -237,7 +237,7 @@ static int order_get(interp *I, const void *pp, const char *name, value *out)
         if (l.k == V_NIL)
             return -1;
         for (int i = 0; i < o->o.len; i++)
-            if (list_push(I, AS_LIST(l), val_num(o->seq[i] + 1))) {
+            if (val_list_push(I, AS_LIST(l), val_num(o->seq[i] + 1))) {
                 val_unref(I, l);
                 return -1;
             }
@@ -289,7 +289,7 @@ static int b_order(interp *I, value *a, int n, value *out)
             mem_free(I, o);
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         }
-        if (get_vec(I, pr, o->p, np, "order: probabilities") || arg_seed(I, a[3], &o->o.seed, "order")) {
+        if (builtin_get_vec(I, pr, o->p, np, "order: probabilities") || lang_arg_seed(I, a[3], &o->o.seed, "order")) {
             order_destroy(o);
             return -1;
         }
@@ -336,7 +336,7 @@ static int b_order(interp *I, value *a, int n, value *out)
                 if (x.k != V_NUM || x.u.n != floor(x.u.n) || x.u.n < 1 || x.u.n > 4096) {
                     char got[40];
                     if (x.k == V_NUM)
-                        fmt_number(x.u.n, got, sizeof got);
+                        val_fmt_number(x.u.n, got, sizeof got);
                     else
                         snprintf(got, sizeof got, "%s", val_type_name(x));
                     err_item(I, sq, i, ERR_VALUE, "order: item %zu must be a set number from 1 (W1) to 4096, got %s",
@@ -405,7 +405,7 @@ int lang_points_arg(interp *I, value v, uint64_t *out, const char *what)
 int lang_window_arg(interp *I, value v, double lo[2], double hi[2], const char *what)
 {
     double win[4];
-    if (get_vec(I, v, win, 4, what))
+    if (builtin_get_vec(I, v, win, 4, what))
         return -1;
     lo[0] = win[0];
     hi[0] = win[1];
@@ -535,9 +535,9 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     long depth;
     if (lang_order_arg(I, a[1], 1, f->n, &o, &tmp, "chaos_fset"))
         goto done;
-    if (lang_points_arg(I, a[2], &co.points, "chaos_fset") || arg_size2(I, a[3], &w, &h, "chaos_fset: size") ||
-        lang_tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || arg_seed(I, a[14], &co.seed, "chaos_fset") ||
-        get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
+    if (lang_points_arg(I, a[2], &co.points, "chaos_fset") || lang_arg_size2(I, a[3], &w, &h, "chaos_fset: size") ||
+        lang_tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || lang_arg_seed(I, a[14], &co.seed, "chaos_fset") ||
+        builtin_get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
         goto done;
     if (f->dim != 2) {
         err_arg(I, 0, ERR_VALUE, "chaos_fset: the function set is 3-D; the chaos game draws 2-D sets (use iterate for 3-D shapes)");
@@ -633,5 +633,5 @@ static const builtin fset_builtins[] = {
 
 int bind_fset_init(interp *I)
 {
-    return builtins_register(I, fset_builtins, (int)(sizeof fset_builtins / sizeof fset_builtins[0]));
+    return builtin_register(I, fset_builtins, (int)(sizeof fset_builtins / sizeof fset_builtins[0]));
 }

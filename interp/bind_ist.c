@@ -55,14 +55,14 @@ static int ist_get(interp *I, const void *p, const char *name, value *out)
     else if (strcmp(name, "closed_form") == 0)
         *out = val_bool(t->closed);
     else if (strcmp(name, "bounds") == 0)
-        return num_list_value(I, t->bounds, (size_t)t->n + 1, out);
+        return lang_num_list_value(I, t->bounds, (size_t)t->n + 1, out);
     else if (strcmp(name, "crossings") == 0) {
         double *m = mem_alloc(I, sizeof(double) * (size_t)t->n);
         if (!m)
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         for (int i = 0; i < t->n; i++)
             m[i] = t->ms[i];
-        int r = num_list_value(I, m, (size_t)t->n, out);
+        int r = lang_num_list_value(I, m, (size_t)t->n, out);
         mem_free(I, m);
         return r;
     } else
@@ -210,7 +210,7 @@ static int ist_map(interp *I, value *a, int fwd, value *out)
         return -1;
     for (size_t i = 0; i < l->n; i++) {
         double u = l->items[i].u.n;
-        if (list_push(I, AS_LIST(r), val_num(fwd ? ist_fwd(t, u) : ist_inv(t, u)))) {
+        if (val_list_push(I, AS_LIST(r), val_num(fwd ? ist_fwd(t, u) : ist_inv(t, u)))) {
             val_unref(I, r);
             return -1;
         }
@@ -303,7 +303,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
         goto done;
     }
     uint64_t seed;
-    if (arg_seed(I, a[3], &seed, "ist_samples"))
+    if (lang_arg_seed(I, a[3], &seed, "ist_samples"))
         goto done;
     pos = mem_alloc(I, sizeof(double) * ((size_t)count + 1));
     if (!pos) {
@@ -315,7 +315,7 @@ static int b_ist_samples(interp *I, value *a, int n, value *out)
         err_at(I, NULL, ERR_VALUE, "ist_samples: too many sub-intervals; lower the levels");
         goto done;
     }
-    rc = num_list_value(I, pos, got, out);
+    rc = lang_num_list_value(I, pos, got, out);
 done:
     mem_free(I, ki);
     mem_free(I, pos);
@@ -347,5 +347,5 @@ static const builtin ist_builtins[] = {
 
 int bind_ist_init(interp *I)
 {
-    return builtins_register(I, ist_builtins, (int)(sizeof ist_builtins / sizeof ist_builtins[0]));
+    return builtin_register(I, ist_builtins, (int)(sizeof ist_builtins / sizeof ist_builtins[0]));
 }

@@ -70,7 +70,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
                             i, val_type_name(it));
     }
     int w, h;
-    if (arg_size2(I, a[2], &w, &h, "rasterize: size"))
+    if (lang_arg_size2(I, a[2], &w, &h, "rasterize: size"))
         return -1;
     raster_opts ro;
     raster_opts_default(&ro);
@@ -78,7 +78,7 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
         lang_get_colour(I, a[9], ro.colour, "rasterize: colour"))
         return -1;
     if (a[4].k != V_NIL) {
-        if (get_vec(I, a[4], ro.light, 3, "rasterize: light"))
+        if (builtin_get_vec(I, a[4], ro.light, 3, "rasterize: light"))
             return -1;
         if (ro.light[0] == 0 && ro.light[1] == 0 && ro.light[2] == 0)
             return err_arg(I, 4, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
@@ -206,5 +206,5 @@ static const builtin raster_builtins[] = {
 
 int bind_raster_init(interp *I)
 {
-    return builtins_register(I, raster_builtins, (int)(sizeof raster_builtins / sizeof raster_builtins[0]));
+    return builtin_register(I, raster_builtins, (int)(sizeof raster_builtins / sizeof raster_builtins[0]));
 }

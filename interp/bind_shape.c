@@ -71,7 +71,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
         b[1] = hi[0];
         b[2] = lo[1];
         b[3] = hi[1];
-        return num_list_value(I, b, (size_t)(4), out);
+        return lang_num_list_value(I, b, (size_t)(4), out);
     } else if (strcmp(name, "coords") == 0) {
         if ((double)s->nverts > I->lim.max_list)
             return err_at(I, NULL, ERR_LIMIT, "shape.coords: %zu vertices exceed the list limit of %.0f (raise it with --max-list)",
@@ -81,7 +81,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
             return -1;
         for (size_t i = 0; i < s->nverts; i++) {
             value p;
-            if (num_list_value(I, s->v + i * (size_t)s->dim, (size_t)(s->dim), &p) || list_push(I, AS_LIST(l), p)) {
+            if (lang_num_list_value(I, s->v + i * (size_t)s->dim, (size_t)(s->dim), &p) || val_list_push(I, AS_LIST(l), p)) {
                 val_unref(I, l);
                 return -1;
             }
@@ -169,7 +169,7 @@ static int shape_arith(interp *I, int op, value a, value b, value *out)
     const affine *m = NULL;
     double t[3] = {0, 0, 0}, k = 1;
     int kind;
-    if (other.k == V_OBJ && AS_OBJ(other)->cls == &map_class && y && op == T_STAR) {
+    if (other.k == V_OBJ && AS_OBJ(other)->cls == &lang_map_class && y && op == T_STAR) {
         m = AS_OBJ(other)->payload;
         kind = 0;
     } else if (other.k == V_LIST && (op == T_PLUS || (op == T_MINUS && x))) {
@@ -177,7 +177,7 @@ static int shape_arith(interp *I, int op, value a, value b, value *out)
         if ((int)nn != src->dim)
             return err_at(I, NULL, ERR_VALUE, "shape %s: a %d-D shape moves by a list of %d numbers, got %zu",
                           op == T_PLUS ? "+" : "-", src->dim, src->dim, nn);
-        if (get_vec(I, other, t, nn, "shape offset"))
+        if (builtin_get_vec(I, other, t, nn, "shape offset"))
             return -1;
         if (op == T_MINUS)
             for (int i = 0; i < 3; i++)
@@ -249,7 +249,7 @@ static int make_shape(interp *I, value *a, int n, detiter_kind kind, const char 
         }
         char w[64];
         snprintf(w, sizeof w, "%s: point %d", what, i + 1);
-        if (get_vec(I, pts[i], v + (size_t)i * (size_t)dim, (size_t)dim, w)) {
+        if (builtin_get_vec(I, pts[i], v + (size_t)i * (size_t)dim, (size_t)dim, w)) {
             mem_free(I, v);
             return -1;
         }
@@ -423,7 +423,7 @@ static int b_draw(interp *I, value *a, int n, value *out)
     if (onto) {
         w = onto->w;
         h = onto->h;
-    } else if (arg_size2(I, a[1], &w, &h, "draw: size"))
+    } else if (lang_arg_size2(I, a[1], &w, &h, "draw: size"))
         return -1;
     if (lang_get_colour(I, a[3], col, "draw: colour") || fill_arg(I, a[6], &fill, fillc, col, "draw: fill") ||
         lang_get_colour(I, a[7], bg, "draw: background"))
@@ -448,8 +448,8 @@ static int opt_colour(interp *I, value opts, const char *key, float rgba[4], int
     *found = 0;
     if (opts.k != V_REC)
         return 0;
-    const char *k = intern(I, key, strlen(key));
-    value *v = k ? rec_get(AS_REC(opts), k) : NULL;
+    const char *k = interp_intern(I, key, strlen(key));
+    value *v = k ? val_rec_get(AS_REC(opts), k) : NULL;
     if (!v || v->k == V_NIL)
         return 0;
     if (v->k == V_BOOL) {
@@ -472,12 +472,12 @@ static int shape_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE, "save: a shape is saved as .svg (draw it with draw(…) for a picture), got '.%s'",
                       ext);
     double size = 512, width = 1, radius = 1, prec = 3;
-    if (opts_check(I, opts,
+    if (contract_check_opts(I, opts,
                    "rec{size: int[1,1000000], width: num[0,1000], radius: num[0,1000], precision: int[0,9], "
                    "colour: nil|bool|" TY_COLOUR ", fill: nil|bool|" TY_COLOUR ", background: nil|bool|" TY_COLOUR "}",
                    "save") ||
-        opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
-        opt_num(I, opts, "radius", &radius) < 0 || opt_num(I, opts, "precision", &prec) < 0)
+        lang_opt_num(I, opts, "size", &size) < 0 || lang_opt_num(I, opts, "width", &width) < 0 ||
+        lang_opt_num(I, opts, "radius", &radius) < 0 || lang_opt_num(I, opts, "precision", &prec) < 0)
         return -1;
     draw_style st;
     memset(&st, 0, sizeof st);
@@ -553,5 +553,5 @@ static const builtin shape_builtins[] = {
 
 int bind_shape_init(interp *I)
 {
-    return builtins_register(I, shape_builtins, (int)(sizeof shape_builtins / sizeof shape_builtins[0]));
+    return builtin_register(I, shape_builtins, (int)(sizeof shape_builtins / sizeof shape_builtins[0]));
 }

@@ -63,7 +63,7 @@ static int superifs_get(interp *I, const void *pp, const char *name, value *out)
         if (l.k == V_NIL)
             return -1;
         for (int v = 0; v < s->st.V; v++)
-            if (list_push(I, AS_LIST(l), s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1))) {
+            if (val_list_push(I, AS_LIST(l), s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1))) {
                 val_unref(I, l);
                 return -1;
             }
@@ -95,8 +95,8 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     memset(&so, 0, sizeof so);
     long V = (long)a[2].u.n, steps = (long)a[4].u.n; /* declared int[1,1024], int[0,100000] */
     uint64_t pts = 0;
-    if (lang_points_arg(I, a[3], &pts, "superifs") || get_vec(I, a[5], so.start, 2, "superifs: start") ||
-        arg_seed(I, a[6], &so.seed, "superifs"))
+    if (lang_points_arg(I, a[3], &pts, "superifs") || builtin_get_vec(I, a[5], so.start, 2, "superifs: start") ||
+        lang_arg_seed(I, a[6], &so.seed, "superifs"))
         goto done;
     if (f->dim != 2) {
         err_arg(I, 0, ERR_VALUE, "superifs: the IFSs are 3-D; a super IFS needs 2-D maps");
@@ -113,7 +113,7 @@ static int b_superifs(interp *I, value *a, int n, value *out)
             err_at(I, NULL, ERR_MEMORY, "out of memory");
             goto done;
         }
-        if (get_vec(I, a[1], P, np, "superifs: probabilities"))
+        if (builtin_get_vec(I, a[1], P, np, "superifs: probabilities"))
             goto done;
         double sum = 0; /* each in [0, 1] (declared) */
         for (size_t i = 0; i < np; i++)
@@ -168,7 +168,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
     tonemap_opts t;
     if (buf > s->st.V)
         return err_arg(I, 1, ERR_VALUE, "superifs_image: buffer must be between 1 and V = %d, got %ld", s->st.V, buf);
-    if (arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
+    if (lang_arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
         lang_tone_args(I, a[4], a[5], a[6], a[7], a[8], &t, &r, "superifs_image"))
         return -1;
     double lo[2], hi[2];
@@ -235,5 +235,5 @@ static const builtin superifs_builtins[] = {
 
 int bind_superifs_init(interp *I)
 {
-    return builtins_register(I, superifs_builtins, (int)(sizeof superifs_builtins / sizeof superifs_builtins[0]));
+    return builtin_register(I, superifs_builtins, (int)(sizeof superifs_builtins / sizeof superifs_builtins[0]));
 }

@@ -44,7 +44,7 @@ static int b_tiling(interp *I, value *a, int n, value *out)
     (void)n;
     const image *t = lang_as_image(a[0]);
     int w, h;
-    if (arg_size2(I, a[1], &w, &h, "tiling: size"))
+    if (lang_arg_size2(I, a[1], &w, &h, "tiling: size"))
         return -1;
     if ((double)w * h > I->lim.max_pixels)
         return err_at(I, NULL, ERR_LIMIT,
@@ -74,5 +74,5 @@ static const builtin tiles_builtins[] = {
 
 int bind_tiles_init(interp *I)
 {
-    return builtins_register(I, tiles_builtins, (int)(sizeof tiles_builtins / sizeof tiles_builtins[0]));
+    return builtin_register(I, tiles_builtins, (int)(sizeof tiles_builtins / sizeof tiles_builtins[0]));
 }

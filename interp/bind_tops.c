@@ -52,9 +52,9 @@ static int b_top(interp *I, value *a, int n, value *out)
     float bg[4];
     long nsym = (long)a[5].u.n; /* declared int[1,64] */
     to.depth = (int)a[6].u.n;   /* declared int[0,64] */
-    if (arg_size2(I, a[1], &w, &h, "top: size") || lang_points_arg(I, a[2], &to.points, "top") ||
+    if (lang_arg_size2(I, a[1], &w, &h, "top: size") || lang_points_arg(I, a[2], &to.points, "top") ||
         lang_get_ramp(I, a[4], &r, "top: palette") || lang_get_colour(I, a[7], bg, "top: background") ||
-        arg_seed(I, a[8], &to.seed, "top"))
+        lang_arg_seed(I, a[8], &to.seed, "top"))
         return -1;
     if (li->f.dim != 2)
         return err_arg(I, 0, ERR_VALUE, "top: the IFS is 3-D; fractal tops need 2-D maps");
@@ -107,13 +107,13 @@ static int steal_args(interp *I, value *a, int k, steal_setup *s, int src_w, int
     memset(s, 0, sizeof *s);
     char wn[64];
     snprintf(wn, sizeof wn, "%s: size", what);
-    if (arg_size2(I, a[k], &s->w, &s->h, wn) || lang_points_arg(I, a[k + 1], &s->to.points, what))
+    if (lang_arg_size2(I, a[k], &s->w, &s->h, wn) || lang_points_arg(I, a[k + 1], &s->to.points, what))
         return -1;
     snprintf(wn, sizeof wn, "%s: background", what);
     if (lang_get_colour(I, a[k + 4], s->bg, wn))
         return -1;
     s->to.depth = (int)a[k + 5].u.n; /* declared int[0,64] */
-    if (arg_seed(I, a[k + 6], &s->to.seed, what))
+    if (lang_arg_seed(I, a[k + 6], &s->to.seed, what))
         return -1;
     if (fi->f.n != gi->f.n)
         return err_arg(I, 1, ERR_VALUE,
@@ -237,7 +237,7 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
         }
         *im = res[i];
         res[i].px = NULL;
-        if (lang_image_value(I, im, &v) || list_push(I, AS_LIST(l), v)) {
+        if (lang_image_value(I, im, &v) || val_list_push(I, AS_LIST(l), v)) {
             i++;
             break;
         }
@@ -283,5 +283,5 @@ static const builtin tops_builtins[] = {
 
 int bind_tops_init(interp *I)
 {
-    return builtins_register(I, tops_builtins, (int)(sizeof tops_builtins / sizeof tops_builtins[0]));
+    return builtin_register(I, tops_builtins, (int)(sizeof tops_builtins / sizeof tops_builtins[0]));
 }

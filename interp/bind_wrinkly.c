@@ -60,7 +60,7 @@ static int get_style(interp *I, value tension, value shuffle, value crack, value
     o->crack_band = crack.u.n;
     o->jitter = jitter.u.b;
     o->extra = (int)extra.u.n;
-    return arg_seed(I, seed, &o->seed, what);
+    return lang_arg_seed(I, seed, &o->seed, what);
 }
 
 static void style_summary(const wrinkly_opts *o, bytebuf *out)
@@ -252,7 +252,7 @@ static int b_wrinkly_curve(interp *I, value *a, int n, value *out)
             err_item(I, a[0], i, ERR_VALUE, "%s must be a list of 2 numbers, got %s", w, got);
             goto fail;
         }
-        if (get_vec(I, pt, c->pts[i].pos, 2, w)) /* numbers: finite (declared list) */
+        if (builtin_get_vec(I, pt, c->pts[i].pos, 2, w)) /* numbers: finite (declared list) */
             goto fail;
     }
     if (fill_scalar(I, a[1], 0, c->n, c->pts, 0, W, "heights") || fill_colours(I, a[2], 0, c->n, c->pts, W) ||
@@ -341,7 +341,7 @@ static int b_wrinkly_points(interp *I, value *a, int n, value *out)
         goto oom;
     for (size_t i = 0; i < pl.n; i++) {
         value pt;
-        if (num_list_value(I, pl.xy + 2 * i, 2, &pt) || list_push(I, AS_LIST(r), pt)) {
+        if (lang_num_list_value(I, pl.xy + 2 * i, 2, &pt) || val_list_push(I, AS_LIST(r), pt)) {
             val_unref(I, r);
             goto oom;
         }
@@ -390,7 +390,7 @@ static int get_view(interp *I, const curve_obj *c, value bounds, int w, int h, d
         snprintf(m, sizeof m, "%s: bounds", what);
         if (l->n != 2 || l->items[0].k != V_LIST || l->items[1].k != V_LIST)
             return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must be [[xmin, ymin], [xmax, ymax]]", what);
-        if (get_vec(I, l->items[0], lo, 2, m) || get_vec(I, l->items[1], hi, 2, m))
+        if (builtin_get_vec(I, l->items[0], lo, 2, m) || builtin_get_vec(I, l->items[1], hi, 2, m))
             return -1;
         if (!(hi[0] > lo[0] && hi[1] > lo[1]))
             return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must have xmin < xmax and ymin < ymax", what);
@@ -480,7 +480,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     if (onto) {
         w = onto->w;
         h = onto->h;
-    } else if (arg_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
+    } else if (lang_arg_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
         return -1;
     }
     draw_view v;
@@ -548,9 +548,9 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE,
                       "save: a wrinkly curve is saved as .svg (draw it with wrinkly_draw for a picture), got '.%s'", ext);
     double size = 512, width = 1.5, iters = -1;
-    if (opts_check(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int[0,20]}", "save") ||
-        opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
-        opt_num(I, opts, "iterations", &iters) < 0)
+    if (contract_check_opts(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int[0,20]}", "save") ||
+        lang_opt_num(I, opts, "size", &size) < 0 || lang_opt_num(I, opts, "width", &width) < 0 ||
+        lang_opt_num(I, opts, "iterations", &iters) < 0)
         return -1;
     draw_view v;
     if (get_view(I, c, val_nil(), (int)size, (int)size, &v, "save"))
@@ -636,11 +636,11 @@ static void get_axis(interp *I, value v, wrinkly_axis *ax)
     if (v.k == V_NIL)
         return;
     double x;
-    if (opt_num(I, v, "cyclic", &x) == 1)
+    if (lang_opt_num(I, v, "cyclic", &x) == 1)
         ax->cyclic = x != 0;
-    if (opt_num(I, v, "ist", &x) == 1)
+    if (lang_opt_num(I, v, "ist", &x) == 1)
         ax->ist = x != 0;
-    if (opt_num(I, v, "crossings", &x) == 1)
+    if (lang_opt_num(I, v, "crossings", &x) == 1)
         ax->m = (int)x;
 }
 
@@ -678,7 +678,7 @@ static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
             char w[96];
             snprintf(w, sizeof w, "wrinkly_surface: control point [%zu][%zu]", j, i);
             double *p = s->pts[j * nu + i].pos;
-            if (get_vec(I, AS_LIST(row)->items[i], p, 3, w)) /* numbers: finite (declared list) */
+            if (builtin_get_vec(I, AS_LIST(row)->items[i], p, 3, w)) /* numbers: finite (declared list) */
                 goto fail;
         }
     }
@@ -788,7 +788,7 @@ static int b_tessellate(interp *I, value *a, int n, value *out)
     camera cam;
     int use_cam, w = 256, h = 256;
     lod l;
-    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || arg_size2(I, a[2], &w, &h, "tessellate: size") ||
+    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || lang_arg_size2(I, a[2], &w, &h, "tessellate: size") ||
         lang_get_lod(I, a[5], a[4], a[6], 4, &l, W))
         return -1;
     mesh *m;
@@ -844,5 +844,5 @@ static const builtin wrinkly_builtins[] = {
 
 int bind_wrinkly_init(interp *I)
 {
-    return builtins_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
+    return builtin_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
 }

@@ -3,7 +3,7 @@
 #include "builtin.h"
 
 int bind_volume_init(interp *I);
-int bindings_init(interp *I)
+int bind_all_init(interp *I)
 {
     return bind_volume_init(I) || bind_field_init(I) || bind_ifs_init(I) || bind_solid_init(I) ||
            bind_ist_init(I) || bind_wrinkly_init(I) || bind_raster_init(I) || bind_show_init(I) ||

@@ -13,7 +13,7 @@
 
 /* ---- registry and helpers ---------------------------------------------------- */
 
-int builtins_register(interp *I, const builtin *b, int n)
+int builtin_register(interp *I, const builtin *b, int n)
 {
     env *root = I->globals;
     while (root->parent)
@@ -36,8 +36,8 @@ int builtins_register(interp *I, const builtin *b, int n)
         value v;
         v.k = V_BUILTIN;
         v.u.bi = &b[i];
-        const char *name = intern(I, b[i].name, strlen(b[i].name));
-        if (!name || env_define(I, root, name, v))
+        const char *name = interp_intern(I, b[i].name, strlen(b[i].name));
+        if (!name || val_env_define(I, root, name, v))
             return -1;
     }
     return 0;
@@ -51,7 +51,7 @@ const builtin *builtin_find(interp *I, const char *name)
     return NULL;
 }
 
-int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
+int builtin_arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
 {
     char msg[768];
     va_list ap;
@@ -63,7 +63,7 @@ int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, .
     return err_at(I, NULL, ERR_VALUE, "%s: %s", b->name, msg);
 }
 
-int get_vec(interp *I, value v, double *out, size_t n, const char *what)
+int builtin_get_vec(interp *I, value v, double *out, size_t n, const char *what)
 {
     if (v.k != V_LIST)
         return err_at(I, NULL, ERR_TYPE, "%s must be a list of %zu numbers, got %s", what, n,
@@ -84,12 +84,12 @@ int get_vec(interp *I, value v, double *out, size_t n, const char *what)
     return 0;
 }
 
-int get_int(interp *I, value v, long lo, long hi, long *out, const char *what)
+int builtin_get_int(interp *I, value v, long lo, long hi, long *out, const char *what)
 {
     if (v.k != V_NUM || !isfinite(v.u.n) || v.u.n != floor(v.u.n)) {
         if (v.k == V_NUM) {
             char got[40];
-            fmt_number(v.u.n, got, sizeof got);
+            val_fmt_number(v.u.n, got, sizeof got);
             return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what,
                           isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
         }

@@ -29,11 +29,11 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
         value it = l->items[i];
         size_t k = it.k == V_LIST ? AS_LIST(it)->n : 0;
         if (k == 3) {
-            if (get_vec(I, it, c + 1, 3, what))
+            if (builtin_get_vec(I, it, c + 1, 3, what))
                 return -1;
             c[0] = l->n == 1 ? 0 : (double)i / (double)(l->n - 1);
         } else if (k == 4 || k == 5) {
-            if (get_vec(I, it, c, k, what))
+            if (builtin_get_vec(I, it, c, k, what))
                 return -1;
             if (k == 4)
                 c[4] = 1;
@@ -53,12 +53,12 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
     return 0;
 }
 
-int opt_num(interp *I, value rec, const char *key, double *out)
+int lang_opt_num(interp *I, value rec, const char *key, double *out)
 {
     if (rec.k != V_REC)
         return 0;
-    const char *k = intern(I, key, strlen(key));
-    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
+    const char *k = interp_intern(I, key, strlen(key));
+    value *v = k ? val_rec_get(AS_REC(rec), k) : NULL;
     if (!v)
         return 0;
     if (v->k == V_NUM) {
@@ -111,8 +111,8 @@ int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
  * runs: eye and target present, 3 finite numbers each, fov in (0, 179)). */
 static void rec_vec3(interp *I, value rec, const char *key, double out[3])
 {
-    const char *k = intern(I, key, strlen(key));
-    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
+    const char *k = interp_intern(I, key, strlen(key));
+    value *v = k ? val_rec_get(AS_REC(rec), k) : NULL;
     if (v)
         for (int i = 0; i < 3; i++)
             out[i] = AS_LIST(*v)->items[i].u.n;
@@ -127,7 +127,7 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what)
     rec_vec3(I, v, "target", cam->target);
     rec_vec3(I, v, "up", cam->up);
     double fov;
-    if (opt_num(I, v, "fov", &fov) == 1)
+    if (lang_opt_num(I, v, "fov", &fov) == 1)
         cam->fov = fov;
     if (camera_setup(cam))
         return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view",
