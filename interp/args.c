@@ -8,7 +8,7 @@
 #include "builtin.h"
 #include "lang_objects.h"
 
-int arg_seed(interp *I, value v, uint64_t *seed, const char *what)
+int lang_arg_seed(interp *I, value v, uint64_t *seed, const char *what)
 {
     if (v.k == V_NIL) {
         *seed = I->seed;
@@ -21,12 +21,12 @@ int arg_seed(interp *I, value v, uint64_t *seed, const char *what)
     return 0;
 }
 
-int arg_size2(interp *I, value v, int *w, int *h, const char *what)
+int lang_arg_size2(interp *I, value v, int *w, int *h, const char *what)
 {
     double s[2];
     if (v.k == V_NUM)
         s[0] = s[1] = v.u.n;
-    else if (get_vec(I, v, s, 2, what))
+    else if (builtin_get_vec(I, v, s, 2, what))
         return -1;
     if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
         return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
@@ -36,32 +36,18 @@ int arg_size2(interp *I, value v, int *w, int *h, const char *what)
     return 0;
 }
 
-int num_list_value(interp *I, const double *x, size_t n, value *out)
+int lang_num_list_value(interp *I, const double *x, size_t n, value *out)
 {
     value l = val_list(I, n);
     if (l.k == V_NIL)
         return -1;
     for (size_t i = 0; i < n; i++)
-        if (list_push(I, AS_LIST(l), val_num(x[i]))) {
+        if (val_list_push(I, AS_LIST(l), val_num(x[i]))) {
             val_unref(I, l);
             return -1;
         }
     *out = l;
     return 0;
-}
-
-err_kind lang_rt_kind(rt_code c)
-{
-    switch (c) {
-    case RT_ENOMEM: return ERR_MEMORY;
-    case RT_EIO: return ERR_IO;
-    case RT_ECANCEL: return ERR_INTERRUPT;
-    case RT_ELIMIT: return ERR_LIMIT;
-    case RT_OK: /* not a failure; callers never pass it */
-    case RT_EFORMAT:
-    case RT_EINVAL: break;
-    }
-    return ERR_VALUE;
 }
 
 int lang_join_path(interp *I, const node *at, const char *dir, const char *p, size_t plen, char *buf, size_t n,
@@ -83,7 +69,7 @@ int lang_join_path(interp *I, const node *at, const char *dir, const char *p, si
     return 0;
 }
 
-int script_relative_path(interp *I, value v, char *buf, size_t n, const char *what)
+int lang_script_path(interp *I, value v, char *buf, size_t n, const char *what)
 {
     const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
     return lang_join_path(I, NULL, dir, AS_STR(v)->s, AS_STR(v)->len, buf, n, what);

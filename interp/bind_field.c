@@ -46,7 +46,7 @@ static void fv_summary(const void *p, bytebuf *out)
 static int fv_arith(interp *I, int op, value a, value b, value *out);
 static int fv_preview(interp *I, const void *p, image **out);
 
-const obj_class field_class = {
+const obj_class lang_field_class = {
     .name = "field",
     .destroy = fv_destroy,
     .summary = fv_summary,
@@ -56,7 +56,7 @@ const obj_class field_class = {
 
 static field_val *as_fv(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &field_class ? AS_OBJ(v)->payload : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_field_class ? AS_OBJ(v)->payload : NULL;
 }
 
 /* Wrap a new node (consumes it). */
@@ -70,7 +70,7 @@ int lang_field_value(interp *I, field *f, value *out)
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a field");
     }
     fv->f = f;
-    *out = val_obj(I, &field_class, fv);
+    *out = val_obj(I, &lang_field_class, fv);
     return out->k == V_NIL ? -1 : 0;
 }
 
@@ -92,7 +92,7 @@ static void vol_field_fn(const void *ctx, size_t n, const double *x, const doubl
 static void vol_release(void *ctx)
 {
     vol_ref *r = ctx;
-    heap_unref(r->I, r->h);
+    val_heap_unref(r->I, r->h);
     rt_free(r);
 }
 
@@ -244,10 +244,10 @@ static int get_bounds(interp *I, value lo, value hi, double l[3], double h[3], c
 {
     char w[128];
     snprintf(w, sizeof w, "%s: lo", what);
-    if (get_vec(I, lo, l, 3, w))
+    if (builtin_get_vec(I, lo, l, 3, w))
         return -1;
     snprintf(w, sizeof w, "%s: hi", what);
-    if (get_vec(I, hi, h, 3, w))
+    if (builtin_get_vec(I, hi, h, 3, w))
         return -1;
     for (int i = 0; i < 3; i++)
         if (!(h[i] > l[i]))
@@ -261,7 +261,7 @@ static int get_grid(interp *I, value v, int n[3], const char *what)
     double g[3];
     if (v.k == V_NUM) {
         g[0] = g[1] = g[2] = v.u.n;
-    } else if (get_vec(I, v, g, 3, what)) {
+    } else if (builtin_get_vec(I, v, g, 3, what)) {
         return -1;
     }
     for (int i = 0; i < 3; i++) {
@@ -297,7 +297,7 @@ static int b_sphere(interp *I, value *a, int n, value *out)
     (void)n;
     density_shape s = {0};
     s.kind = DENSITY_SPHERE;
-    if (get_vec(I, a[0], s.c, 3, "sphere: center"))
+    if (builtin_get_vec(I, a[0], s.c, 3, "sphere: center"))
         return -1;
     s.r = a[1].u.n;
     s.s = a[2].u.n;
@@ -309,7 +309,7 @@ static int b_box(interp *I, value *a, int n, value *out)
     (void)n;
     density_shape s = {0};
     s.kind = DENSITY_BOX;
-    if (get_vec(I, a[0], s.c, 3, "box: center") || get_vec(I, a[1], s.h, 3, "box: half"))
+    if (builtin_get_vec(I, a[0], s.c, 3, "box: center") || builtin_get_vec(I, a[1], s.h, 3, "box: half"))
         return -1;
     s.s = a[2].u.n;
     return shape(I, &s, out);
@@ -320,7 +320,7 @@ static int b_torus(interp *I, value *a, int n, value *out)
     (void)n;
     density_shape s = {0};
     s.kind = DENSITY_TORUS;
-    if (get_vec(I, a[0], s.c, 3, "torus: center"))
+    if (builtin_get_vec(I, a[0], s.c, 3, "torus: center"))
         return -1;
     s.R = a[1].u.n;
     s.r = a[2].u.n;
@@ -333,7 +333,7 @@ static int b_cylinder(interp *I, value *a, int n, value *out)
     (void)n;
     density_shape s = {0};
     s.kind = DENSITY_CYLINDER;
-    if (get_vec(I, a[0], s.c, 3, "cylinder: center"))
+    if (builtin_get_vec(I, a[0], s.c, 3, "cylinder: center"))
         return -1;
     s.r = a[1].u.n;
     s.h[2] = a[2].u.n;
@@ -356,7 +356,7 @@ static int b_perlin(interp *I, value *a, int n, value *out)
 {
     (void)n;
     uint64_t seed;
-    if (arg_seed(I, a[1], &seed, "perlin"))
+    if (lang_arg_seed(I, a[1], &seed, "perlin"))
         return -1;
     return noise_common(I, field_perlin(seed), a[0].u.n, out);
 }
@@ -364,7 +364,7 @@ static int b_perlin(interp *I, value *a, int n, value *out)
 static int octaves_arg(interp *I, value v, int *oct, const char *what)
 {
     long o;
-    if (get_int(I, v, 1, 30, &o, what))
+    if (builtin_get_int(I, v, 1, 30, &o, what))
         return -1;
     *oct = (int)o;
     return 0;
@@ -375,7 +375,7 @@ static int b_fbm(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct, "fbm: octaves") || arg_seed(I, a[4], &seed, "fbm"))
+    if (octaves_arg(I, a[0], &oct, "fbm: octaves") || lang_arg_seed(I, a[4], &seed, "fbm"))
         return -1;
     return noise_common(I, field_fbm(seed, oct, a[2].u.n, a[3].u.n), a[1].u.n, out);
 }
@@ -385,7 +385,7 @@ static int b_turbulence(interp *I, value *a, int n, value *out)
     (void)n;
     uint64_t seed;
     int oct;
-    if (octaves_arg(I, a[0], &oct, "turbulence: octaves") || arg_seed(I, a[2], &seed, "turbulence"))
+    if (octaves_arg(I, a[0], &oct, "turbulence: octaves") || lang_arg_seed(I, a[2], &seed, "turbulence"))
         return -1;
     return noise_common(I, field_turbulence(seed, oct), a[1].u.n, out);
 }
@@ -483,7 +483,7 @@ static int b_translate(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double d[3];
-    if (get_vec(I, a[1], d, 3, "translate: by"))
+    if (builtin_get_vec(I, a[1], d, 3, "translate: by"))
         return -1;
     field *f = lang_to_field(I, a[0], "translate: field");
     return f ? lang_field_value(I, field_translate(f, d[0], d[1], d[2]), out) : -1;
@@ -504,7 +504,7 @@ static int b_rotate(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double ax[3];
-    if (get_vec(I, a[1], ax, 3, "rotate: axis"))
+    if (builtin_get_vec(I, a[1], ax, 3, "rotate: axis"))
         return -1;
     double l = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
     if (!(l > 0))
@@ -541,7 +541,7 @@ static int b_at(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double p[3];
-    if (get_vec(I, a[1], p, 3, "at: point"))
+    if (builtin_get_vec(I, a[1], p, 3, "at: point"))
         return -1;
     if (a[0].k == V_NUM) {
         *out = a[0];
@@ -697,7 +697,7 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     double sz[2];
     if (a[2].k == V_NUM)
         sz[0] = sz[1] = a[2].u.n;
-    else if (get_vec(I, a[2], sz, 2, "raymarch: size"))
+    else if (builtin_get_vec(I, a[2], sz, 2, "raymarch: size"))
         return -1;
     if (sz[0] != floor(sz[0]) || sz[1] != floor(sz[1]) || sz[0] < 1 || sz[1] < 1 || sz[0] > 1e6 || sz[1] > 1e6)
         return err_at(I, NULL, ERR_VALUE, "raymarch: size must be whole numbers of pixels");
@@ -733,7 +733,7 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     if (lang_get_colour(I, a[10], o.background, "raymarch: background"))
         return -1;
     o.lighting = val_truthy(a[11]);
-    if (a[12].k != V_NIL && get_vec(I, a[12], o.light, 3, "raymarch: light"))
+    if (a[12].k != V_NIL && builtin_get_vec(I, a[12], o.light, 3, "raymarch: light"))
         return -1;
     image *im;
     if (lang_image_new(I, w, h, &im))
@@ -845,8 +845,8 @@ int bind_field_init(interp *I)
     const char *names[3] = {"X", "Y", "Z"};
     for (int i = 0; i < 3; i++) {
         value v;
-        if (lang_field_value(I, field_coord(i), &v) || env_define(I, root, intern(I, names[i], 1), v))
+        if (lang_field_value(I, field_coord(i), &v) || val_env_define(I, root, interp_intern(I, names[i], 1), v))
             return -1;
     }
-    return builtins_register(I, field_builtins, (int)(sizeof field_builtins / sizeof field_builtins[0]));
+    return builtin_register(I, field_builtins, (int)(sizeof field_builtins / sizeof field_builtins[0]));
 }

@@ -46,7 +46,7 @@ static int map_row(interp *I, const affine *a, value *out)
 {
     if (a->dim == 2) {
         double r[6] = {a->m[0][0], a->m[0][1], a->m[1][0], a->m[1][1], a->t[0], a->t[1]};
-        return num_list_value(I, r, (size_t)(6), out);
+        return lang_num_list_value(I, r, (size_t)(6), out);
     }
     double r[12];
     for (int i = 0; i < 3; i++)
@@ -54,7 +54,7 @@ static int map_row(interp *I, const affine *a, value *out)
             r[3 * i + j] = a->m[i][j];
     for (int i = 0; i < 3; i++)
         r[9 + i] = a->t[i];
-    return num_list_value(I, r, (size_t)(12), out);
+    return lang_num_list_value(I, r, (size_t)(12), out);
 }
 
 static int map_get(interp *I, const void *p, const char *name, value *out)
@@ -75,7 +75,7 @@ static int map_get(interp *I, const void *p, const char *name, value *out)
 
 static int map_arith(interp *I, int op, value a, value b, value *out);
 
-const obj_class map_class = {
+const obj_class lang_map_class = {
     .name = "map",
     .destroy = map_destroy,
     .summary = map_summary,
@@ -85,7 +85,7 @@ const obj_class map_class = {
 
 static const affine *as_map(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &map_class ? AS_OBJ(v)->payload : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_map_class ? AS_OBJ(v)->payload : NULL;
 }
 
 static int map_value(interp *I, affine a, value *out)
@@ -94,7 +94,7 @@ static int map_value(interp *I, affine a, value *out)
     if (!p)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     *p = a;
-    *out = val_obj(I, &map_class, p);
+    *out = val_obj(I, &lang_map_class, p);
     return out->k == V_NIL ? -1 : 0;
 }
 
@@ -111,10 +111,10 @@ static int map_arith(interp *I, int op, value a, value b, value *out)
         if ((int)n != x->dim)
             return err_at(I, NULL, ERR_VALUE, "a %d-D map applies to points of %d numbers, got %zu", x->dim,
                           x->dim, n);
-        if (get_vec(I, b, p, n, "point"))
+        if (builtin_get_vec(I, b, p, n, "point"))
             return -1;
         affine_apply(x, p, q);
-        return num_list_value(I, q, (size_t)(x->dim), out) ? -1 : 1;
+        return lang_num_list_value(I, q, (size_t)(x->dim), out) ? -1 : 1;
     }
     return 0;
 }
@@ -132,7 +132,7 @@ static int row_to_map(interp *I, value table, value row, affine *m, double *p, i
                       "%s: row %d has %zu numbers; a map row has 6 or 7 (2-D: a b c d e f [p]) or 12 or 13 (3-D: "
                       "a b c d e f g h i j k l [p])",
                       fn, index + 1, n);
-    if (get_vec(I, row, r, n, what))
+    if (builtin_get_vec(I, row, r, n, what))
         return -1;
     if (n <= 7) {
         *m = affine_from_2d(r[0], r[1], r[2], r[3], r[4], r[5]);
@@ -248,7 +248,7 @@ static int ifs_get(interp *I, const void *p, const char *name, value *out)
             return -1;
         for (int i = 0; i < li->f.n; i++) {
             value m;
-            if (map_value(I, li->f.maps[i], &m) || list_push(I, AS_LIST(l), m)) {
+            if (map_value(I, li->f.maps[i], &m) || val_list_push(I, AS_LIST(l), m)) {
                 val_unref(I, l);
                 return -1;
             }
@@ -257,7 +257,7 @@ static int ifs_get(interp *I, const void *p, const char *name, value *out)
         return 0;
     }
     if (strcmp(name, "probabilities") == 0)
-        return num_list_value(I, li->f.p, (size_t)(li->f.n), out);
+        return lang_num_list_value(I, li->f.p, (size_t)(li->f.n), out);
     if (strcmp(name, "contraction") == 0)
         *out = val_num(li->f.max_contraction);
     else if (strcmp(name, "dim") == 0)
@@ -278,7 +278,7 @@ static int ifs_save_hook(interp *I, const void *p, const char *path, value opts)
     return sys_save(I, &s, path, opts);
 }
 
-const obj_class ifs_class = {
+const obj_class lang_ifs_class = {
     .name = "ifs",
     .destroy = ifs_destroy,
     .summary = ifs_summary,
@@ -289,7 +289,7 @@ const obj_class ifs_class = {
 
 const lang_ifs *lang_as_ifs(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &ifs_class ? AS_OBJ(v)->payload : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_ifs_class ? AS_OBJ(v)->payload : NULL;
 }
 
 typedef struct lang_rifs {
@@ -322,7 +322,7 @@ static int rifs_get(interp *I, const void *p, const char *name, value *out)
             mem_free(I, pi);
             return lang_rt_error(I, e.code, &e, "stationary");
         }
-        int rc = num_list_value(I, pi, (size_t)(r->n), out);
+        int rc = lang_num_list_value(I, pi, (size_t)(r->n), out);
         mem_free(I, pi);
         return rc;
     }
@@ -347,7 +347,7 @@ static int rifs_save_hook(interp *I, const void *p, const char *path, value opts
 
 static int rifs_preview(interp *I, const void *p, image **out);
 
-const obj_class rifs_class = {
+const obj_class lang_rifs_class = {
     .name = "rifs",
     .destroy = rifs_destroy,
     .summary = rifs_summary,
@@ -358,7 +358,7 @@ const obj_class rifs_class = {
 
 static const rifs *as_rifs(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &rifs_class ? &((lang_rifs *)AS_OBJ(v)->payload)->r : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_rifs_class ? &((lang_rifs *)AS_OBJ(v)->payload)->r : NULL;
 }
 
 int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what)
@@ -395,7 +395,7 @@ static int b_map(interp *I, value *a, int n, value *out)
         sx = sy = a[6].u.n;
     } else if (a[6].k == V_LIST) {
         double s[2];
-        if (get_vec(I, a[6], s, 2, "affine: scale"))
+        if (builtin_get_vec(I, a[6], s, 2, "affine: scale"))
             return -1;
         sx = s[0];
         sy = s[1];
@@ -412,7 +412,7 @@ static int b_map(interp *I, value *a, int n, value *out)
     }
     if (a[9].k != V_NIL) {
         double t[2];
-        if (get_vec(I, a[9], t, 2, "affine: translate"))
+        if (builtin_get_vec(I, a[9], t, 2, "affine: translate"))
             return -1;
         m.t[0] += t[0];
         m.t[1] += t[1];
@@ -428,9 +428,9 @@ static int b_map3(interp *I, value *a, int n, value *out)
     if (rows.k != V_LIST || AS_LIST(rows)->n != 3)
         return err_at(I, NULL, ERR_VALUE, "affine3: matrix must be 3 rows of 3 numbers");
     for (int i = 0; i < 3; i++)
-        if (get_vec(I, AS_LIST(rows)->items[i], m9 + 3 * i, 3, "affine3: matrix row"))
+        if (builtin_get_vec(I, AS_LIST(rows)->items[i], m9 + 3 * i, 3, "affine3: matrix row"))
             return -1;
-    if (a[1].k != V_NIL && get_vec(I, a[1], t, 3, "affine3: translate"))
+    if (a[1].k != V_NIL && builtin_get_vec(I, a[1], t, 3, "affine3: translate"))
         return -1;
     return map_value(I, affine_from_3d(m9, t), out);
 }
@@ -457,7 +457,7 @@ static int b_ifs(interp *I, value *a, int n, value *out)
             mem_free(I, p);
             return err_at(I, NULL, ERR_VALUE, "ifs: probabilities must be a list of %d numbers (one per map)", count);
         }
-        if (get_vec(I, a[1], p, (size_t)count, "ifs: probabilities")) {
+        if (builtin_get_vec(I, a[1], p, (size_t)count, "ifs: probabilities")) {
             mem_free(I, maps);
             mem_free(I, p);
             return -1;
@@ -480,7 +480,7 @@ static int b_ifs(interp *I, value *a, int n, value *out)
     }
     if (li->f.warning[0] && !I->quiet)
         fprintf(stderr, "warning: ifs: %s\n", li->f.warning);
-    *out = val_obj(I, &ifs_class, li);
+    *out = val_obj(I, &lang_ifs_class, li);
     return out->k == V_NIL ? -1 : 0;
 }
 
@@ -494,7 +494,7 @@ static int b_rifs(interp *I, value *a, int n, value *out)
         return -1;
     mem_free(I, p);
     long order;
-    if (get_int(I, a[2], 1, 2, &order, "rifs: order")) {
+    if (builtin_get_int(I, a[2], 1, 2, &order, "rifs: order")) {
         mem_free(I, maps);
         return -1;
     }
@@ -519,7 +519,7 @@ static int b_rifs(interp *I, value *a, int n, value *out)
             mem_free(I, P);
             return err_item(I, M, (size_t)i, ERR_VALUE, "%s must have %d numbers (one per map)", what, count);
         }
-        if (get_vec(I, row, P + (size_t)i * count, (size_t)count, what)) {
+        if (builtin_get_vec(I, row, P + (size_t)i * count, (size_t)count, what)) {
             mem_free(I, maps);
             mem_free(I, P);
             return -1;
@@ -541,7 +541,7 @@ static int b_rifs(interp *I, value *a, int n, value *out)
     }
     if (lr->r.warning[0] && !I->quiet)
         fprintf(stderr, "warning: rifs: %s\n", lr->r.warning);
-    *out = val_obj(I, &rifs_class, lr);
+    *out = val_obj(I, &lang_rifs_class, lr);
     return out->k == V_NIL ? -1 : 0;
 }
 
@@ -586,9 +586,9 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     long ss;
     ramp r;
     if (lang_get_sys(I, a[0], &s, "chaos: system") || points_arg(I, a[1], &o.points, "chaos") ||
-        arg_size2(I, a[2], &w, &h, "chaos: size") || colour_mode(I, a[4], &o.colour, "chaos") ||
-        lang_get_ramp(I, a[5], &r, "chaos: palette") || get_int(I, a[10], 1, 8, &ss, "chaos: supersample") ||
-        arg_seed(I, a[11], &o.seed, NULL))
+        lang_arg_size2(I, a[2], &w, &h, "chaos: size") || colour_mode(I, a[4], &o.colour, "chaos") ||
+        lang_get_ramp(I, a[5], &r, "chaos: palette") || builtin_get_int(I, a[10], 1, 8, &ss, "chaos: supersample") ||
+        lang_arg_seed(I, a[11], &o.seed, NULL))
         return -1;
     if (sys_dim(&s) != 2)
         return err_at(I, NULL, ERR_VALUE,
@@ -617,7 +617,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     rt_code c;
     if (a[3].k != V_NIL) {
         double win[4];
-        if (get_vec(I, a[3], win, 4, "chaos: window"))
+        if (builtin_get_vec(I, a[3], win, 4, "chaos: window"))
             return -1;
         lo[0] = win[0];
         hi[0] = win[1];
@@ -677,13 +677,13 @@ static int b_measure(interp *I, value *a, int n, value *out)
     memset(&o, 0, sizeof o);
     chaos_norm nm = CHAOS_NORM_TOTAL;
     if (lang_get_sys(I, a[0], &s, "measure: system") || points_arg(I, a[2], &o.points, "measure") ||
-        norm_arg(I, a[3], &nm, "measure") || arg_seed(I, a[6], &o.seed, NULL))
+        norm_arg(I, a[3], &nm, "measure") || lang_arg_seed(I, a[6], &o.seed, NULL))
         return -1;
     int dim = sys_dim(&s);
     double g[3];
     if (a[1].k == V_NUM)
         g[0] = g[1] = g[2] = a[1].u.n;
-    else if (get_vec(I, a[1], g, (size_t)dim, "measure: grid"))
+    else if (builtin_get_vec(I, a[1], g, (size_t)dim, "measure: grid"))
         return -1;
     for (int i = 0; i < dim; i++)
         if (g[i] != floor(g[i]) || g[i] < 1 || g[i] > 65536)
@@ -692,7 +692,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code c;
     if (a[4].k != V_NIL || a[5].k != V_NIL) {
-        if (get_vec(I, a[4], lo, (size_t)dim, "measure: lo") || get_vec(I, a[5], hi, (size_t)dim, "measure: hi"))
+        if (builtin_get_vec(I, a[4], lo, (size_t)dim, "measure: lo") || builtin_get_vec(I, a[5], hi, (size_t)dim, "measure: hi"))
             return -1;
         for (int i = 0; i < dim; i++)
             if (!(hi[i] > lo[i]))
@@ -746,7 +746,7 @@ static int b_points(interp *I, value *a, int n, value *out)
     ramp r;
     if (lang_get_sys(I, a[0], &s, "points: system") || points_arg(I, a[1], &o.points, "points") ||
         colour_mode(I, a[2], &o.colour, "points") || lang_get_ramp(I, a[3], &r, "points: palette") ||
-        arg_seed(I, a[4], &o.seed, NULL))
+        lang_arg_seed(I, a[4], &o.seed, NULL))
         return -1;
     o.ramp = &r;
     if (mem_precheck(I, (double)o.points * 28, "points: the point cloud"))
@@ -777,9 +777,9 @@ static int b_view(interp *I, value *a, int n, value *out)
     int w, h;
     ramp r;
     if (lang_get_sys(I, a[0], &s, "view: system") || lang_get_camera(I, a[1], &cam, "view") ||
-        arg_size2(I, a[2], &w, &h, "view: size") || points_arg(I, a[3], &o.points, "view") ||
+        lang_arg_size2(I, a[2], &w, &h, "view: size") || points_arg(I, a[3], &o.points, "view") ||
         colour_mode(I, a[4], &o.colour, "view") || lang_get_ramp(I, a[5], &r, "view: palette") ||
-        lang_get_colour(I, a[6], o.bg, "view: background") || arg_seed(I, a[7], &o.seed, NULL))
+        lang_get_colour(I, a[6], o.bg, "view: background") || lang_arg_seed(I, a[7], &o.seed, NULL))
         return -1;
     if (sys_dim(&s) != 3)
         return err_at(I, NULL, ERR_VALUE, "view: the system is 2-D; use chaos(…) to draw it");
@@ -813,11 +813,11 @@ static int sys_save(interp *I, chaos_sys *s, const char *path, value opts)
     memset(&fo, 0, sizeof fo);
     fo.width = fo.height = 512;
     double v;
-    if (opts_check(I, opts, "rec{width: int[1,100000], height: int[1,100000]}", "save"))
+    if (contract_check_opts(I, opts, "rec{width: int[1,100000], height: int[1,100000]}", "save"))
         return -1;
-    if (opt_num(I, opts, "width", &v) == 1)
+    if (lang_opt_num(I, opts, "width", &v) == 1)
         fo.width = (int)v;
-    if (opt_num(I, opts, "height", &v) == 1)
+    if (lang_opt_num(I, opts, "height", &v) == 1)
         fo.height = (int)v;
     if (I->err.active)
         return -1;
@@ -899,7 +899,7 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    if (script_relative_path(I, a[0], path, sizeof path, "load_ifs"))
+    if (lang_script_path(I, a[0], path, sizeof path, "load_ifs"))
         return -1;
     fractint_list fl;
     rt_error e;
@@ -933,9 +933,9 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
             val_unref(I, r);
             return -1;
         }
-        value v = val_obj(I, &ifs_class, li);
-        const char *key = intern(I, en->name, strlen(en->name));
-        if (v.k == V_NIL || !key || rec_set(I, AS_REC(r), key, v)) {
+        value v = val_obj(I, &lang_ifs_class, li);
+        const char *key = interp_intern(I, en->name, strlen(en->name));
+        if (v.k == V_NIL || !key || val_rec_set(I, AS_REC(r), key, v)) {
             fractint_free(&fl);
             val_unref(I, r);
             return -1;
@@ -993,5 +993,5 @@ static const builtin ifs_builtins[] = {
 
 int bind_ifs_init(interp *I)
 {
-    return builtins_register(I, ifs_builtins, (int)(sizeof ifs_builtins / sizeof ifs_builtins[0]));
+    return builtin_register(I, ifs_builtins, (int)(sizeof ifs_builtins / sizeof ifs_builtins[0]));
 }

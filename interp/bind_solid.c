@@ -27,7 +27,7 @@
 
 static int get_vec3(interp *I, value v, double out[3], const char *what)
 {
-    if (get_vec(I, v, out, 3, what))
+    if (builtin_get_vec(I, v, out, 3, what))
         return -1;
     for (int i = 0; i < 3; i++)
         if (!isfinite(out[i]))
@@ -271,12 +271,12 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     mpd_params_default(&p);
     p.R = (int)a[0].u.n;
     p.beta = a[1].u.n; /* declared: finite, >= 0 */
-    if (arg_seed(I, a[2], &p.seed, W))
+    if (lang_arg_seed(I, a[2], &p.seed, W))
         return -1;
     if (a[3].k == V_NUM) {
         for (int i = 0; i < 8; i++)
             p.corner[i] = a[3].u.n;
-    } else if (a[3].k != V_NIL && get_vec(I, a[3], p.corner, 8, "fractal: corners")) {
+    } else if (a[3].k != V_NIL && builtin_get_vec(I, a[3], p.corner, 8, "fractal: corners")) {
         return -1;
     }
     for (int i = 0; i < 8; i++)
@@ -368,7 +368,7 @@ static int b_fractal(interp *I, value *a, int n, value *out)
 
 static int rec_num(interp *I, value r, const char *key, double v)
 {
-    return rec_set(I, AS_REC(r), intern(I, key, strlen(key)), val_num(v));
+    return val_rec_set(I, AS_REC(r), interp_intern(I, key, strlen(key)), val_num(v));
 }
 
 /* fractal_memory(R, R2): the bytes each strategy needs, as this
@@ -425,7 +425,7 @@ static int b_marble(interp *I, value *a, int n, value *out)
         }
         char w[48];
         snprintf(w, sizeof w, "marble: layer %zu", i + 1);
-        if (get_vec(I, row, v, 3, w)) {
+        if (builtin_get_vec(I, row, v, 3, w)) {
             mem_free(I, m);
             return -1;
         }
@@ -541,7 +541,7 @@ static int b_textured(interp *I, value *a, int n, value *out)
     camera cam;
     int w, h;
     ramp r;
-    if (lang_get_camera(I, a[2], &cam, W) || arg_size2(I, a[3], &w, &h, "textured: size") ||
+    if (lang_get_camera(I, a[2], &cam, W) || lang_arg_size2(I, a[3], &w, &h, "textured: size") ||
         lang_get_ramp(I, a[4], &r, "textured: palette") || get_vec3(I, a[7], s.center, "textured: center") ||
         get_vec3(I, a[10], s.normal, "textured: normal"))
         return -1;
@@ -564,7 +564,7 @@ static int b_textured(interp *I, value *a, int n, value *out)
     if (lang_get_colour(I, a[14], o.background, "textured: background"))
         return -1;
     long ss;
-    if (get_int(I, a[15], 1, 8, &ss, "textured: supersample"))
+    if (builtin_get_int(I, a[15], 1, 8, &ss, "textured: supersample"))
         return -1;
     o.samples = (int)ss;
     field *tmp;
@@ -597,7 +597,7 @@ static int b_slice_plane(interp *I, value *a, int n, value *out)
     int w, h;
     ramp r;
     if (get_vec3(I, a[1], o, "slice_plane: origin") || get_vec3(I, a[2], u, "slice_plane: u") ||
-        get_vec3(I, a[3], v, "slice_plane: v") || arg_size2(I, a[4], &w, &h, "slice_plane: size") ||
+        get_vec3(I, a[3], v, "slice_plane: v") || lang_arg_size2(I, a[4], &w, &h, "slice_plane: size") ||
         lang_get_ramp(I, a[5], &r, "slice_plane: palette"))
         return -1;
     double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
@@ -686,5 +686,5 @@ static const builtin solid_builtins[] = {
 
 int bind_solid_init(interp *I)
 {
-    return builtins_register(I, solid_builtins, (int)(sizeof solid_builtins / sizeof solid_builtins[0]));
+    return builtin_register(I, solid_builtins, (int)(sizeof solid_builtins / sizeof solid_builtins[0]));
 }

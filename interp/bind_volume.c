@@ -12,118 +12,7 @@
 #include "vdb.h"
 #include "volume_io.h"
 
-/* ---- colour ramps -------------------------------------------------------------- */
-
-int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
-{
-    if (v.k == V_NIL) {
-        *out = ramp_grey();
-        return 0;
-    }
-    if (v.k != V_LIST || AS_LIST(v)->n < 1 || AS_LIST(v)->n > RAMP_MAX_STOPS)
-        return err_at(I, NULL, ERR_TYPE,
-                      "%s must be a palette: a list of 1 to %d colours [r, g, b], or rows [t, r, g, b]",
-                      what, RAMP_MAX_STOPS);
-    vlist *l = AS_LIST(v);
-    memset(out, 0, sizeof *out);
-    out->n = (int)l->n;
-    double prev = -INFINITY;
-    for (size_t i = 0; i < l->n; i++) {
-        double c[5] = {0, 0, 0, 0, 1};
-        value it = l->items[i];
-        size_t k = it.k == V_LIST ? AS_LIST(it)->n : 0;
-        if (k == 3) {
-            if (get_vec(I, it, c + 1, 3, what))
-                return -1;
-            c[0] = l->n == 1 ? 0 : (double)i / (double)(l->n - 1);
-        } else if (k == 4 || k == 5) {
-            if (get_vec(I, it, c, k, what))
-                return -1;
-            if (k == 4)
-                c[4] = 1;
-        } else {
-            return err_at(I, NULL, ERR_VALUE,
-                          "%s: stop %zu must be [r, g, b] or [t, r, g, b] or [t, r, g, b, a], got %s", what, i,
-                          it.k == V_LIST ? "a list of another length" : val_type_name(it));
-        }
-        if (c[0] < prev)
-            return err_at(I, NULL, ERR_VALUE, "%s: stop positions must not decrease (stop %zu at %g after %g)",
-                          what, i, c[0], prev);
-        prev = c[0];
-        out->pos[i] = c[0];
-        for (int j = 0; j < 4; j++)
-            out->rgba[i][j] = (float)c[j + 1];
-    }
-    return 0;
-}
-
-int opt_num(interp *I, value rec, const char *key, double *out)
-{
-    if (rec.k != V_REC)
-        return 0;
-    const char *k = intern(I, key, strlen(key));
-    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
-    if (!v)
-        return 0;
-    if (v->k == V_NUM) {
-        *out = v->u.n;
-        return 1;
-    }
-    if (v->k == V_BOOL) {
-        *out = v->u.b;
-        return 1;
-    }
-    return err_at(I, NULL, ERR_TYPE, "option '%s' must be a number, got %s", key, val_type_name(*v));
-}
-
-rt_run lang_run(interp *I)
-{
-    rt_run r;
-    r.threads = I->threads > 0 ? I->threads : 1;
-    r.cancel = I->interrupt;
-    r.progress = I->progress && !I->quiet;
-    return r;
-}
-
-int lang_rt_error(interp *I, rt_code c, const rt_error *e, const char *what)
-{
-    err_kind k = lang_rt_kind(c);
-    if (c == RT_ENOMEM) /* why the allocation hook refused: limit, --fail-alloc or the system */
-        return mem_engine_error(I, what, e->msg);
-    if (c == RT_ECANCEL)
-        return err_at(I, NULL, k, "%s: interrupted", what);
-    return err_at(I, NULL, k, "%s: %s", what, e->msg);
-}
-
 /* ---- cameras ------------------------------------------------------------------------ */
-
-/* A camera record as TY_CAMERA declares it (checked before the builtin
- * runs: eye and target present, 3 finite numbers each, fov in (0, 179)). */
-static void rec_vec3(interp *I, value rec, const char *key, double out[3])
-{
-    const char *k = intern(I, key, strlen(key));
-    value *v = k ? rec_get(AS_REC(rec), k) : NULL;
-    if (v)
-        for (int i = 0; i < 3; i++)
-            out[i] = AS_LIST(*v)->items[i].u.n;
-}
-
-int lang_get_camera(interp *I, value v, camera *cam, const char *what)
-{
-    memset(cam, 0, sizeof *cam);
-    cam->up[1] = 1;
-    cam->fov = 40;
-    rec_vec3(I, v, "eye", cam->eye);
-    rec_vec3(I, v, "target", cam->target);
-    rec_vec3(I, v, "up", cam->up);
-    double fov;
-    if (opt_num(I, v, "fov", &fov) == 1)
-        cam->fov = fov;
-    if (camera_setup(cam))
-        return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view",
-                        what);
-    return 0;
-}
 
 static int camera_record(interp *I, const double eye[3], const double target[3], const double up[3], double fov,
                          value *out)
@@ -138,14 +27,14 @@ static int camera_record(interp *I, const double eye[3], const double target[3],
         if (l.k == V_NIL)
             goto fail;
         for (int j = 0; j < 3; j++)
-            if (list_push(I, AS_LIST(l), val_num(vals[i][j]))) {
+            if (val_list_push(I, AS_LIST(l), val_num(vals[i][j]))) {
                 val_unref(I, l);
                 goto fail;
             }
-        if (rec_set(I, AS_REC(r), intern(I, names[i], strlen(names[i])), l))
+        if (val_rec_set(I, AS_REC(r), interp_intern(I, names[i], strlen(names[i])), l))
             goto fail;
     }
-    if (rec_set(I, AS_REC(r), intern(I, "fov", 3), val_num(fov)))
+    if (val_rec_set(I, AS_REC(r), interp_intern(I, "fov", 3), val_num(fov)))
         goto fail;
     *out = r;
     return 0;
@@ -158,7 +47,7 @@ static int b_orbit(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double target[3];
-    if (get_vec(I, a[3], target, 3, "orbit: target"))
+    if (builtin_get_vec(I, a[3], target, 3, "orbit: target"))
         return -1;
     if (!(a[2].u.n > 0))
         return err_at(I, NULL, ERR_VALUE, "orbit: distance must be positive, got %g", a[2].u.n);
@@ -173,8 +62,8 @@ static int b_look_at(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double eye[3], target[3], up[3];
-    if (get_vec(I, a[0], eye, 3, "look_at: eye") || get_vec(I, a[1], target, 3, "look_at: target") ||
-        get_vec(I, a[2], up, 3, "look_at: up"))
+    if (builtin_get_vec(I, a[0], eye, 3, "look_at: eye") || builtin_get_vec(I, a[1], target, 3, "look_at: target") ||
+        builtin_get_vec(I, a[2], up, 3, "look_at: up"))
         return -1;
     return camera_record(I, eye, target, up, a[3].u.n, out);
 }
@@ -210,12 +99,12 @@ static int volume_get(interp *I, const void *p, const char *name, value *out)
     const volume *v = &((const vol_payload *)p)->v;
     if (strcmp(name, "size") == 0) {
         double s[3] = {v->nx, v->ny, v->nz};
-        return num_list_value(I, s, 3, out);
+        return lang_num_list_value(I, s, 3, out);
     }
     if (strcmp(name, "lo") == 0)
-        return num_list_value(I, v->lo, 3, out);
+        return lang_num_list_value(I, v->lo, 3, out);
     if (strcmp(name, "hi") == 0)
-        return num_list_value(I, v->hi, 3, out);
+        return lang_num_list_value(I, v->hi, 3, out);
     return 1;
 }
 
@@ -223,8 +112,8 @@ static int save_type(interp *I, value opts, int vdb, int *type)
 {
     double bits = 32;
     /* `grids` (extra named grids) exists only in .vdb files */
-    if (opts_check(I, opts, vdb ? "rec{bits: int{8,16,32}, grids: rec}" : "rec{bits: int{8,16,32}}", "save") ||
-        opt_num(I, opts, "bits", &bits) < 0)
+    if (contract_check_opts(I, opts, vdb ? "rec{bits: int{8,16,32}, grids: rec}" : "rec{bits: int{8,16,32}}", "save") ||
+        lang_opt_num(I, opts, "bits", &bits) < 0)
         return -1;
     if (bits == 8)
         *type = VIO_UCHAR;
@@ -249,8 +138,8 @@ static int volume_save_vdb(interp *I, const volume *v, const char *path, value o
     vdb_grid g[16] = {{"density", 1, {v, NULL, NULL}}};
     int n = 1;
     value *gr = NULL;
-    const char *k = opts.k == V_REC ? intern(I, "grids", 5) : NULL;
-    if (k && (gr = rec_get(AS_REC(opts), k)) && gr->k != V_REC)
+    const char *k = opts.k == V_REC ? interp_intern(I, "grids", 5) : NULL;
+    if (k && (gr = val_rec_get(AS_REC(opts), k)) && gr->k != V_REC)
         return err_at(I, NULL, ERR_TYPE, "save: option 'grids' must be a record {name: volume}, got %s",
                       val_type_name(*gr));
     for (size_t i = 0; gr && i < AS_REC(*gr)->n; i++, n++) {
@@ -308,7 +197,7 @@ static int volume_save(interp *I, const void *p, const char *path, value opts)
     return 0;
 }
 
-const obj_class volume_class = {
+const obj_class lang_volume_class = {
     .name = "volume",
     .destroy = volume_destroy,
     .summary = volume_summary,
@@ -345,13 +234,13 @@ int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const
 int lang_volume_value(interp *I, volume *v, value *out)
 {
     /* v is the first member of its payload */
-    *out = val_obj(I, &volume_class, v);
+    *out = val_obj(I, &lang_volume_class, v);
     return out->k == V_NIL ? -1 : 0;
 }
 
 volume *lang_as_volume(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &volume_class ? &((vol_payload *)AS_OBJ(v)->payload)->v : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_volume_class ? &((vol_payload *)AS_OBJ(v)->payload)->v : NULL;
 }
 
 /* ---- meshes --------------------------------------------------------------------------- */
@@ -391,7 +280,7 @@ static int mesh_save_hook(interp *I, const void *p, const char *path, value opts
     char ext[16];
     fileio_ext(path, ext, sizeof ext);
     double ascii = 0;
-    if (opts_check(I, opts, "rec{ascii: bool}", "save") || opt_num(I, opts, "ascii", &ascii) < 0)
+    if (contract_check_opts(I, opts, "rec{ascii: bool}", "save") || lang_opt_num(I, opts, "ascii", &ascii) < 0)
         return -1;
     rt_error e;
     rt_code c;
@@ -406,7 +295,7 @@ static int mesh_save_hook(interp *I, const void *p, const char *path, value opts
     return 0;
 }
 
-const obj_class mesh_class = {
+const obj_class lang_mesh_class = {
     .name = "mesh",
     .destroy = mesh_destroy,
     .summary = mesh_summary,
@@ -420,13 +309,13 @@ int lang_mesh_value(interp *I, mesh *m, value *out)
         mesh_destroy(m);
         return err_at(I, NULL, ERR_MEMORY, "out of memory building a mesh");
     }
-    *out = val_obj(I, &mesh_class, m);
+    *out = val_obj(I, &lang_mesh_class, m);
     return out->k == V_NIL ? -1 : 0;
 }
 
 mesh *lang_as_mesh(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &mesh_class ? AS_OBJ(v)->payload : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_mesh_class ? AS_OBJ(v)->payload : NULL;
 }
 
 /* ---- builtins ----------------------------------------------------------------------------- */
@@ -448,7 +337,7 @@ static int load_vdb(interp *I, const char *path, value grid, value *out)
         rc = lang_volume_new(I, tmp[i].nx, tmp[i].ny, tmp[i].nz, tmp[i].lo, tmp[i].hi, &v);
         if (!rc) {
             memcpy(v->v, tmp[i].v, (size_t)tmp[i].nx * tmp[i].ny * tmp[i].nz * sizeof(float));
-            rc = lang_volume_value(I, v, ch == 3 ? &x : out) || (ch == 3 && list_push(I, AS_LIST(l), x));
+            rc = lang_volume_value(I, v, ch == 3 ? &x : out) || (ch == 3 && val_list_push(I, AS_LIST(l), x));
         }
     }
     for (int i = 0; i < ch; i++)
@@ -466,7 +355,7 @@ static int b_load_volume(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096], ext[16];
-    if (script_relative_path(I, a[0], path, sizeof path, "load_volume"))
+    if (lang_script_path(I, a[0], path, sizeof path, "load_volume"))
         return -1;
     fileio_ext(path, ext, sizeof ext);
     if (strcmp(ext, "vdb") == 0)
@@ -492,7 +381,7 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
 {
     (void)n;
     char path[4096];
-    if (script_relative_path(I, a[0], path, sizeof path, "load_mesh"))
+    if (lang_script_path(I, a[0], path, sizeof path, "load_mesh"))
         return -1;
     mesh *m = mem_alloc(I, sizeof *m);
     if (!m)
@@ -530,9 +419,9 @@ static int b_mesh_stats(interp *I, value *a, int n, value *out)
              {"volume", st.volume},
              {"watertight", st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.triangles > 0}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
-        const char *k = intern(I, f[i].k, strlen(f[i].k));
+        const char *k = interp_intern(I, f[i].k, strlen(f[i].k));
         value v = i == 9 ? val_bool(f[i].v != 0) : val_num(f[i].v);
-        if (!k || rec_set(I, AS_REC(r), k, v)) {
+        if (!k || val_rec_set(I, AS_REC(r), k, v)) {
             val_unref(I, r);
             return -1;
         }
@@ -559,7 +448,7 @@ static int b_slice(interp *I, value *a, int n, value *out)
         return -1;
     int len = axis == 0 ? v->nx : axis == 1 ? v->ny : v->nz;
     long index = len / 2;
-    if (a[2].k != V_NIL && get_int(I, a[2], 0, len - 1, &index, "slice: index"))
+    if (a[2].k != V_NIL && builtin_get_int(I, a[2], 0, len - 1, &index, "slice: index"))
         return -1;
     ramp r;
     if (lang_get_ramp(I, a[3], &r, "slice: palette"))
@@ -615,5 +504,5 @@ static const builtin volume_builtins[] = {
 
 int bind_volume_init(interp *I)
 {
-    return builtins_register(I, volume_builtins, (int)(sizeof volume_builtins / sizeof volume_builtins[0]));
+    return builtin_register(I, volume_builtins, (int)(sizeof volume_builtins / sizeof volume_builtins[0]));
 }

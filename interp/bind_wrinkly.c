@@ -1,8 +1,8 @@
-/* bind_wrinkly.c — seed 002 in the language: the Iterated Shuffle
- * Transformation (ist objects), wrinkly curves (drawn into images or SVG)
- * and wrinkly surfaces (tessellated into meshes, rasterised with a Z-buffer).
- * The reference for scripts is docs/wrinkly.md; the engines are
- * runtime/ist.h, runtime/wrinkly.h and runtime/raster.h. */
+/* bind_wrinkly.c — seed 002 in the language: wrinkly curves (drawn into
+ * images or SVG) and wrinkly surfaces (tessellated into meshes). The IST
+ * binding is bind_ist.c, the rasteriser's bind_raster.c; what they share is
+ * in lang_wrinkly.h. The reference for scripts is docs/wrinkly.md; the
+ * engines are runtime/ist.h and runtime/wrinkly.h. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,12 +14,8 @@
 #include "ist.h"
 #include "lang_image.h"
 #include "lang_objects.h"
-#include "raster.h"
+#include "lang_wrinkly.h"
 #include "wrinkly.h"
-
-#define MAX_CONTROL 100000 /* control points per axis */
-#define MAX_M 50           /* crossing count of curves and surfaces (wrinkly.c) */
-#define MAX_KMAX 20
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
@@ -64,7 +60,7 @@ static int get_style(interp *I, value tension, value shuffle, value crack, value
     o->crack_band = crack.u.n;
     o->jitter = jitter.u.b;
     o->extra = (int)extra.u.n;
-    return arg_seed(I, seed, &o->seed, what);
+    return lang_arg_seed(I, seed, &o->seed, what);
 }
 
 static void style_summary(const wrinkly_opts *o, bytebuf *out)
@@ -78,316 +74,6 @@ static void style_summary(const wrinkly_opts *o, bytebuf *out)
     if (o->normal != WRINKLY_NORMAL_AUTO)
         bytebuf_printf(out, ", normal %s",
                        o->normal == WRINKLY_NORMAL_OUTWARD ? "outward" : o->normal == WRINKLY_NORMAL_INWARD ? "inward" : "uv");
-}
-
-/* ---- ist objects -------------------------------------------------------------------- */
-
-typedef struct ist_obj {
-    ist t;
-} ist_obj;
-
-static void ist_destroy(void *p)
-{
-    ist_obj *o = p;
-    ist_free(&o->t);
-    rt_free(o);
-}
-
-static void ist_summary(const void *p, bytebuf *out)
-{
-    const ist *t = &((const ist_obj *)p)->t;
-    int lo = t->ms[0], hi = t->ms[0];
-    for (int i = 1; i < t->n; i++) {
-        lo = t->ms[i] < lo ? t->ms[i] : lo;
-        hi = t->ms[i] > hi ? t->ms[i] : hi;
-    }
-    bytebuf_printf(out, "ist: %d interval%s", t->n, t->n == 1 ? "" : "s");
-    if (t->bounds[0] != 0 || t->bounds[t->n] != t->n)
-        bytebuf_printf(out, " on [%g, %g)", t->bounds[0], t->bounds[t->n]);
-    if (lo == hi)
-        bytebuf_printf(out, ", M = %d", lo);
-    else
-        bytebuf_printf(out, ", M = %d..%d", lo, hi);
-    bytebuf_printf(out, ", K = %d, %s", t->k, t->axis == IST_CYCLIC ? "cyclic" : "translation");
-}
-
-static int ist_get(interp *I, const void *p, const char *name, value *out)
-{
-    const ist *t = &((const ist_obj *)p)->t;
-    if (strcmp(name, "intervals") == 0)
-        *out = val_num(t->n);
-    else if (strcmp(name, "iterations") == 0)
-        *out = val_num(t->k);
-    else if (strcmp(name, "cyclic") == 0)
-        *out = val_bool(t->axis == IST_CYCLIC);
-    else if (strcmp(name, "closed_form") == 0)
-        *out = val_bool(t->closed);
-    else if (strcmp(name, "bounds") == 0)
-        return num_list_value(I, t->bounds, (size_t)t->n + 1, out);
-    else if (strcmp(name, "crossings") == 0) {
-        double *m = mem_alloc(I, sizeof(double) * (size_t)t->n);
-        if (!m)
-            return err_at(I, NULL, ERR_MEMORY, "out of memory");
-        for (int i = 0; i < t->n; i++)
-            m[i] = t->ms[i];
-        int r = num_list_value(I, m, (size_t)t->n, out);
-        mem_free(I, m);
-        return r;
-    } else
-        return 1;
-    return 0;
-}
-
-static const obj_class ist_class = {
-    .name = "ist",
-    .destroy = ist_destroy,
-    .summary = ist_summary,
-    .get = ist_get,
-};
-
-/* Bytes the list evaluator needs for Σ|L_i^K| entries (ist.h: seven arrays). */
-#define IST_ENTRY_BYTES 48.0
-
-static double ist_list_estimate(const ist *t)
-{
-    int bmax = 1;
-    for (int i = 0; i < t->n; i++)
-        bmax = 2 * t->ms[i] + 1 > bmax ? 2 * t->ms[i] + 1 : bmax;
-    double e = t->n * pow(bmax, t->k);
-    return e > (double)IST_MAX_ENTRIES ? (double)IST_MAX_ENTRIES : e;
-}
-
-/* ist(intervals, crossings, iterations, cyclic, bounds, method) */
-static int b_ist(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    const char *W = "ist";
-    long nint = 5, k;
-    double *bounds = NULL;
-    int *ms = NULL;
-    if (a[4].k != V_NIL) {
-        size_t nb = AS_LIST(a[4])->n;
-        if (nb < 2 || nb > MAX_CONTROL + 1)
-            return err_arg(I, 4, ERR_VALUE, "ist: bounds must be a list of 2 to %d numbers (N + 1 for N intervals), got %zu",
-                           MAX_CONTROL + 1, nb);
-        if (a[0].k != V_NIL && a[0].u.n + 1 != (double)nb)
-            return err_arg(I, 4, ERR_VALUE, "ist: intervals is %g but bounds gives %zu intervals (N + 1 bounds for N intervals)",
-                           a[0].u.n, nb - 1);
-        nint = (long)nb - 1;
-    } else if (a[0].k != V_NIL) {
-        nint = (long)a[0].u.n;
-    }
-    k = (long)a[2].u.n;
-    ist_spec s = {.n = (int)nint, .k = (int)k, .axis = a[3].u.b ? IST_CYCLIC : IST_TRANSLATION};
-    const char *meth = AS_STR(a[5])->s;
-    s.method = strcmp(meth, "lists") == 0 ? IST_LISTS : strcmp(meth, "closed") == 0 ? IST_CLOSED : IST_AUTO;
-    int rc = -1;
-    if (a[4].k != V_NIL) {
-        bounds = mem_alloc(I, sizeof(double) * (size_t)(nint + 1));
-        if (!bounds)
-            return err_at(I, NULL, ERR_MEMORY, "out of memory");
-        for (long i = 0; i <= nint; i++)
-            bounds[i] = AS_LIST(a[4])->items[i].u.n; /* declared vec: finite numbers */
-        for (long i = 0; i < nint; i++)
-            if (!(bounds[i + 1] > bounds[i])) {
-                err_item(I, a[4], (size_t)i + 1, ERR_VALUE,
-                         "ist: bounds must increase, but bound %ld = %g is not greater than bound %ld = %g", i + 1,
-                         bounds[i + 1], i, bounds[i]);
-                goto done;
-            }
-        s.bounds = bounds;
-    }
-    if (a[1].k == V_LIST) {
-        if (AS_LIST(a[1])->n != (size_t)nint) {
-            err_arg(I, 1, ERR_VALUE, "ist: crossings must be one whole number or a list of %ld (one per interval), got %zu",
-                    nint, AS_LIST(a[1])->n);
-            goto done;
-        }
-        ms = mem_alloc(I, sizeof(int) * (size_t)nint);
-        if (!ms) {
-            err_at(I, NULL, ERR_MEMORY, "out of memory");
-            goto done;
-        }
-        for (long i = 0; i < nint; i++) {
-            double x = AS_LIST(a[1])->items[i].u.n; /* declared vec[0,1000] */
-            if (x != floor(x)) {
-                err_item(I, a[1], (size_t)i, ERR_VALUE, "ist: argument 'crossings' item %ld must be a whole number, got %g",
-                         i + 1, x);
-                goto done;
-            }
-            ms[i] = (int)x;
-        }
-        s.m_each = ms;
-    } else {
-        s.m = (int)a[1].u.n;
-    }
-    ist_obj *o = mem_calloc(I, 1, sizeof *o);
-    if (!o) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory");
-        goto done;
-    }
-    /* The list evaluator is used unless the closed form applies: check its
-     * memory first (an upper bound: N·(2M+1)^K entries; the hook counts the
-     * lists themselves). */
-    {
-        int mmax = s.m, uniform = 1, equal = 1;
-        if (ms)
-            for (long i = 0; i < nint; i++) {
-                mmax = ms[i] > mmax ? ms[i] : mmax;
-                uniform &= ms[i] == ms[0];
-            }
-        if (bounds)
-            for (long i = 0; i <= nint; i++)
-                equal &= bounds[i] == bounds[0] + (double)i * (bounds[1] - bounds[0]);
-        double est = (double)nint * pow(2.0 * mmax + 1, (double)s.k);
-        if (est > (double)IST_MAX_ENTRIES)
-            est = (double)IST_MAX_ENTRIES;
-        int closed = uniform && equal && s.method != IST_LISTS && pow(2.0 * mmax + 1, (double)s.k) <= 4503599627370496.0;
-        if (!closed) {
-            if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST list evaluator")) {
-                mem_free(I, o);
-                goto done;
-            }
-        }
-    }
-    rt_error e;
-    rt_code c = ist_init(&o->t, &s, &e);
-    if (c) {
-        mem_free(I, o);
-        lang_rt_error(I, c, &e, W);
-        goto done;
-    }
-    *out = val_obj(I, &ist_class, o);
-    rc = out->k == V_NIL ? -1 : 0;
-done:
-    mem_free(I, bounds);
-    mem_free(I, ms);
-    return rc;
-}
-
-static int ist_map(interp *I, value *a, int fwd, value *out)
-{
-    const ist *t = &((ist_obj *)AS_OBJ(a[0])->payload)->t;
-    if (a[1].k == V_NUM) {
-        *out = val_num(fwd ? ist_fwd(t, a[1].u.n) : ist_inv(t, a[1].u.n));
-        return 0;
-    }
-    vlist *l = AS_LIST(a[1]);
-    value r = val_list(I, l->n);
-    if (r.k == V_NIL)
-        return -1;
-    for (size_t i = 0; i < l->n; i++) {
-        double u = l->items[i].u.n;
-        if (list_push(I, AS_LIST(r), val_num(fwd ? ist_fwd(t, u) : ist_inv(t, u)))) {
-            val_unref(I, r);
-            return -1;
-        }
-    }
-    *out = r;
-    return 0;
-}
-
-static int b_ist_inv(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    return ist_map(I, a, 0, out);
-}
-
-static int b_ist_fwd(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    return ist_map(I, a, 1, out);
-}
-
-static int b_ist_lists(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    ist_obj *o = AS_OBJ(a[0])->payload;
-    ist *t = &o->t;
-    if (t->k > 9)
-        return err_at(I, NULL, ERR_VALUE, "ist_lists: the Fig. 2 notation needs iterations <= 9, this ist has K = %d",
-                      t->k);
-    if (t->closed && !t->x) {
-        double est = ist_list_estimate(t);
-        if (mem_precheck(I, est * IST_ENTRY_BYTES, "the IST list evaluator"))
-            return -1;
-    }
-    bytebuf b;
-    bytebuf_init(&b);
-    rt_error e;
-    rt_code c = ist_print(t, &b, &e);
-    if (c) {
-        bytebuf_free(&b);
-        return lang_rt_error(I, c, &e, "ist_lists");
-    }
-    /* drop the final newline: print() adds one */
-    size_t len = b.len;
-    if (len && b.data[len - 1] == '\n')
-        len--;
-    *out = val_str(I, (const char *)b.data, len);
-    bytebuf_free(&b);
-    return out->k == V_NIL ? -1 : 0;
-}
-
-static int b_ist_samples(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    const ist *t = &((ist_obj *)AS_OBJ(a[0])->payload)->t;
-    int *ki = mem_alloc(I, sizeof(int) * (size_t)t->n);
-    if (!ki)
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
-    int rc = -1;
-    double *pos = NULL;
-    if (a[1].k == V_LIST && AS_LIST(a[1])->n != (size_t)t->n) {
-        err_arg(I, 1, ERR_VALUE, "ist_samples: levels must be one whole number or a list of %d (one per interval), got %zu",
-                t->n, AS_LIST(a[1])->n);
-        goto done;
-    }
-    double count = 0;
-    for (int i = 0; i < t->n; i++) {
-        double l = t->k;
-        value v = a[1].k == V_LIST ? AS_LIST(a[1])->items[i] : a[1];
-        if (v.k != V_NIL)
-            l = v.u.n; /* declared: >= 0 */
-        if (l != floor(l) || l > t->k) {
-            char lw[48] = "";
-            if (a[1].k == V_LIST)
-                snprintf(lw, sizeof lw, " item %d", i + 1);
-            if (a[1].k == V_LIST)
-                err_item(I, a[1], (size_t)i, ERR_VALUE,
-                         "ist_samples: argument 'levels'%s must be a whole number from 0 to the ist's iterations %d, got %g",
-                         lw, t->k, l);
-            else
-                err_arg(I, 1, ERR_VALUE,
-                        "ist_samples: argument 'levels' must be a whole number from 0 to the ist's iterations %d, got %g",
-                        t->k, l);
-            goto done;
-        }
-        ki[i] = (int)l;
-        count += pow(2.0 * t->ms[i] + 1, (double)l);
-    }
-    if (count > I->lim.max_list || count > I->lim.max_points) {
-        err_at(I, NULL, ERR_LIMIT, "ist_samples: %.0f samples exceed the list limit (raise it with --max-list)", count);
-        goto done;
-    }
-    uint64_t seed;
-    if (arg_seed(I, a[3], &seed, "ist_samples"))
-        goto done;
-    pos = mem_alloc(I, sizeof(double) * ((size_t)count + 1));
-    if (!pos) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory for %.0f samples", count);
-        goto done;
-    }
-    size_t got = ist_sample_positions(t, ki, a[2].u.b, seed, pos, (size_t)count);
-    if (got == (size_t)-1 || got > (size_t)count) {
-        err_at(I, NULL, ERR_VALUE, "ist_samples: too many sub-intervals; lower the levels");
-        goto done;
-    }
-    rc = num_list_value(I, pos, got, out);
-done:
-    mem_free(I, ki);
-    mem_free(I, pos);
-    return rc;
 }
 
 /* ---- control points ------------------------------------------------------------------ */
@@ -566,7 +252,7 @@ static int b_wrinkly_curve(interp *I, value *a, int n, value *out)
             err_item(I, a[0], i, ERR_VALUE, "%s must be a list of 2 numbers, got %s", w, got);
             goto fail;
         }
-        if (get_vec(I, pt, c->pts[i].pos, 2, w)) /* numbers: finite (declared list) */
+        if (builtin_get_vec(I, pt, c->pts[i].pos, 2, w)) /* numbers: finite (declared list) */
             goto fail;
     }
     if (fill_scalar(I, a[1], 0, c->n, c->pts, 0, W, "heights") || fill_colours(I, a[2], 0, c->n, c->pts, W) ||
@@ -584,18 +270,10 @@ fail:
     return -1;
 }
 
-/* Level of detail: iterations (fixed K) or tolerance (world length of a
- * sub-interval); kmax caps K. */
-typedef struct lod {
-    int k, kmax;
-    double tol;
-    int fixed; /* iterations given */
-} lod;
-
 /* iterations, tolerance and kmax as declared (int[0,20], num>0, int[0,20]);
  * tol_slot: the argument to blame when both iterations and tolerance are
  * given (-1: the call). */
-static int get_lod(interp *I, value iterations, value tolerance, value kmax, int tol_slot, lod *l, const char *what)
+int lang_get_lod(interp *I, value iterations, value tolerance, value kmax, int tol_slot, lod *l, const char *what)
 {
     l->k = 3;
     l->tol = 0;
@@ -648,7 +326,7 @@ static int b_wrinkly_points(interp *I, value *a, int n, value *out)
     (void)n;
     const curve_obj *c = AS_OBJ(a[0])->payload;
     lod l;
-    if (get_lod(I, a[1], a[2], a[3], 2, &l, "wrinkly_points"))
+    if (lang_get_lod(I, a[1], a[2], a[3], 2, &l, "wrinkly_points"))
         return -1;
     wrinkly_polyline pl;
     if (curve_sample(I, c, &l, &pl, "wrinkly_points"))
@@ -663,7 +341,7 @@ static int b_wrinkly_points(interp *I, value *a, int n, value *out)
         goto oom;
     for (size_t i = 0; i < pl.n; i++) {
         value pt;
-        if (num_list_value(I, pl.xy + 2 * i, 2, &pt) || list_push(I, AS_LIST(r), pt)) {
+        if (lang_num_list_value(I, pl.xy + 2 * i, 2, &pt) || val_list_push(I, AS_LIST(r), pt)) {
             val_unref(I, r);
             goto oom;
         }
@@ -712,7 +390,7 @@ static int get_view(interp *I, const curve_obj *c, value bounds, int w, int h, d
         snprintf(m, sizeof m, "%s: bounds", what);
         if (l->n != 2 || l->items[0].k != V_LIST || l->items[1].k != V_LIST)
             return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must be [[xmin, ymin], [xmax, ymax]]", what);
-        if (get_vec(I, l->items[0], lo, 2, m) || get_vec(I, l->items[1], hi, 2, m))
+        if (builtin_get_vec(I, l->items[0], lo, 2, m) || builtin_get_vec(I, l->items[1], hi, 2, m))
             return -1;
         if (!(hi[0] > lo[0] && hi[1] > lo[1]))
             return err_item(I, bounds, SIZE_MAX, ERR_VALUE, "%s: bounds must have xmin < xmax and ymin < ymax", what);
@@ -802,7 +480,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     if (onto) {
         w = onto->w;
         h = onto->h;
-    } else if (arg_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
+    } else if (lang_arg_size2(I, a[1], &w, &h, "wrinkly_draw: size")) {
         return -1;
     }
     draw_view v;
@@ -817,7 +495,7 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
         return err_arg(I, 5, ERR_VALUE, "wrinkly_draw: fill needs a closed curve (wrinkly_curve(…, closed: true))");
     lod l;
     value tol = a[9].k == V_NIL ? val_num(a[8].u.n / v.sx) : val_nil();
-    if (get_lod(I, a[9], tol, a[10], -1, &l, W))
+    if (lang_get_lod(I, a[9], tol, a[10], -1, &l, W))
         return -1;
     image *im;
     if (lang_image_new(I, w, h, &im))
@@ -870,15 +548,15 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
         return err_at(I, NULL, ERR_VALUE,
                       "save: a wrinkly curve is saved as .svg (draw it with wrinkly_draw for a picture), got '.%s'", ext);
     double size = 512, width = 1.5, iters = -1;
-    if (opts_check(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int[0,20]}", "save") ||
-        opt_num(I, opts, "size", &size) < 0 || opt_num(I, opts, "width", &width) < 0 ||
-        opt_num(I, opts, "iterations", &iters) < 0)
+    if (contract_check_opts(I, opts, "rec{size: int[1,1000000], width: num(0,1000], iterations: int[0,20]}", "save") ||
+        lang_opt_num(I, opts, "size", &size) < 0 || lang_opt_num(I, opts, "width", &width) < 0 ||
+        lang_opt_num(I, opts, "iterations", &iters) < 0)
         return -1;
     draw_view v;
     if (get_view(I, c, val_nil(), (int)size, (int)size, &v, "save"))
         return -1;
     lod l;
-    if (get_lod(I, iters >= 0 ? val_num(iters) : val_nil(), iters >= 0 ? val_nil() : val_num(1 / v.sx), val_num(8), -1,
+    if (lang_get_lod(I, iters >= 0 ? val_num(iters) : val_nil(), iters >= 0 ? val_nil() : val_num(1 / v.sx), val_num(8), -1,
                 &l, "save"))
         return -1;
     wrinkly_polyline pl;
@@ -905,13 +583,6 @@ static int curve_save(interp *I, const void *p, const char *path, value opts)
 }
 
 /* ---- surfaces ------------------------------------------------------------------------ */
-
-typedef struct surf_obj {
-    wrinkly_point *pts;
-    int nu, nv;
-    wrinkly_axis au, av;
-    wrinkly_opts style;
-} surf_obj;
 
 static void surf_destroy(void *p)
 {
@@ -965,11 +636,11 @@ static void get_axis(interp *I, value v, wrinkly_axis *ax)
     if (v.k == V_NIL)
         return;
     double x;
-    if (opt_num(I, v, "cyclic", &x) == 1)
+    if (lang_opt_num(I, v, "cyclic", &x) == 1)
         ax->cyclic = x != 0;
-    if (opt_num(I, v, "ist", &x) == 1)
+    if (lang_opt_num(I, v, "ist", &x) == 1)
         ax->ist = x != 0;
-    if (opt_num(I, v, "crossings", &x) == 1)
+    if (lang_opt_num(I, v, "crossings", &x) == 1)
         ax->m = (int)x;
 }
 
@@ -1007,7 +678,7 @@ static int b_wrinkly_surface(interp *I, value *a, int n, value *out)
             char w[96];
             snprintf(w, sizeof w, "wrinkly_surface: control point [%zu][%zu]", j, i);
             double *p = s->pts[j * nu + i].pos;
-            if (get_vec(I, AS_LIST(row)->items[i], p, 3, w)) /* numbers: finite (declared list) */
+            if (builtin_get_vec(I, AS_LIST(row)->items[i], p, 3, w)) /* numbers: finite (declared list) */
                 goto fail;
         }
     }
@@ -1037,15 +708,15 @@ fail:
     return -1;
 }
 
-static surf_obj *as_surf(value v)
+surf_obj *lang_as_surf(value v)
 {
     return v.k == V_OBJ && AS_OBJ(v)->cls == &surf_class ? AS_OBJ(v)->payload : NULL;
 }
 
 /* Tessellate after checking the vertex count (--max-points) and the memory
  * the engine needs (--max-memory). cam may be NULL. */
-static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
-                     mesh **out, const char *what)
+int lang_surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
+                   mesh **out, const char *what)
 {
     wrinkly_surface ws = {so->pts, so->nu, so->nv, so->au, so->av};
     wrinkly_opts o = so->style;
@@ -1117,203 +788,20 @@ static int b_tessellate(interp *I, value *a, int n, value *out)
     camera cam;
     int use_cam, w = 256, h = 256;
     lod l;
-    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || arg_size2(I, a[2], &w, &h, "tessellate: size") ||
-        get_lod(I, a[5], a[4], a[6], 4, &l, W))
+    if (get_camera_lod(I, a[1], a[4], a[5], &cam, &use_cam, W) || lang_arg_size2(I, a[2], &w, &h, "tessellate: size") ||
+        lang_get_lod(I, a[5], a[4], a[6], 4, &l, W))
         return -1;
     mesh *m;
-    if (surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, &m, W))
+    if (lang_surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, &m, W))
         return -1;
     return lang_mesh_value(I, m, out);
 }
 
-/* ---- rasterising ------------------------------------------------------------------- */
+/* ---- registration ---------------------------------------------------------------------- */
 
-/* Bounding box of a scene item: a mesh's vertices, or a surface's control
- * points widened by the largest |height|. */
-static void item_box(value v, double lo[3], double hi[3])
-{
-    mesh *m = lang_as_mesh(v);
-    surf_obj *s = as_surf(v);
-    if (m) {
-        for (size_t i = 0; i < m->nv; i++)
-            for (int d = 0; d < 3; d++) {
-                lo[d] = fmin(lo[d], m->pos[3 * i + d]);
-                hi[d] = fmax(hi[d], m->pos[3 * i + d]);
-            }
-    } else if (s) {
-        double hm = 0;
-        for (size_t i = 0; i < (size_t)s->nu * (size_t)s->nv; i++) {
-            hm = fmax(hm, fabs(s->pts[i].h));
-            for (int d = 0; d < 3; d++) {
-                lo[d] = fmin(lo[d], s->pts[i].pos[d] - hm);
-                hi[d] = fmax(hi[d], s->pts[i].pos[d] + hm);
-            }
-        }
-        for (int d = 0; d < 3; d++) {
-            lo[d] -= hm;
-            hi[d] += hm;
-        }
-    }
-}
-
-/* Append src to dst (with fallback colour for meshes without colours). */
-static void mesh_append(mesh *dst, const mesh *src, const float colour[4])
-{
-    uint32_t base = (uint32_t)dst->nv;
-    static const float up[3] = {0, 1, 0};
-    for (size_t i = 0; i < src->nv; i++)
-        mesh_add_vertex(dst, src->pos + 3 * i, src->nrm ? src->nrm + 3 * i : up, src->col ? src->col + 4 * i : colour);
-    for (size_t t = 0; t < src->nt; t++)
-        mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
-}
-
-/* rasterize(scene, camera, size, background, light, ambient, diffuse, flat, unlit, colour, pixel, kmax) */
-static int b_rasterize(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    const char *W = "rasterize";
-    value scene = a[0];
-    size_t nitems = scene.k == V_LIST ? AS_LIST(scene)->n : 1;
-    if (nitems == 0)
-        return err_arg(I, 0, ERR_VALUE, "rasterize: the scene list is empty");
-    for (size_t i = 0; i < nitems; i++) {
-        value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
-        if (!lang_as_mesh(it) && !as_surf(it))
-            return err_item(I, scene, i, ERR_TYPE,
-                            "rasterize: the scene must be a mesh, a wrinkly_surface or a list of them, but item %zu is %s",
-                            i, val_type_name(it));
-    }
-    int w, h;
-    if (arg_size2(I, a[2], &w, &h, "rasterize: size"))
-        return -1;
-    raster_opts ro;
-    raster_opts_default(&ro);
-    if (lang_get_colour(I, a[3], ro.background, "rasterize: background") ||
-        lang_get_colour(I, a[9], ro.colour, "rasterize: colour"))
-        return -1;
-    if (a[4].k != V_NIL) {
-        if (get_vec(I, a[4], ro.light, 3, "rasterize: light"))
-            return -1;
-        if (ro.light[0] == 0 && ro.light[1] == 0 && ro.light[2] == 0)
-            return err_arg(I, 4, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
-    }
-    ro.ambient = a[5].u.n;
-    ro.diffuse = a[6].u.n;
-    ro.flat = a[7].u.b;
-    ro.unlit = a[8].u.b;
-    lod l;
-    if (get_lod(I, val_nil(), val_nil(), a[11], -1, &l, W))
-        return -1;
-    camera cam;
-    if (a[1].k != V_NIL) {
-        if (lang_get_camera(I, a[1], &cam, W))
-            return -1;
-    } else {
-        /* frame the scene: orbit(30, 20) around the centre of its box */
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
-        for (size_t i = 0; i < nitems; i++)
-            item_box(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene, lo, hi);
-        double r = 0;
-        for (int d = 0; d < 3; d++) {
-            if (!(hi[d] >= lo[d]))
-                lo[d] = hi[d] = 0;
-            c[d] = 0.5 * (lo[d] + hi[d]);
-            r += 0.25 * (hi[d] - lo[d]) * (hi[d] - lo[d]);
-        }
-        r = sqrt(r);
-        double fov = 40, half = 0.5 * fov * 3.14159265358979323846 / 180;
-        if (w < h)
-            half = atan(tan(half) * w / h);
-        camera_orbit(&cam, c, r > 0 ? 1.05 * r / sin(half) : 1, 30, 20, fov);
-        if (camera_setup(&cam))
-            return err_at(I, NULL, ERR_VALUE, "rasterize: cannot frame the scene");
-    }
-    /* one mesh to draw: a mesh as given, or the tessellations (LOD from this
-     * camera) and meshes merged in order */
-    mesh *single = nitems == 1 ? lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[0] : scene) : NULL;
-    mesh *merged = NULL;
-    int rc = -1;
-    image *im = NULL;
-    if (!single) {
-        int normals = 1;
-        double tv = 0;
-        for (size_t i = 0; i < nitems; i++) {
-            mesh *m = lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene);
-            if (m && !m->nrm && m->nt)
-                normals = 0;
-            tv += m ? (double)m->nv : 0;
-        }
-        merged = mem_alloc(I, sizeof *merged);
-        if (!merged)
-            return err_at(I, NULL, ERR_MEMORY, "out of memory");
-        mesh_init(merged, normals, 1);
-        for (size_t i = 0; i < nitems; i++) {
-            value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
-            mesh *m = lang_as_mesh(it), *t = NULL;
-            if (!m) {
-                if (surf_mesh(I, as_surf(it), &cam, w, h, a[10].u.n, &l, &t, W))
-                    goto done;
-                m = t;
-            }
-            tv += t ? (double)t->nv : 0;
-            if (tv >= 4294967295.0 || tv > I->lim.max_points) {
-                if (t) {
-                    mesh_free(t);
-                    mem_free(I, t);
-                }
-                err_at(I, NULL, ERR_LIMIT,
-                       "rasterize: the scene has more than %.0f vertices (raise it with --max-points)",
-                       fmin(I->lim.max_points, 4294967294.0));
-                goto done;
-            }
-            mesh_append(merged, m, ro.colour);
-            if (t) {
-                mesh_free(t);
-                mem_free(I, t);
-            }
-            if (merged->failed) {
-                err_at(I, NULL, ERR_MEMORY, "out of memory merging the scene");
-                goto done;
-            }
-        }
-        single = merged;
-    }
-    if (lang_image_new(I, w, h, &im))
-        goto done;
-    rt_run run = lang_run(I);
-    rt_error e;
-    rt_code c = raster_render(single, &cam, &ro, &run, im, &e);
-    if (c) {
-        lang_rt_error(I, c, &e, W);
-        goto done;
-    }
-    rc = lang_image_value(I, im, out);
-    im = NULL;
-done:
-    lang_image_discard(im);
-    if (merged) {
-        mesh_free(merged);
-        mem_free(I, merged);
-    }
-    return rc;
-}
-
-/* ---- registration -------------------------------------------------------------------- */
-
-/* MAX_CONTROL, MAX_M and MAX_KMAX written out (type texts are literal);
- * IST_MAX_K is a plain number in ist.h, so its text comes from the macro. */
-#define TY_STR_(x) #x
-#define TY_STR(x) TY_STR_(x)
-#define TY_LOD_K "int[0,20]"
+/* MAX_CONTROL, MAX_M and MAX_KMAX written out (type texts are literal). */
 #define TY_AXIS "rec{cyclic: bool, crossings: int[0,50], ist: bool}"
 #define TY_SHUFFLE "str{height,colour,color,opacity}|list"
-static const bparam p_ist[] = {{"intervals", "int[1,100000]", "nil"}, {"crossings", "int[0,1000]|vec[0,1000]", "1"},
-                               {"iterations", "int[0," TY_STR(IST_MAX_K) "]", "2"},      {"cyclic", "bool", "false"},
-                               {"bounds", "vec", "nil"},              {"method", "str{auto,lists,closed}", "\"auto\""}};
-static const bparam p_ist_map[] = {{"ist", "ist", NULL}, {"u", "num|vec", NULL}};
-static const bparam p_ist_one[] = {{"ist", "ist", NULL}};
-static const bparam p_ist_samples[] = {{"ist", "ist", NULL}, {"levels", "int>=0|vec[0,60]", "nil"},
-                                       {"jitter", "bool", "false"}, {"seed", "int>=0", "nil"}};
 static const bparam p_curve[] = {{"points", "list", NULL},          {"heights", "num|vec", "0"},
                                  {"colours", "num|str|list", "nil"}, {"opacity", "num|vec", "1"},
                                  {"crossings", "int[0,50]", "1"},   {"closed", "bool", "false"},
@@ -1340,29 +828,8 @@ static const bparam p_tess[] = {{"surface", "wrinkly_surface", NULL}, {"camera",
                                 {"size", TY_SIZE, "[256, 256]"},      {"pixel", "num>0", "1"},
                                 {"tolerance", "num>0", "nil"},        {"iterations", TY_LOD_K, "nil"},
                                 {"kmax", TY_LOD_K, "8"}};
-static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
-                                  {"camera", TY_CAMERA, "nil"},
-                                  {"size", TY_SIZE, "[256, 256]"},
-                                  {"background", TY_COLOUR, "0"},
-                                  {"light", "vec3", "nil"},
-                                  {"ambient", "num>=0", "0.2"},
-                                  {"diffuse", "num>=0", "0.8"},
-                                  {"flat", "bool", "false"},
-                                  {"unlit", "bool", "false"},
-                                  {"colour", TY_COLOUR, "1"},
-                                  {"pixel", "num>0", "1"},
-                                  {"kmax", TY_LOD_K, "8"}};
 
 static const builtin wrinkly_builtins[] = {
-    BUILTIN("ist", b_ist, p_ist,
-            "An Iterated Shuffle Transformation (seed 002 §4.1): N base intervals (default 5, or the N + 1 `bounds`), crossing count M (`crossings`, one number or one per interval), K = `iterations`, on a translation or `cyclic` axis. method: \"auto\", \"lists\" or \"closed\"."),
-    BUILTIN("ist_inv", b_ist_inv, p_ist_map,
-            "F^{-1}(u) of an ist: the source coordinate whose attributes appear at u (eq. 9); u a number or a list of numbers."),
-    BUILTIN("ist_fwd", b_ist_fwd, p_ist_map, "F(u) of an ist: where the source coordinate u is moved to (eq. 6)."),
-    BUILTIN("ist_lists", b_ist_lists, p_ist_one,
-            "The lists L_i^K of an ist in the notation of the paper's Fig. 2, one line per base interval (\"L5: 322 412 502 | …\"); K <= 9."),
-    BUILTIN("ist_samples", b_ist_samples, p_ist_samples,
-            "The adaptive sample positions of §5.2: in each base interval the (2M+1)^levels chosen sub-intervals' centres (or a seeded random point with jitter); levels one number or one per interval, default K."),
     BUILTIN("wrinkly_curve", b_wrinkly_curve, p_curve,
             "A wrinkly curve (eq. 10) through 2-D control points with heights, colours and opacity; crossings M, closed (cyclic), ist: false for the plain spline; shuffle names the attributes the IST moves; crack_band, jitter, extra, seed control the sampling."),
     BUILTIN("wrinkly_points", b_wrinkly_points, p_points,
@@ -1373,11 +840,9 @@ static const builtin wrinkly_builtins[] = {
             "A wrinkly surface (eq. 11) over a grid of control points [x, y, z] (a list of rows): heights, colours, opacity per point (or one value); u and v are records {cyclic, crossings, ist}; normal: \"outward\", \"inward\" or \"uv\" orients N (default: outward for a body-like surface, else P_u × P_v)."),
     BUILTIN("tessellate", b_tessellate, p_tess,
             "Sample a wrinkly surface into a coloured mesh (§5.2): with a camera, sub-intervals project to at most `pixel` pixels of an image of `size`; else `tolerance` (world length) or fixed `iterations` (default 3)."),
-    BUILTIN("rasterize", b_rasterize, p_raster,
-            "Render a mesh, a wrinkly surface or a list of them with a Z-buffer into an image: camera (default: framing the scene), lights, background; surfaces are tessellated for this camera."),
 };
 
 int bind_wrinkly_init(interp *I)
 {
-    return builtins_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
+    return builtin_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
 }

@@ -4,7 +4,7 @@
  * the table is the contract: argument matching, every check of types,
  * ranges and finiteness, the messages ("chaos: argument 'points' must be a
  * number, got string"), `frac check` and `:help NAME` all come from it
- * (contract.c compiles it once, at builtins_register; call_builtin checks
+ * (contract.c compiles it once, at builtin_register; call_builtin checks
  * it before the builtin runs). A builtin only reads what was declared.
  *
  * Types: '|'-separated alternatives, each a base name with optional parts:
@@ -71,40 +71,46 @@ typedef struct builtin {
 #define BUILTIN(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 0, doc}
 #define BUILTIN_VAR(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 1, doc}
 
-/* Register a table of builtins (static storage) as globals. */
-int builtins_register(interp *I, const builtin *b, int n);
+/* The registry (builtin.c). Register a table of builtins (static storage) as globals. */
+int builtin_register(interp *I, const builtin *b, int n);
 /* All modules' registration functions, called by interp setup. */
-int builtins_core_init(interp *I);
-int builtins_image_init(interp *I);
+int builtin_core_init(interp *I);
+int builtin_image_init(interp *I);
 /* Engine bindings (interp/bind_*.c), registered by bindings.c. */
-int bindings_init(interp *I);
+int bind_all_init(interp *I);
 int bind_volume_init(interp *I);
 int bind_field_init(interp *I);
 int bind_ifs_init(interp *I);
 int bind_solid_init(interp *I);
+int bind_ist_init(interp *I);
 int bind_wrinkly_init(interp *I);
+int bind_raster_init(interp *I);
 int bind_show_init(interp *I);
 int bind_fset_init(interp *I);
+int bind_shape_init(interp *I);
+int bind_tops_init(interp *I);
+int bind_superifs_init(interp *I);
+int bind_tiles_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
-int call_value(interp *I, value fn, const value *args, int nargs, value *out);
+int eval_call_value(interp *I, value fn, const value *args, int nargs, value *out);
 
 /* Helpers for builtins. */
-int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
+int builtin_arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 /* Check that v is a list of n numbers (n = 0: any length); copy to out. */
-int get_vec(interp *I, value v, double *out, size_t n, const char *what);
-int get_int(interp *I, value v, long lo, long hi, long *out, const char *what);
+int builtin_get_vec(interp *I, value v, double *out, size_t n, const char *what);
+int builtin_get_int(interp *I, value v, long lo, long hi, long *out, const char *what);
 /* Shared argument readers (args.c): a seed (nil: the global --seed), an
  * image size (n or [w, h] whole pixels), a list of numbers as a value, and a
  * path relative to the folder of the script being run. `what` prefixes
- * messages ("chaos: size"); arg_seed accepts NULL. */
-int arg_seed(interp *I, value v, uint64_t *seed, const char *what);
-int arg_size2(interp *I, value v, int *w, int *h, const char *what);
-int num_list_value(interp *I, const double *x, size_t n, value *out);
+ * messages ("chaos: size"); lang_arg_seed accepts NULL. */
+int lang_arg_seed(interp *I, value v, uint64_t *seed, const char *what);
+int lang_arg_size2(interp *I, value v, int *w, int *h, const char *what);
+int lang_num_list_value(interp *I, const double *x, size_t n, value *out);
 /* A path string v relative to the script's folder, into buf; 0, or -1 with
  * an error "WHAT: path too long: …" (never truncated) or a NUL byte error. */
-int script_relative_path(interp *I, value v, char *buf, size_t n, const char *what);
+int lang_script_path(interp *I, value v, char *buf, size_t n, const char *what);
 /* dir/p (p alone if it is absolute or dir is NULL or "."), checked the same
  * way; errors are at node at (NULL: the current call). */
 int lang_join_path(interp *I, const node *at, const char *dir, const char *p, size_t plen, char *buf, size_t n,
@@ -125,7 +131,7 @@ int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...) __attribute__
  * of an image, a mesh…) against a declared type text "rec{…}" (compiled
  * once); nil passes. Errors point at the record's key when it is written at
  * the call. */
-int opts_check(interp *I, value opts, const char *type, const char *who);
+int contract_check_opts(interp *I, value opts, const char *type, const char *who);
 
 /* Signature text "name(a, b: num[0,1] = 2)" for help: the declared types. */
 void builtin_signature(const builtin *b, struct bytebuf *out);

@@ -2,122 +2,14 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
-#include <stdarg.h>
 #include <string.h>
 
 #include "builtin.h"
-#include "contract.h"
 #include "cstack.h"
 #include "eval.h"
 #include "fileio.h"
 #include "lexer.h"
 #include "rng.h"
-
-/* ---- registry and helpers ---------------------------------------------------- */
-
-int builtins_register(interp *I, const builtin *b, int n)
-{
-    env *root = I->globals;
-    while (root->parent)
-        root = root->parent;
-    for (int i = 0; i < n; i++) {
-        /* two builtins with one name would silently hide each other */
-        if (builtin_find(I, b[i].name))
-            return err_at(I, NULL, ERR_RUNTIME, "internal error: builtin '%s' is defined twice", b[i].name);
-        if (I->nbuiltins == I->cap_builtins) {
-            int nc = I->cap_builtins ? I->cap_builtins * 2 : 256;
-            const builtin **nb = mem_realloc(I, I->builtins, (size_t)nc * sizeof *nb);
-            if (!nb)
-                return -1;
-            I->builtins = nb;
-            I->cap_builtins = nc;
-        }
-        I->builtins[I->nbuiltins++] = &b[i];
-        if (contract_register(I, &b[i]))
-            return -1;
-        value v;
-        v.k = V_BUILTIN;
-        v.u.bi = &b[i];
-        const char *name = intern(I, b[i].name, strlen(b[i].name));
-        if (!name || env_define(I, root, name, v))
-            return -1;
-    }
-    return 0;
-}
-
-const builtin *builtin_find(interp *I, const char *name)
-{
-    for (int i = 0; i < I->nbuiltins; i++)
-        if (strcmp(I->builtins[i]->name, name) == 0)
-            return I->builtins[i];
-    return NULL;
-}
-
-int arg_error(interp *I, const builtin *b, const char *param, const char *fmt, ...)
-{
-    char msg[768];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    if (param)
-        return err_at(I, NULL, ERR_VALUE, "%s: argument '%s' %s", b->name, param, msg);
-    return err_at(I, NULL, ERR_VALUE, "%s: %s", b->name, msg);
-}
-
-int get_vec(interp *I, value v, double *out, size_t n, const char *what)
-{
-    if (v.k != V_LIST)
-        return err_at(I, NULL, ERR_TYPE, "%s must be a list of %zu numbers, got %s", what, n,
-                      val_type_name(v));
-    vlist *l = AS_LIST(v);
-    if (n && l->n != n)
-        return err_at(I, NULL, ERR_VALUE, "%s must be a list of %zu numbers, got %zu items", what, n, l->n);
-    for (size_t i = 0; i < l->n; i++) {
-        if (l->items[i].k != V_NUM)
-            return err_item(I, v, i, ERR_TYPE, "%s must contain numbers, but item %zu is %s", what, i + 1,
-                            val_type_name(l->items[i]));
-        if (!isfinite(l->items[i].u.n))
-            return err_item(I, v, i, ERR_VALUE, "%s item %zu must be a finite number, got %s", what, i + 1,
-                            isnan(l->items[i].u.n) ? "nan" : l->items[i].u.n < 0 ? "-inf" : "inf");
-        if (out)
-            out[i] = l->items[i].u.n;
-    }
-    return 0;
-}
-
-int get_int(interp *I, value v, long lo, long hi, long *out, const char *what)
-{
-    if (v.k != V_NUM || !isfinite(v.u.n) || v.u.n != floor(v.u.n)) {
-        if (v.k == V_NUM) {
-            char got[40];
-            fmt_number(v.u.n, got, sizeof got);
-            return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what,
-                          isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
-        }
-        return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what, val_type_name(v));
-    }
-    if (v.u.n < (double)lo || v.u.n > (double)hi)
-        return err_at(I, NULL, ERR_VALUE, "%s must be between %ld and %ld, got %.17g", what, lo, hi, v.u.n);
-    *out = (long)v.u.n;
-    return 0;
-}
-
-void builtin_signature(const builtin *b, bytebuf *out)
-{
-    bytebuf_printf(out, "%s(", b->name);
-    if (b->variadic)
-        bytebuf_printf(out, "…%s", b->nparams ? ", " : "");
-    for (int i = 0; i < b->nparams; i++) {
-        const bparam *p = &b->params[i];
-        bytebuf_printf(out, "%s%s", i ? ", " : "", p->name);
-        if (p->type && strcmp(p->type, "any") != 0)
-            bytebuf_printf(out, ": %s", p->type);
-        if (p->def)
-            bytebuf_printf(out, " = %s", p->def);
-    }
-    bytebuf_printf(out, ")");
-}
 
 /* ---- math -------------------------------------------------------------------- */
 
@@ -139,7 +31,7 @@ static int apply1(interp *I, value a, math1 f, int opcode, value *out)
             return -1;
         for (size_t i = 0; i < AS_LIST(a)->n; i++) {
             value r;
-            if (apply1(I, AS_LIST(a)->items[i], f, opcode, &r) || list_push(I, AS_LIST(res), r)) {
+            if (apply1(I, AS_LIST(a)->items[i], f, opcode, &r) || val_list_push(I, AS_LIST(res), r)) {
                 val_unref(I, res);
                 return -1;
             }
@@ -287,7 +179,7 @@ static int b_dot(interp *I, value *a, int n, value *out)
         AS_LIST(a[0])->n > 64)
         return err_at(I, NULL, ERR_TYPE, "dot expects two lists of numbers of the same length");
     size_t k = AS_LIST(a[0])->n;
-    if (get_vec(I, a[0], x, k, "dot's first argument") || get_vec(I, a[1], y, k, "dot's second argument"))
+    if (builtin_get_vec(I, a[0], x, k, "dot's first argument") || builtin_get_vec(I, a[1], y, k, "dot's second argument"))
         return -1;
     double s = 0;
     for (size_t i = 0; i < k; i++)
@@ -300,7 +192,7 @@ static int b_length(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double x[64];
-    if (a[0].k != V_LIST || AS_LIST(a[0])->n > 64 || get_vec(I, a[0], x, AS_LIST(a[0])->n, "norm's argument"))
+    if (a[0].k != V_LIST || AS_LIST(a[0])->n > 64 || builtin_get_vec(I, a[0], x, AS_LIST(a[0])->n, "norm's argument"))
         return I->err.active ? -1 : err_at(I, NULL, ERR_TYPE, "norm expects a list of numbers");
     double s = 0;
     for (size_t i = 0; i < AS_LIST(a[0])->n; i++)
@@ -347,7 +239,7 @@ static int b_range(interp *I, value *a, int n, value *out)
     if (l.k == V_NIL)
         return -1;
     for (size_t i = 0; i < (size_t)count; i++)
-        if (list_push(I, AS_LIST(l), val_num(start + step * (double)i))) {
+        if (val_list_push(I, AS_LIST(l), val_num(start + step * (double)i))) {
             val_unref(I, l);
             return -1;
         }
@@ -359,14 +251,14 @@ static int b_linspace(interp *I, value *a, int n, value *out)
 {
     (void)n;
     long k;
-    if (get_int(I, a[2], 1, (long)I->lim.max_list, &k, "linspace: argument 'n'"))
+    if (builtin_get_int(I, a[2], 1, (long)I->lim.max_list, &k, "linspace: argument 'n'"))
         return -1;
     value l = val_list(I, (size_t)k);
     if (l.k == V_NIL)
         return -1;
     for (long i = 0; i < k; i++) {
         double t = k == 1 ? 0 : (double)i / (double)(k - 1);
-        if (list_push(I, AS_LIST(l), val_num(a[0].u.n + (a[1].u.n - a[0].u.n) * t))) {
+        if (val_list_push(I, AS_LIST(l), val_num(a[0].u.n + (a[1].u.n - a[0].u.n) * t))) {
             val_unref(I, l);
             return -1;
         }
@@ -384,7 +276,7 @@ static int b_map(interp *I, value *a, int n, value *out)
         return -1;
     for (size_t i = 0; i < src->n; i++) {
         value r;
-        if (call_value(I, a[1], &src->items[i], 1, &r) || list_push(I, AS_LIST(l), r)) {
+        if (eval_call_value(I, a[1], &src->items[i], 1, &r) || val_list_push(I, AS_LIST(l), r)) {
             val_unref(I, l);
             return -1;
         }
@@ -402,7 +294,7 @@ static int b_filter(interp *I, value *a, int n, value *out)
         return -1;
     for (size_t i = 0; i < src->n; i++) {
         value r;
-        if (call_value(I, a[1], &src->items[i], 1, &r)) {
+        if (eval_call_value(I, a[1], &src->items[i], 1, &r)) {
             val_unref(I, l);
             return -1;
         }
@@ -410,7 +302,7 @@ static int b_filter(interp *I, value *a, int n, value *out)
         val_unref(I, r);
         if (keep) {
             val_ref(src->items[i]);
-            if (list_push(I, AS_LIST(l), src->items[i])) {
+            if (val_list_push(I, AS_LIST(l), src->items[i])) {
                 val_unref(I, l);
                 return -1;
             }
@@ -428,7 +320,7 @@ static int b_fold(interp *I, value *a, int n, value *out)
     val_ref(acc);
     for (size_t i = 0; i < src->n; i++) {
         value args[2] = {acc, src->items[i]}, r;
-        int rc = call_value(I, a[2], args, 2, &r);
+        int rc = eval_call_value(I, a[2], args, 2, &r);
         val_unref(I, acc);
         if (rc)
             return -1;
@@ -452,7 +344,7 @@ static int b_concat(interp *I, value *a, int n, value *out)
         for (size_t i = 0; i < AS_LIST(a[k])->n; i++) {
             value x = AS_LIST(a[k])->items[i];
             val_ref(x);
-            if (list_push(I, AS_LIST(l), x)) {
+            if (val_list_push(I, AS_LIST(l), x)) {
                 val_unref(I, l);
                 return -1;
             }
@@ -489,7 +381,7 @@ static int b_reverse(interp *I, value *a, int n, value *out)
         return -1;
     for (size_t i = src->n; i-- > 0;) {
         val_ref(src->items[i]);
-        if (list_push(I, AS_LIST(l), src->items[i])) {
+        if (val_list_push(I, AS_LIST(l), src->items[i])) {
             val_unref(I, l);
             return -1;
         }
@@ -502,7 +394,7 @@ static int b_repeat(interp *I, value *a, int n, value *out)
 {
     (void)n;
     long times;
-    if (get_int(I, a[1], 0, (long)I->lim.max_list, &times, "repeat: argument 'times'"))
+    if (builtin_get_int(I, a[1], 0, (long)I->lim.max_list, &times, "repeat: argument 'times'"))
         return -1;
     value l = val_list(I, 0);
     if (l.k == V_NIL)
@@ -511,14 +403,14 @@ static int b_repeat(interp *I, value *a, int n, value *out)
         if (a[0].k == V_LIST) {
             for (size_t i = 0; i < AS_LIST(a[0])->n; i++) {
                 val_ref(AS_LIST(a[0])->items[i]);
-                if (list_push(I, AS_LIST(l), AS_LIST(a[0])->items[i])) {
+                if (val_list_push(I, AS_LIST(l), AS_LIST(a[0])->items[i])) {
                     val_unref(I, l);
                     return -1;
                 }
             }
         } else {
             val_ref(a[0]);
-            if (list_push(I, AS_LIST(l), a[0])) {
+            if (val_list_push(I, AS_LIST(l), a[0])) {
                 val_unref(I, l);
                 return -1;
             }
@@ -536,7 +428,7 @@ static int b_keys(interp *I, value *a, int n, value *out)
     if (l.k == V_NIL)
         return -1;
     for (size_t i = 0; i < r->n; i++)
-        if (list_push(I, AS_LIST(l), val_cstr(I, r->keys[i]))) {
+        if (val_list_push(I, AS_LIST(l), val_cstr(I, r->keys[i]))) {
             val_unref(I, l);
             return -1;
         }
@@ -547,8 +439,8 @@ static int b_keys(interp *I, value *a, int n, value *out)
 static int b_has(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    const char *k = intern(I, AS_STR(a[1])->s, AS_STR(a[1])->len);
-    *out = val_bool(k && rec_get(AS_REC(a[0]), k));
+    const char *k = interp_intern(I, AS_STR(a[1])->s, AS_STR(a[1])->len);
+    *out = val_bool(k && val_rec_get(AS_REC(a[0]), k));
     return 0;
 }
 
@@ -622,7 +514,7 @@ static int do_format(interp *I, const char *fmt, size_t flen, value *args, int n
                 /* a long long holds only whole numbers up to 2^63: say so rather than cast */
                 if (!(fabs(v.u.n) < 9223372036854775808.0)) {
                     char got[40];
-                    fmt_number(v.u.n, got, sizeof got);
+                    val_fmt_number(v.u.n, got, sizeof got);
                     return err_at(I, NULL, ERR_VALUE, "format: '{:%s}' needs a number below 2^63 in size, got %s",
                                   spec + 1, isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
                 }
@@ -735,7 +627,7 @@ static int b_randoms(interp *I, value *a, int n, value *out)
 {
     (void)n;
     long k;
-    if (get_int(I, a[0], 0, (long)I->lim.max_list, &k, "randoms: argument 'n'"))
+    if (builtin_get_int(I, a[0], 0, (long)I->lim.max_list, &k, "randoms: argument 'n'"))
         return -1;
     value l = val_list(I, (size_t)k);
     if (l.k == V_NIL)
@@ -743,7 +635,7 @@ static int b_randoms(interp *I, value *a, int n, value *out)
     uint64_t s = seed_of(I, a[1]);
     for (long i = 0; i < k; i++) {
         uint64_t h = rng_hash3(s, (uint64_t)i, 0x72616e64ull, 0);
-        if (list_push(I, AS_LIST(l), val_num(rng_to_unit(h)))) {
+        if (val_list_push(I, AS_LIST(l), val_num(rng_to_unit(h)))) {
             val_unref(I, l);
             return -1;
         }
@@ -831,14 +723,14 @@ static const builtin core[] = {
     BUILTIN("seed", b_seed, p_none, "The global seed (--seed, default 1)."),
 };
 
-int builtins_core_init(interp *I)
+int builtin_core_init(interp *I)
 {
     env *root = I->globals;
     while (root->parent)
         root = root->parent;
-    const char *pi = intern(I, "pi", 2), *tau = intern(I, "tau", 3), *inf = intern(I, "inf", 3);
-    if (!pi || !tau || !inf || env_define(I, root, pi, val_num(3.14159265358979323846)) ||
-        env_define(I, root, tau, val_num(6.28318530717958647692)) || env_define(I, root, inf, val_num(INFINITY)))
+    const char *pi = interp_intern(I, "pi", 2), *tau = interp_intern(I, "tau", 3), *inf = interp_intern(I, "inf", 3);
+    if (!pi || !tau || !inf || val_env_define(I, root, pi, val_num(3.14159265358979323846)) ||
+        val_env_define(I, root, tau, val_num(6.28318530717958647692)) || val_env_define(I, root, inf, val_num(INFINITY)))
         return -1;
-    return builtins_register(I, core, (int)(sizeof core / sizeof core[0]));
+    return builtin_register(I, core, (int)(sizeof core / sizeof core[0]));
 }

@@ -39,7 +39,7 @@ static int image_get(interp *I, const void *p, const char *name, value *out)
 static int image_arith(interp *I, int op, value a, value b, value *out);
 static int image_save_hook(interp *I, const void *p, const char *path, value opts);
 
-const obj_class image_class = {
+const obj_class lang_image_class = {
     .name = "image",
     .destroy = image_destroy,
     .summary = image_summary,
@@ -75,7 +75,7 @@ int lang_image_new(interp *I, int w, int h, image **out)
 
 int lang_image_value(interp *I, image *im, value *out)
 {
-    *out = val_obj(I, &image_class, im);
+    *out = val_obj(I, &lang_image_class, im);
     return out->k == V_NIL ? -1 : 0;
 }
 
@@ -98,7 +98,7 @@ int lang_image_finish(interp *I, image *im, rt_code c, const rt_error *e, const 
 
 image *lang_as_image(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &image_class ? AS_OBJ(v)->payload : NULL;
+    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_image_class ? AS_OBJ(v)->payload : NULL;
 }
 
 int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
@@ -113,7 +113,7 @@ int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
     }
     if (v.k == V_LIST && (AS_LIST(v)->n == 3 || AS_LIST(v)->n == 4)) {
         double c[4] = {0, 0, 0, 1};
-        if (get_vec(I, v, c, AS_LIST(v)->n, what))
+        if (builtin_get_vec(I, v, c, AS_LIST(v)->n, what))
             return -1;
         for (int i = 0; i < 4; i++)
             rgba[i] = (float)c[i];
@@ -199,7 +199,7 @@ static int b_image(interp *I, value *a, int n, value *out)
     int w, h;
     float c[4];
     image *im;
-    if (arg_size2(I, a[0], &w, &h, "image: size") || lang_get_colour(I, a[1], c, "image: colour") ||
+    if (lang_arg_size2(I, a[0], &w, &h, "image: size") || lang_get_colour(I, a[1], c, "image: colour") ||
         lang_image_new(I, w, h, &im))
         return -1;
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
@@ -215,7 +215,7 @@ static int b_gradient(interp *I, value *a, int n, value *out)
     int w, h;
     float c0[4], c1[4];
     image *im;
-    if (arg_size2(I, a[0], &w, &h, "gradient: size") || lang_get_colour(I, a[1], c0, "gradient: from") ||
+    if (lang_arg_size2(I, a[0], &w, &h, "gradient: size") || lang_get_colour(I, a[1], c0, "gradient: from") ||
         lang_get_colour(I, a[2], c1, "gradient: to"))
         return -1;
     double ang = a[3].u.n * 3.14159265358979323846 / 180.0;
@@ -247,7 +247,7 @@ static int b_checker(interp *I, value *a, int n, value *out)
     long cell;
     float c0[4], c1[4];
     image *im;
-    if (arg_size2(I, a[0], &w, &h, "checker: size") || get_int(I, a[1], 1, 1000000, &cell, "checker: cell") ||
+    if (lang_arg_size2(I, a[0], &w, &h, "checker: size") || builtin_get_int(I, a[1], 1, 1000000, &cell, "checker: cell") ||
         lang_get_colour(I, a[2], c0, "checker: a") || lang_get_colour(I, a[3], c1, "checker: b") ||
         lang_image_new(I, w, h, &im))
         return -1;
@@ -262,14 +262,14 @@ static int b_pixel(interp *I, value *a, int n, value *out)
     (void)n;
     image *im = lang_as_image(a[0]);
     long x, y;
-    if (get_int(I, a[1], 0, im->w - 1, &x, "pixel: x") || get_int(I, a[2], 0, im->h - 1, &y, "pixel: y"))
+    if (builtin_get_int(I, a[1], 0, im->w - 1, &x, "pixel: x") || builtin_get_int(I, a[2], 0, im->h - 1, &y, "pixel: y"))
         return -1;
     const float *p = image_at(im, (int)x, (int)y);
     value l = val_list(I, 4);
     if (l.k == V_NIL)
         return -1;
     for (int c = 0; c < 4; c++)
-        if (list_push(I, AS_LIST(l), val_num(p[c]))) {
+        if (val_list_push(I, AS_LIST(l), val_num(p[c]))) {
             val_unref(I, l);
             return -1;
         }
@@ -284,7 +284,7 @@ static int b_load(interp *I, value *a, int n, value *out)
     if (!im)
         return -1;
     char path[4096];
-    if (script_relative_path(I, a[0], path, sizeof path, "load")) {
+    if (lang_script_path(I, a[0], path, sizeof path, "load")) {
         mem_free(I, im);
         return -1;
     }
@@ -332,12 +332,12 @@ static int b_save(interp *I, value *a, int n, value *out)
 static int image_save_hook(interp *I, const void *p, const char *path, value opts)
 {
     image_save_opts o = {0, 0};
-    if (opts_check(I, opts, "rec{bits: int{8,16}, channels: int[1,4]}", "save"))
+    if (contract_check_opts(I, opts, "rec{bits: int{8,16}, channels: int[1,4]}", "save"))
         return -1;
     double x;
-    if (opt_num(I, opts, "bits", &x) == 1)
+    if (lang_opt_num(I, opts, "bits", &x) == 1)
         o.bits = (int)x;
-    if (opt_num(I, opts, "channels", &x) == 1)
+    if (lang_opt_num(I, opts, "channels", &x) == 1)
         o.channels = (int)x;
     rt_error e;
     rt_code c = image_save(p, path, &o, &e);
@@ -360,7 +360,7 @@ static int stack(interp *I, value *a, int n, value *out, int horizontal)
     value gapv = a[n], bgv = a[n + 1];
     long gap;
     float bg[4];
-    if (get_int(I, gapv, 0, 100000, &gap, horizontal ? "hstack: gap" : "vstack: gap") ||
+    if (builtin_get_int(I, gapv, 0, 100000, &gap, horizontal ? "hstack: gap" : "vstack: gap") ||
         lang_get_colour(I, bgv, bg, horizontal ? "hstack: background" : "vstack: background"))
         return -1;
     if (count == 0)
@@ -426,7 +426,7 @@ static const builtin image_builtins[] = {
             "Save an image (.png .ppm .pgm .pfm), volume or mesh; the extension picks the format. Relative paths go under --out-dir. Options: {bits: 16, channels: 3}."),
 };
 
-int builtins_image_init(interp *I)
+int builtin_image_init(interp *I)
 {
-    return builtins_register(I, image_builtins, (int)(sizeof image_builtins / sizeof image_builtins[0]));
+    return builtin_register(I, image_builtins, (int)(sizeof image_builtins / sizeof image_builtins[0]));
 }

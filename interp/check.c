@@ -172,9 +172,9 @@ int check_call(interp *I, const check_names *bound, env *const *mods, int nmods,
         return check_lambda(I, name, def->kids[0], call);
     value *v = NULL;
     for (int m = nmods - 1; m >= 0 && !v; m--)
-        v = env_lookup(mods[m], name);
+        v = val_env_lookup(mods[m], name);
     if (!v)
-        v = env_lookup(I->globals, name);
+        v = val_env_lookup(I->globals, name);
     if (!v)
         return 0;
     if (v->k == V_BUILTIN)

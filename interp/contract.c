@@ -55,7 +55,7 @@ typedef struct contract_cache {
 static contract_cache *cache_of(interp *I)
 {
     if (!I->contract) {
-        contract_cache *c = arena_alloc(I, sizeof *c);
+        contract_cache *c = mem_arena_alloc(I, sizeof *c);
         if (!c)
             return NULL;
         memset(c, 0, sizeof *c);
@@ -85,7 +85,7 @@ static int cache_put(interp *I, const void *key, void *val)
         return -1;
     if ((c->n + 1) * 2 > c->cap) {
         size_t cap = c->cap ? c->cap * 2 : 512;
-        centry *t = arena_alloc(I, cap * sizeof *t);
+        centry *t = mem_arena_alloc(I, cap * sizeof *t);
         if (!t)
             return -1;
         memset(t, 0, cap * sizeof *t);
@@ -176,7 +176,7 @@ static int tp_keys(tparser *t, calt *a)
             t->err = "a key name";
             return -1;
         }
-        keys[n].name = intern(t->I, s, (size_t)(t->p - s));
+        keys[n].name = interp_intern(t->I, s, (size_t)(t->p - s));
         keys[n].required = *t->p == '!';
         if (keys[n].required)
             t->p++;
@@ -205,7 +205,7 @@ static int tp_keys(tparser *t, calt *a)
     }
     t->p++;
     a->nkeys = n;
-    a->keys = arena_alloc(t->I, sizeof(ckey) * (size_t)(n ? n : 1));
+    a->keys = mem_arena_alloc(t->I, sizeof(ckey) * (size_t)(n ? n : 1));
     if (!a->keys)
         return -1;
     memcpy(a->keys, keys, sizeof(ckey) * (size_t)n);
@@ -232,7 +232,7 @@ static int tp_choices(tparser *t, calt *a)
             const char *e = t->p;
             while (e > s && e[-1] == ' ')
                 e--;
-            words[n] = intern(t->I, s, (size_t)(e - s));
+            words[n] = interp_intern(t->I, s, (size_t)(e - s));
             if (!words[n])
                 return -1;
         } else if (tp_number(t, &nums[n])) {
@@ -249,12 +249,12 @@ static int tp_choices(tparser *t, calt *a)
     t->p++;
     a->nchoice = n;
     if (a->kind == K_STR) {
-        a->schoices = arena_alloc(t->I, sizeof(char *) * (size_t)n);
+        a->schoices = mem_arena_alloc(t->I, sizeof(char *) * (size_t)n);
         if (!a->schoices)
             return -1;
         memcpy(a->schoices, words, sizeof(char *) * (size_t)n);
     } else {
-        a->nchoices = arena_alloc(t->I, sizeof(double) * (size_t)n);
+        a->nchoices = mem_arena_alloc(t->I, sizeof(double) * (size_t)n);
         if (!a->nchoices)
             return -1;
         memcpy(a->nchoices, nums, sizeof(double) * (size_t)n);
@@ -381,9 +381,9 @@ static const ctype *compile_text(interp *I, const char *text, size_t len, const 
         *err = t.err;
         return NULL;
     }
-    ctype *ct = arena_alloc(I, sizeof *ct);
-    calt *al = arena_alloc(I, sizeof *al * (size_t)n);
-    char *keep = arena_alloc(I, len + 1);
+    ctype *ct = mem_arena_alloc(I, sizeof *ct);
+    calt *al = mem_arena_alloc(I, sizeof *al * (size_t)n);
+    char *keep = mem_arena_alloc(I, len + 1);
     if (!ct || !al || !keep)
         return NULL;
     memcpy(keep, buf, len + 1);
@@ -449,7 +449,7 @@ static int literal_default(interp *I, const char *d, value *out)
                 val_unref(I, l);
                 return 0;
             }
-            if (list_push(I, AS_LIST(l), val_num(x))) {
+            if (val_list_push(I, AS_LIST(l), val_num(x))) {
                 val_unref(I, l);
                 return -1;
             }
@@ -469,8 +469,8 @@ static int literal_default(interp *I, const char *d, value *out)
 
 int contract_register(interp *I, const builtin *b)
 {
-    bspec *s = arena_alloc(I, sizeof *s);
-    cparam *p = arena_alloc(I, sizeof *p * (size_t)(b->nparams ? b->nparams : 1));
+    bspec *s = mem_arena_alloc(I, sizeof *s);
+    cparam *p = mem_arena_alloc(I, sizeof *p * (size_t)(b->nparams ? b->nparams : 1));
     if (!s || !p)
         return -1;
     memset(p, 0, sizeof *p * (size_t)(b->nparams ? b->nparams : 1));
@@ -479,7 +479,7 @@ int contract_register(interp *I, const builtin *b)
     s->p = p;
     for (int j = 0; j < b->nparams; j++) {
         const bparam *bp = &b->params[j];
-        p[j].name = intern(I, bp->name, strlen(bp->name));
+        p[j].name = interp_intern(I, bp->name, strlen(bp->name));
         if (!p[j].name)
             return -1;
         if (bp->type && strcmp(bp->type, "any") != 0) {
@@ -641,7 +641,7 @@ static void fmt_num(double x, char *buf, size_t n)
     else if (isinf(x))
         snprintf(buf, n, "%s", x < 0 ? "-inf" : "inf");
     else
-        fmt_number(x, buf, n);
+        val_fmt_number(x, buf, n);
 }
 
 /* A small text buffer for messages. */
@@ -817,7 +817,7 @@ static int check_alt(cctx *c, const calt *a, value v, const char *what, cpos at)
                     return 0;
             sbuf d = {{0}, 0};
             describe_alt(a, &d);
-            const char *s = suggest_name(AS_STR(v)->s, a->schoices, (size_t)a->nchoice);
+            const char *s = interp_suggest_name(AS_STR(v)->s, a->schoices, (size_t)a->nchoice);
             int rc = err_cpos(c->I, at, ERR_VALUE, "%s: %s must be %s, got \"%s\"%s%s%s", c->who, what,
                               d.data, AS_STR(v)->s, s ? " (did you mean \"" : "", s ? s : "",
                               s ? "\"?)" : "");
@@ -847,7 +847,7 @@ static int check_alt(cctx *c, const calt *a, value v, const char *what, cpos at)
                 const char *cands[64];
                 for (int j = 0; j < a->nkeys; j++)
                     cands[j] = a->keys[j].name;
-                const char *s = suggest_name(r->keys[i], cands, (size_t)a->nkeys);
+                const char *s = interp_suggest_name(r->keys[i], cands, (size_t)a->nkeys);
                 char sug[128] = "";
                 if (s)
                     snprintf(sug, sizeof sug, " (did you mean '%s'?)", s);
@@ -864,7 +864,7 @@ static int check_alt(cctx *c, const calt *a, value v, const char *what, cpos at)
                 return -1;
         }
         for (int j = 0; j < a->nkeys; j++)
-            if (a->keys[j].required && !rec_get(r, a->keys[j].name)) {
+            if (a->keys[j].required && !val_rec_get(r, a->keys[j].name)) {
                 if (opts)
                     return err_cpos(c->I, at, ERR_VALUE, "%s: missing option '%s'", c->who, a->keys[j].name);
                 return err_cpos(c->I, at, ERR_VALUE, "%s: %s is missing key '%s'", c->who, what, a->keys[j].name);
@@ -969,7 +969,7 @@ int contract_match(interp *I, const char *fname, const char *const *pnames, cons
                 if (strcmp(pnames[j], anames[i]) == 0)
                     break;
             if (j == np) {
-                const char *s = suggest_name(anames[i], pnames, (size_t)np);
+                const char *s = interp_suggest_name(anames[i], pnames, (size_t)np);
                 cpos p = arg_pos(I, anodes, i, 1);
                 if (!p.n && p.src < 0)
                     p.n = call;
@@ -1077,7 +1077,7 @@ int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...)
     return err_at(I, n, k, "%s", msg);
 }
 
-int opts_check(interp *I, value opts, const char *type, const char *who)
+int contract_check_opts(interp *I, value opts, const char *type, const char *who)
 {
     if (opts.k == V_NIL)
         return 0;

@@ -3,7 +3,7 @@
  * Every builtin declares, for each parameter, a type text (see builtin.h for
  * the mini-language: "num[0,1]", "int>=1", "vec3", "str{log,linear}",
  * "rec{bits: int{8,16}, channels: int[1,4]}", "num+inf" …). contract.c
- * compiles each text once per interpreter (at builtins_register, with the
+ * compiles each text once per interpreter (at builtin_register, with the
  * parameter defaults) and checks values against it in one function,
  * contract_check_value, used by call_builtin at run time, by the static
  * call checks of resolve.c before anything runs, and by option readers

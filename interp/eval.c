@@ -140,7 +140,7 @@ static int binary_op(interp *I, int op, value a, value b, value *out, const node
             value x = a.k == V_LIST ? AS_LIST(a)->items[i] : a;
             value y = b.k == V_LIST ? AS_LIST(b)->items[i] : b;
             value r;
-            if (binary_op(I, op, x, y, &r, at) || list_push(I, AS_LIST(res), r)) {
+            if (binary_op(I, op, x, y, &r, at) || val_list_push(I, AS_LIST(res), r)) {
                 val_unref(I, res);
                 return -1;
             }
@@ -227,7 +227,7 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
         bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
         have[slot[i]] = 1;
     }
-    env *e = env_new(I, f->closure);
+    env *e = val_env_new(I, f->closure);
     if (!e)
         return -1;
     int rc = -1;
@@ -241,7 +241,7 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
             if (eval_expr(I, e, l->kids[j], &v))
                 goto done;
         }
-        if (env_define(I, e, l->names[j], v))
+        if (val_env_define(I, e, l->names[j], v))
             goto done;
     }
     if (push_frame(I, fname, call))
@@ -252,7 +252,7 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
         rc = eval_expr(I, e, l->body, out);
     I->depth--;
 done:
-    heap_unref(I, &e->h);
+    val_heap_unref(I, &e->h);
     return rc;
 }
 
@@ -335,7 +335,7 @@ static int call_any(interp *I, value fn, const value *pos, int npos, const char 
     return err_at(I, call, ERR_TYPE, "cannot call %s (it is not a function)", val_type_name(fn));
 }
 
-int call_value(interp *I, value fn, const value *args, int nargs, value *out)
+int eval_call_value(interp *I, value fn, const value *args, int nargs, value *out)
 {
     return call_any(I, fn, args, nargs, NULL, NULL, 0, NULL, I->cur, out);
 }
@@ -407,8 +407,8 @@ static int eval_index(interp *I, value a, value ix, value *out, const node *at)
     if (a.k == V_REC) {
         if (ix.k != V_STR)
             return err_at(I, at, ERR_TYPE, "record index must be a string, got %s", val_type_name(ix));
-        const char *key = intern(I, AS_STR(ix)->s, AS_STR(ix)->len);
-        value *v = key ? rec_get(AS_REC(a), key) : NULL;
+        const char *key = interp_intern(I, AS_STR(ix)->s, AS_STR(ix)->len);
+        value *v = key ? val_rec_get(AS_REC(a), key) : NULL;
         if (!v)
             return err_at(I, at, ERR_VALUE, "record has no field \"%s\"", AS_STR(ix)->s);
         *out = *v;
@@ -421,10 +421,10 @@ static int eval_index(interp *I, value a, value ix, value *out, const node *at)
 static int eval_field(interp *I, value a, const char *name, value *out, const node *at)
 {
     if (a.k == V_REC) {
-        value *v = rec_get(AS_REC(a), name);
+        value *v = val_rec_get(AS_REC(a), name);
         if (!v) {
             vrec *r = AS_REC(a);
-            const char *s = suggest_name(name, r->keys, r->n);
+            const char *s = interp_suggest_name(name, r->keys, r->n);
             return err_at(I, at, ERR_VALUE, "record has no field '%s'%s%s%s", name,
                           s ? " (did you mean '" : "", s ? s : "", s ? "'?)" : "");
         }
@@ -466,12 +466,12 @@ __attribute__((noinline)) static int eval_table(interp *I, env *e, const node *n
                 val_unref(I, rv);
                 goto fail;
             }
-            if (list_push(I, AS_LIST(rv), v)) {
+            if (val_list_push(I, AS_LIST(rv), v)) {
                 val_unref(I, rv);
                 goto fail;
             }
         }
-        if (list_push(I, AS_LIST(t), rv))
+        if (val_list_push(I, AS_LIST(t), rv))
             goto fail;
     }
     *out = t;
@@ -506,12 +506,12 @@ __attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n,
     for (size_t i = 0; i < AS_LIST(it)->n; i++) {
         if (check_interrupt(I, n))
             goto fail;
-        env *s = env_new(I, e);
+        env *s = val_env_new(I, e);
         if (!s)
             goto fail;
         value x = AS_LIST(it)->items[i];
         val_ref(x);
-        int ok = env_define(I, s, n->str, x) == 0;
+        int ok = val_env_define(I, s, n->str, x) == 0;
         int keep = 1;
         if (ok && n->kids[2]) {
             value c;
@@ -523,9 +523,9 @@ __attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n,
         }
         value v = val_nil();
         if (ok && keep) {
-            ok = eval_expr(I, s, n->kids[0], &v) == 0 && list_push(I, AS_LIST(res), v) == 0;
+            ok = eval_expr(I, s, n->kids[0], &v) == 0 && val_list_push(I, AS_LIST(res), v) == 0;
         }
-        heap_unref(I, &s->h);
+        val_heap_unref(I, &s->h);
         if (!ok)
             goto fail;
     }
@@ -567,7 +567,7 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
     case N_NIL:
         return 0;
     case N_NAME: {
-        value *v = env_lookup(e, n->str);
+        value *v = val_env_lookup(e, n->str);
         if (!v)
             return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
         *out = *v;
@@ -580,7 +580,7 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
             return -1;
         for (int i = 0; i < n->nkids; i++) {
             value v;
-            if (eval_expr(I, e, n->kids[i], &v) || list_push(I, AS_LIST(l), v)) {
+            if (eval_expr(I, e, n->kids[i], &v) || val_list_push(I, AS_LIST(l), v)) {
                 val_unref(I, l);
                 return -1;
             }
@@ -596,7 +596,7 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
             return -1;
         for (int i = 0; i < n->nkids; i++) {
             value v;
-            if (eval_expr(I, e, n->kids[i], &v) || rec_set(I, AS_REC(r), n->names[i], v)) {
+            if (eval_expr(I, e, n->kids[i], &v) || val_rec_set(I, AS_REC(r), n->names[i], v)) {
                 val_unref(I, r);
                 return -1;
             }
@@ -694,11 +694,11 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
         return 0;
     }
     case N_BLOCK: {
-        env *s = env_new(I, e);
+        env *s = val_env_new(I, e);
         if (!s)
             return -1;
         int r = eval_block(I, s, n, out);
-        heap_unref(I, &s->h);
+        val_heap_unref(I, &s->h);
         return r;
     }
     case N_LAMBDA:
@@ -798,17 +798,17 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         value v;
         if (eval_expr(I, e, n->kids[0], &v))
             return -1;
-        return env_define(I, e, n->str, v);
+        return val_env_define(I, e, n->str, v);
     }
     case N_ASSIGN: {
-        value *slot = env_lookup(e, n->str);
+        value *slot = val_env_lookup(e, n->str);
         if (!slot)
             return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                           n->str, n->str);
         value v;
         if (eval_expr(I, e, n->kids[0], &v))
             return -1;
-        slot = env_lookup(e, n->str); /* the evaluation may have grown the scope */
+        slot = val_env_lookup(e, n->str); /* the evaluation may have grown the scope */
         val_unref(I, *slot);
         *slot = v;
         return 0;
@@ -829,13 +829,13 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
             val_unref(I, def);
             def = ov;
         }
-        return env_define(I, e, n->str, def);
+        return val_env_define(I, e, n->str, def);
     }
     case N_FNDEF: {
         value f = val_func(I, n->kids[0], e, n->str);
         if (f.k == V_NIL)
             return -1;
-        return env_define(I, e, n->str, f);
+        return val_env_define(I, e, n->str, f);
     }
     case N_IMPORT: {
         env *m;
@@ -847,16 +847,16 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
                 return -1;
             for (size_t i = 0; i < m->n; i++) {
                 val_ref(m->vals[i]);
-                if (rec_set(I, AS_REC(r), m->names[i], m->vals[i])) {
+                if (val_rec_set(I, AS_REC(r), m->names[i], m->vals[i])) {
                     val_unref(I, r);
                     return -1;
                 }
             }
-            return env_define(I, e, n->names[0], r);
+            return val_env_define(I, e, n->names[0], r);
         }
         for (size_t i = 0; i < m->n; i++) {
             val_ref(m->vals[i]);
-            if (env_define(I, e, m->names[i], m->vals[i]))
+            if (val_env_define(I, e, m->names[i], m->vals[i]))
                 return -1;
         }
         return 0;
@@ -875,17 +875,17 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
                 rc = -1;
                 break;
             }
-            env *s = env_new(I, e);
+            env *s = val_env_new(I, e);
             if (!s) {
                 rc = -1;
                 break;
             }
             value x = AS_LIST(it)->items[i];
             val_ref(x);
-            rc = env_define(I, s, n->str, x);
+            rc = val_env_define(I, s, n->str, x);
             if (rc == 0)
                 rc = eval_block(I, s, n->kids[1], NULL);
-            heap_unref(I, &s->h);
+            val_heap_unref(I, &s->h);
         }
         val_unref(I, it);
         return rc;
@@ -978,7 +978,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
             size_t nc = 0;
             for (const stdlib_module *m = stdlib_modules; m->name && nc < 256; m++)
                 cands[nc++] = m->name;
-            const char *s = suggest_name(name, cands, nc);
+            const char *s = interp_suggest_name(name, cands, nc);
             return err_at(I, at, ERR_NAME,
                           "no standard module named \"%s\"%s%s%s (to import a file, write \"./%s.frac\")",
                           name, s ? " (did you mean \"" : "", s ? s : "", s ? "\"?)" : "", name);
@@ -1021,7 +1021,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     env *root = I->globals;
     while (root->parent)
         root = root->parent;
-    m->exports = env_new(I, root);
+    m->exports = val_env_new(I, root);
     if (!m->exports) {
         mem_free(I, m->key);
         return -1;

@@ -12,7 +12,7 @@ typedef struct lang_ifs {
     ifs f;
 } lang_ifs;
 
-extern const obj_class ifs_class, rifs_class, map_class;
+extern const obj_class lang_ifs_class, lang_rifs_class, lang_map_class;
 
 const lang_ifs *lang_as_ifs(value v);
 /* The system behind an ifs or rifs value. */

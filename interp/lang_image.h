@@ -5,7 +5,7 @@
 #include "image.h"
 #include "state.h"
 
-extern const obj_class image_class;
+extern const obj_class lang_image_class;
 
 /* Allocate an image after checking the pixel limit. */
 int lang_image_new(interp *I, int w, int h, image **out);

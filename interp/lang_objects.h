@@ -12,8 +12,8 @@
 #include "state.h"
 #include "volume.h"
 
-extern const obj_class volume_class;
-extern const obj_class mesh_class;
+extern const obj_class lang_volume_class;
+extern const obj_class lang_mesh_class;
 
 /* Check the voxel limit and the memory budget, then allocate. */
 int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3], volume **out);
@@ -34,7 +34,7 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what);
  * lang_field_fn_done(tmp, own) to release what it made. */
 struct field;
 struct field_prog;
-extern const obj_class field_class;
+extern const obj_class lang_field_class;
 int lang_field_value(interp *I, struct field *f, value *out);
 struct field *lang_to_field(interp *I, value v, const char *what);
 int lang_field_fn(interp *I, value v, struct field **tmp, struct field_prog **own,
@@ -43,7 +43,7 @@ void lang_field_fn_done(struct field *tmp, struct field_prog *own);
 
 /* Read an optional number/int/bool field of an options record: 1 found,
  * 0 absent, -1 error. */
-int opt_num(interp *I, value rec, const char *key, double *out);
+int lang_opt_num(interp *I, value rec, const char *key, double *out);
 
 /* A camera from a record {eye: [x,y,z], target: [x,y,z], up: [0,1,0],
  * fov: 40} (what orbit() and look_at() return), an argument declared
@@ -52,7 +52,7 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
-/* The one map from runtime codes to error kinds (args.c): RT_ENOMEM ->
+/* The one map from runtime codes to error kinds (lang_objects.c): RT_ENOMEM ->
  * ERR_MEMORY (exit 70), RT_EIO -> ERR_IO (74), RT_ECANCEL -> ERR_INTERRUPT
  * (130), RT_ELIMIT -> ERR_LIMIT (65), RT_EFORMAT and RT_EINVAL -> ERR_VALUE (65). */
 err_kind lang_rt_kind(rt_code c);

@@ -383,10 +383,10 @@ static int set_script_args(interp *I, const opts *o)
     if (l.k == V_NIL)
         return -1;
     for (int i = 0; i < o->nargs; i++)
-        if (list_push(I, AS_LIST(l), val_cstr(I, o->args[i])))
+        if (val_list_push(I, AS_LIST(l), val_cstr(I, o->args[i])))
             return -1;
-    const char *name = intern(I, "args", 4);
-    return name ? env_define(I, I->globals, name, l) : -1;
+    const char *name = interp_intern(I, "args", 4);
+    return name ? val_env_define(I, I->globals, name, l) : -1;
 }
 
 static void print_params(interp *I)
@@ -458,15 +458,15 @@ static int check_overrides(interp *I, const char *name, const char *text, size_t
         }
         const char *ovname = I->overrides[k].name;
         if (!decl) {
-            const char *s = suggest_name(ovname, cands, (size_t)nc);
+            const char *s = interp_suggest_name(ovname, cands, (size_t)nc);
             return err_pos(I, -1, 0, 0, ERR_USAGE, "-D %s: the script has no param '%s'%s%s%s", ovname,
                            ovname, s ? " (did you mean '" : nc ? "" : " (it declares none)",
                            s ? s : "", s ? "'?)" : "");
         }
         if (!is_literal(decl->kids[0]))
             continue;
-        node *blk = arena_alloc(I, sizeof *blk);
-        node **kids = arena_alloc(I, sizeof *kids);
+        node *blk = mem_arena_alloc(I, sizeof *blk);
+        node **kids = mem_arena_alloc(I, sizeof *kids);
         if (!blk || !kids)
             return -1;
         memset(blk, 0, sizeof *blk);
@@ -517,7 +517,7 @@ static int run_frac(interp *I, opts *o)
         return session_report(I);
     for (int k = 0; k < o->nov; k++) {
         const char *eq = strchr(o->ov[k].name, '=');
-        I->overrides[k].name = intern(I, o->ov[k].name, (size_t)(eq - o->ov[k].name));
+        I->overrides[k].name = interp_intern(I, o->ov[k].name, (size_t)(eq - o->ov[k].name));
         I->overrides[k].text = o->ov[k].text;
         I->overrides[k].used = 0;
         if (!I->overrides[k].name)

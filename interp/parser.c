@@ -212,7 +212,7 @@ static int expect_close(parser *p, tok_type t, const token *open)
 
 static node *mk(parser *p, node_kind k, const token *at)
 {
-    node *n = arena_alloc(p->I, sizeof(node));
+    node *n = mem_arena_alloc(p->I, sizeof(node));
     if (!n) {
         p->failed = 1;
         return NULL;
@@ -228,7 +228,7 @@ static node *mk(parser *p, node_kind k, const token *at)
 static node *mk1(parser *p, node_kind k, const token *at, node *a)
 {
     node *n = mk(p, k, at);
-    if (!n || !(n->kids = arena_alloc(p->I, sizeof(node *))))
+    if (!n || !(n->kids = mem_arena_alloc(p->I, sizeof(node *))))
         return NULL;
     n->nkids = 1;
     n->kids[0] = a;
@@ -238,7 +238,7 @@ static node *mk1(parser *p, node_kind k, const token *at, node *a)
 static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
 {
     node *n = mk(p, k, at);
-    if (!n || !(n->kids = arena_alloc(p->I, 2 * sizeof(node *))))
+    if (!n || !(n->kids = mem_arena_alloc(p->I, 2 * sizeof(node *))))
         return NULL;
     n->nkids = 2;
     n->kids[0] = a;
@@ -256,8 +256,8 @@ static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
     if (nv->n == nv->cap) {
         int nc = nv->cap ? nv->cap * 2 : 8;
-        node **a = arena_alloc(p->I, (size_t)nc * sizeof *a);
-        const char **b = arena_alloc(p->I, (size_t)nc * sizeof *b);
+        node **a = mem_arena_alloc(p->I, (size_t)nc * sizeof *a);
+        const char **b = mem_arena_alloc(p->I, (size_t)nc * sizeof *b);
         if (!a || !b) {
             p->failed = 1;
             return -1;
@@ -278,7 +278,7 @@ static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 
 static const char *tok_name(parser *p, const token *t)
 {
-    const char *s = intern(p->I, t->start, (size_t)t->len);
+    const char *s = interp_intern(p->I, t->start, (size_t)t->len);
     if (!s)
         p->failed = 1;
     return s;
@@ -290,7 +290,7 @@ static node *string_node(parser *p, const token *t)
     node *n = mk(p, N_STR, t);
     if (!n)
         return NULL;
-    char *s = arena_alloc(p->I, (size_t)t->len + 1);
+    char *s = mem_arena_alloc(p->I, (size_t)t->len + 1);
     if (!s)
         return NULL;
     size_t k = 0;
@@ -401,8 +401,8 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = arena_alloc(p->I, (size_t)c->nkids * sizeof(node *));
-    c->names = arena_alloc(p->I, (size_t)c->nkids * sizeof(char *));
+    c->kids = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(node *));
+    c->names = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(char *));
     if (!c->kids || !c->names)
         return NULL;
     c->kids[0] = callee;
@@ -610,7 +610,7 @@ static node *parse_brace(parser *p)
                 key = tok_name(p, k);
             } else if (k->type == T_STRING) {
                 node *s = string_node(p, k);
-                key = s ? intern(p->I, s->str, s->slen) : NULL;
+                key = s ? interp_intern(p->I, s->str, s->slen) : NULL;
             } else {
                 char buf[64];
                 syntax_error(p, k, "expected a field name in record, found %s", tok_desc(k, buf, sizeof buf));
@@ -713,7 +713,7 @@ static node *parse_list(parser *p)
             n->kind = N_COMP;
             n->str = tok_name(p, var);
             n->nkids = 3;
-            n->kids = arena_alloc(p->I, 3 * sizeof(node *));
+            n->kids = mem_arena_alloc(p->I, 3 * sizeof(node *));
             if (!n->kids)
                 break;
             n->kids[0] = e;
@@ -754,7 +754,7 @@ static node *parse_if(parser *p, token *at)
         if (!n)
             return NULL;
         n->nkids = 3;
-        n->kids = arena_alloc(p->I, 3 * sizeof(node *));
+        n->kids = mem_arena_alloc(p->I, 3 * sizeof(node *));
         if (!n->kids)
             return NULL;
         *slot = n;
@@ -1066,7 +1066,7 @@ static const char *trailing_comment(parser *p, const token *t)
     const char *e = s;
     while (*e && *e != '\n')
         e++;
-    char *d = arena_alloc(p->I, (size_t)(e - s) + 1);
+    char *d = mem_arena_alloc(p->I, (size_t)(e - s) + 1);
     if (d)
         memcpy(d, s, (size_t)(e - s));
     return d;
@@ -1126,7 +1126,7 @@ static node *parse_statement(parser *p)
             return NULL;
         n->str = sn->str;
         n->slen = sn->slen;
-        n->names = arena_alloc(p->I, sizeof(char *));
+        n->names = mem_arena_alloc(p->I, sizeof(char *));
         if (!n->names)
             return NULL;
         if (match(p, T_AS)) {

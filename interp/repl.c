@@ -317,9 +317,9 @@ static int run_command(repl *r, char *line)
         cmd_vars(r);
     } else if (strcmp(cmd, "reset") == 0) {
         env *root = I->globals->parent;
-        env *fresh = env_new(I, root);
+        env *fresh = val_env_new(I, root);
         if (fresh) {
-            heap_unref(I, &I->globals->h);
+            val_heap_unref(I, &I->globals->h);
             I->globals = fresh;
         }
     } else if (strcmp(cmd, "load") == 0) {

@@ -110,7 +110,7 @@ static int visible(resolver *r, scope *s, const char *name)
     for (; s; s = s->parent)
         if (scope_has(s, name))
             return 1;
-    return env_lookup(r->globals, name) != NULL;
+    return val_env_lookup(r->globals, name) != NULL;
 }
 
 /* Append a name to a growable array (freed on failure). */
@@ -177,7 +177,7 @@ static int unknown(resolver *r, scope *s, const node *at, const char *name)
             if (push_candidate(r->I, &c, &n, &cap, e->names[i]))
                 return -1;
     const char *mod = stdlib_defining(name);
-    const char *sug = mod ? NULL : suggest_name(name, c, n);
+    const char *sug = mod ? NULL : interp_suggest_name(name, c, n);
     if (mod)
         err_at(r->I, at, ERR_NAME, "unknown name '%s' (import \"%s\" defines it)", name, mod);
     else

@@ -11,14 +11,14 @@
 
 int session_setup(interp *I)
 {
-    env *root = env_new(I, NULL);
+    env *root = val_env_new(I, NULL);
     if (!root)
         return -1;
     I->globals = root; /* builtins register into the root */
-    if (builtins_core_init(I) || builtins_image_init(I) || bindings_init(I))
+    if (builtin_core_init(I) || builtin_image_init(I) || bind_all_init(I))
         return -1;
-    I->globals = env_new(I, root);
-    heap_unref(I, &root->h); /* the global scope holds it now */
+    I->globals = val_env_new(I, root);
+    val_heap_unref(I, &root->h); /* the global scope holds it now */
     return I->globals ? 0 : -1;
 }
 
@@ -69,7 +69,7 @@ int session_run_lines(interp *I, const char *name, const char *text, size_t len,
                     cands[nc++] = I->params[p].name;
             }
             if (!found) {
-                const char *s = suggest_name(I->overrides[k].name, cands, (size_t)nc);
+                const char *s = interp_suggest_name(I->overrides[k].name, cands, (size_t)nc);
                 return err_pos(I, -1, 0, 0, ERR_USAGE, "-D %s: the script has no param '%s'%s%s%s",
                                I->overrides[k].name, I->overrides[k].name, s ? " (did you mean '" : "",
                                s ? s : "", s ? "'?)" : "");

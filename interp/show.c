@@ -117,7 +117,7 @@ static int b_show(interp *I, value *a, int n, value *out)
     memset(&o, 0, sizeof o);
     int width = lineedit_term_width(1);
     long cols = width > 2 ? width - 1 : 1;
-    if (a[1].k == V_NUM && get_int(I, a[1], 1, 10000, &cols, "show: width")) {
+    if (a[1].k == V_NUM && builtin_get_int(I, a[1], 1, 10000, &cols, "show: width")) {
         if (owned) {
             lang_image_discard(im);
         }
@@ -145,5 +145,5 @@ static const builtin show_builtins[] = {
 
 int bind_show_init(interp *I)
 {
-    return builtins_register(I, show_builtins, 1);
+    return builtin_register(I, show_builtins, 1);
 }

@@ -174,7 +174,7 @@ typedef struct arena_block {
     max_align_t data[];
 } arena_block;
 
-void *arena_alloc(interp *I, size_t n)
+void *mem_arena_alloc(interp *I, size_t n)
 {
     n = (n + 15) & ~(size_t)15;
     arena_block *b = I->arena;
@@ -204,7 +204,7 @@ static uint64_t hash_bytes(const char *s, size_t n)
     return h;
 }
 
-const char *intern(interp *I, const char *s, size_t len)
+const char *interp_intern(interp *I, const char *s, size_t len)
 {
     if (I->intern_n * 2 >= I->intern_cap) {
         size_t nc = I->intern_cap ? I->intern_cap * 2 : 1024;
@@ -310,7 +310,7 @@ void interp_init(interp *I)
 
 void interp_free(interp *I)
 {
-    heap_free_all(I);
+    val_heap_free_all(I);
     for (int i = 0; i < I->nmods; i++)
         mem_free(I, I->mods[i].key);
     mem_free(I, I->mods);
@@ -485,7 +485,7 @@ static size_t edit_distance(const char *a, const char *b)
     return row[lb];
 }
 
-const char *suggest_name(const char *name, const char *const *cands, size_t n)
+const char *interp_suggest_name(const char *name, const char *const *cands, size_t n)
 {
     const char *best = NULL;
     size_t bestd = 99;

@@ -176,8 +176,8 @@ int mem_engine_error(interp *I, const char *what, const char *msg);
 void interp_init(interp *I);
 void interp_free(interp *I);
 int interp_add_source(interp *I, const char *name, const char *text, size_t len);
-const char *intern(interp *I, const char *s, size_t len);
-void *arena_alloc(interp *I, size_t n);
+const char *interp_intern(interp *I, const char *s, size_t len);
+void *mem_arena_alloc(interp *I, size_t n);
 
 /* Record an error at a node's position (or at I->cur when at is NULL). */
 int err_at(interp *I, const node *at, err_kind k, const char *fmt, ...)
@@ -192,6 +192,6 @@ void diag_print(interp *I, FILE *f, const err_state *e);
 
 /* Names closest to `name` among candidates, for "did you mean" (NULL if none
  * is close enough). */
-const char *suggest_name(const char *name, const char *const *cands, size_t n);
+const char *interp_suggest_name(const char *name, const char *const *cands, size_t n);
 
 #endif

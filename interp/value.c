@@ -129,7 +129,7 @@ static void heap_destroy(interp *I, heap *h)
 /* Freeing is iterative: objects whose count reaches zero wait on a local
  * list instead of being freed recursively, so dropping a list nested 10^6
  * deep uses no stack. */
-void heap_unref(interp *I, heap *h)
+void val_heap_unref(interp *I, heap *h)
 {
     heap *pending = NULL;
     drop_heap(I, h, &pending);
@@ -150,10 +150,10 @@ void val_ref(value v)
 void val_unref(interp *I, value v)
 {
     if (v.k >= V_STR && v.k != V_BUILTIN)
-        heap_unref(I, v.u.h);
+        val_heap_unref(I, v.u.h);
 }
 
-void heap_free_all(interp *I)
+void val_heap_free_all(interp *I)
 {
     while (I->heap_all)
         heap_destroy(I, I->heap_all);
@@ -198,7 +198,7 @@ value val_list(interp *I, size_t cap)
     return v;
 }
 
-int list_push(interp *I, vlist *l, value v)
+int val_list_push(interp *I, vlist *l, value v)
 {
     /* every push, not only when the list grows its storage: the limit is
      * exact whatever capacity val_list reserved */
@@ -232,7 +232,7 @@ value val_rec(interp *I)
     return v;
 }
 
-value *rec_get(const vrec *r, const char *key)
+value *val_rec_get(const vrec *r, const char *key)
 {
     for (size_t i = 0; i < r->n; i++)
         if (r->keys[i] == key)
@@ -240,9 +240,9 @@ value *rec_get(const vrec *r, const char *key)
     return NULL;
 }
 
-int rec_set(interp *I, vrec *r, const char *key, value v)
+int val_rec_set(interp *I, vrec *r, const char *key, value v)
 {
-    value *old = rec_get(r, key);
+    value *old = val_rec_get(r, key);
     if (old) {
         val_unref(I, *old);
         *old = v;
@@ -302,7 +302,7 @@ value val_obj(interp *I, const obj_class *cls, void *payload)
     return v;
 }
 
-env *env_new(interp *I, env *parent)
+env *val_env_new(interp *I, env *parent)
 {
     env *e = heap_new(I, sizeof(env), H_ENV);
     if (!e)
@@ -349,7 +349,7 @@ static int env_reindex(interp *I, env *e)
     return 0;
 }
 
-int env_define(interp *I, env *e, const char *name, value v)
+int val_env_define(interp *I, env *e, const char *name, value v)
 {
     long at = env_find(e, name);
     if (at >= 0) {
@@ -388,7 +388,7 @@ int env_define(interp *I, env *e, const char *name, value v)
     return 0;
 }
 
-value *env_lookup(env *e, const char *name)
+value *val_env_lookup(env *e, const char *name)
 {
     for (; e; e = e->parent) {
         long at = env_find(e, name);
@@ -460,7 +460,7 @@ int val_equal(interp *I, value a, value b)
     if (x->n != y->n)
         return 0;
     for (size_t i = 0; i < x->n; i++) {
-        value *o = rec_get(y, x->keys[i]);
+        value *o = val_rec_get(y, x->keys[i]);
         int r = o ? val_equal(I, x->vals[i], *o) : 0;
         if (r != 1)
             return r;
@@ -470,7 +470,7 @@ int val_equal(interp *I, value a, value b)
 
 /* Numbers print in the shortest form that reads back to the same double
  * (%.17g would show 0.1 as 0.10000000000000001). */
-void fmt_number(double n, char *buf, size_t size)
+void val_fmt_number(double n, char *buf, size_t size)
 {
     if (isnan(n)) {
         snprintf(buf, size, "nan");
@@ -515,7 +515,7 @@ static void print_atom(value v, bytebuf *out, int repr)
     case V_NIL: bytebuf_printf(out, "nil"); break;
     case V_BOOL: bytebuf_printf(out, v.u.b ? "true" : "false"); break;
     case V_NUM:
-        fmt_number(v.u.n, buf, sizeof buf);
+        val_fmt_number(v.u.n, buf, sizeof buf);
         bytebuf_printf(out, "%s", buf);
         break;
     case V_STR:

@@ -132,23 +132,23 @@ static inline value val_num(double n) { value v; v.k = V_NUM; v.u.n = n; return 
 
 void val_ref(value v);
 void val_unref(struct interp *I, value v);
-void heap_unref(struct interp *I, heap *h);
+void val_heap_unref(struct interp *I, heap *h);
 
 /* Constructors return a new reference, or a nil value with an out-of-memory
  * error raised in I (check I->err.active or use the eval helpers). */
 value val_str(struct interp *I, const char *s, size_t len);
 value val_cstr(struct interp *I, const char *s);
 value val_list(struct interp *I, size_t cap);
-int list_push(struct interp *I, vlist *l, value v); /* takes ownership of v */
+int val_list_push(struct interp *I, vlist *l, value v); /* takes ownership of v */
 value val_rec(struct interp *I);
-int rec_set(struct interp *I, vrec *r, const char *key, value v); /* key interned; takes v */
-value *rec_get(const vrec *r, const char *key);                 /* borrowed, or NULL */
+int val_rec_set(struct interp *I, vrec *r, const char *key, value v); /* key interned; takes v */
+value *val_rec_get(const vrec *r, const char *key);                 /* borrowed, or NULL */
 value val_func(struct interp *I, const struct node *lambda, env *closure, const char *name);
 value val_obj(struct interp *I, const obj_class *cls, void *payload); /* destroys payload on OOM */
 
-env *env_new(struct interp *I, env *parent);
-int env_define(struct interp *I, env *e, const char *name, value v); /* takes v; redefines */
-value *env_lookup(env *e, const char *name);                        /* borrowed, or NULL */
+env *val_env_new(struct interp *I, env *parent);
+int val_env_define(struct interp *I, env *e, const char *name, value v); /* takes v; redefines */
+value *val_env_lookup(env *e, const char *name);                        /* borrowed, or NULL */
 
 /* The type name used in messages: "number", "string", "list", "image"… */
 const char *val_type_name(value v);
@@ -161,11 +161,11 @@ int val_equal(struct interp *I, value a, value b);
 void val_print(struct interp *I, value v, struct bytebuf *out, int repr);
 
 /* Free every heap object (end of session): ignores reference counts. */
-void heap_free_all(struct interp *I);
+void val_heap_free_all(struct interp *I);
 
 
 
 /* Shortest decimal that reads back to the same double. */
-void fmt_number(double n, char *buf, size_t size);
+void val_fmt_number(double n, char *buf, size_t size);
 
 #endif

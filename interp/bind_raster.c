@@ -1,0 +1,210 @@
+/* bind_raster.c — the Z-buffer rasteriser in the language: rasterize(scene,
+ * camera, …) draws meshes and wrinkly surfaces (tessellated for the view)
+ * into an image. The engine is runtime/raster.h. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "lang_image.h"
+#include "lang_objects.h"
+#include "lang_wrinkly.h"
+#include "raster.h"
+#include "wrinkly.h"
+
+/* ---- rasterising ------------------------------------------------------------------- */
+
+/* Bounding box of a scene item: a mesh's vertices, or a surface's control
+ * points widened by the largest |height|. */
+static void item_box(value v, double lo[3], double hi[3])
+{
+    mesh *m = lang_as_mesh(v);
+    surf_obj *s = lang_as_surf(v);
+    if (m) {
+        for (size_t i = 0; i < m->nv; i++)
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fmin(lo[d], m->pos[3 * i + d]);
+                hi[d] = fmax(hi[d], m->pos[3 * i + d]);
+            }
+    } else if (s) {
+        double hm = 0;
+        for (size_t i = 0; i < (size_t)s->nu * (size_t)s->nv; i++) {
+            hm = fmax(hm, fabs(s->pts[i].h));
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fmin(lo[d], s->pts[i].pos[d] - hm);
+                hi[d] = fmax(hi[d], s->pts[i].pos[d] + hm);
+            }
+        }
+        for (int d = 0; d < 3; d++) {
+            lo[d] -= hm;
+            hi[d] += hm;
+        }
+    }
+}
+
+/* Append src to dst (with fallback colour for meshes without colours). */
+static void mesh_append(mesh *dst, const mesh *src, const float colour[4])
+{
+    uint32_t base = (uint32_t)dst->nv;
+    static const float up[3] = {0, 1, 0};
+    for (size_t i = 0; i < src->nv; i++)
+        mesh_add_vertex(dst, src->pos + 3 * i, src->nrm ? src->nrm + 3 * i : up, src->col ? src->col + 4 * i : colour);
+    for (size_t t = 0; t < src->nt; t++)
+        mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
+}
+
+/* rasterize(scene, camera, size, background, light, ambient, diffuse, flat, unlit, colour, pixel, kmax) */
+static int b_rasterize(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "rasterize";
+    value scene = a[0];
+    size_t nitems = scene.k == V_LIST ? AS_LIST(scene)->n : 1;
+    if (nitems == 0)
+        return err_arg(I, 0, ERR_VALUE, "rasterize: the scene list is empty");
+    for (size_t i = 0; i < nitems; i++) {
+        value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
+        if (!lang_as_mesh(it) && !lang_as_surf(it))
+            return err_item(I, scene, i, ERR_TYPE,
+                            "rasterize: the scene must be a mesh, a wrinkly_surface or a list of them, but item %zu is %s",
+                            i, val_type_name(it));
+    }
+    int w, h;
+    if (lang_arg_size2(I, a[2], &w, &h, "rasterize: size"))
+        return -1;
+    raster_opts ro;
+    raster_opts_default(&ro);
+    if (lang_get_colour(I, a[3], ro.background, "rasterize: background") ||
+        lang_get_colour(I, a[9], ro.colour, "rasterize: colour"))
+        return -1;
+    if (a[4].k != V_NIL) {
+        if (builtin_get_vec(I, a[4], ro.light, 3, "rasterize: light"))
+            return -1;
+        if (ro.light[0] == 0 && ro.light[1] == 0 && ro.light[2] == 0)
+            return err_arg(I, 4, ERR_VALUE, "rasterize: light must be a direction toward the light, not [0, 0, 0]");
+    }
+    ro.ambient = a[5].u.n;
+    ro.diffuse = a[6].u.n;
+    ro.flat = a[7].u.b;
+    ro.unlit = a[8].u.b;
+    lod l;
+    if (lang_get_lod(I, val_nil(), val_nil(), a[11], -1, &l, W))
+        return -1;
+    camera cam;
+    if (a[1].k != V_NIL) {
+        if (lang_get_camera(I, a[1], &cam, W))
+            return -1;
+    } else {
+        /* frame the scene: orbit(30, 20) around the centre of its box */
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
+        for (size_t i = 0; i < nitems; i++)
+            item_box(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene, lo, hi);
+        double r = 0;
+        for (int d = 0; d < 3; d++) {
+            if (!(hi[d] >= lo[d]))
+                lo[d] = hi[d] = 0;
+            c[d] = 0.5 * (lo[d] + hi[d]);
+            r += 0.25 * (hi[d] - lo[d]) * (hi[d] - lo[d]);
+        }
+        r = sqrt(r);
+        double fov = 40, half = 0.5 * fov * 3.14159265358979323846 / 180;
+        if (w < h)
+            half = atan(tan(half) * w / h);
+        camera_orbit(&cam, c, r > 0 ? 1.05 * r / sin(half) : 1, 30, 20, fov);
+        if (camera_setup(&cam))
+            return err_at(I, NULL, ERR_VALUE, "rasterize: cannot frame the scene");
+    }
+    /* one mesh to draw: a mesh as given, or the tessellations (LOD from this
+     * camera) and meshes merged in order */
+    mesh *single = nitems == 1 ? lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[0] : scene) : NULL;
+    mesh *merged = NULL;
+    int rc = -1;
+    image *im = NULL;
+    if (!single) {
+        int normals = 1;
+        double tv = 0;
+        for (size_t i = 0; i < nitems; i++) {
+            mesh *m = lang_as_mesh(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene);
+            if (m && !m->nrm && m->nt)
+                normals = 0;
+            tv += m ? (double)m->nv : 0;
+        }
+        merged = mem_alloc(I, sizeof *merged);
+        if (!merged)
+            return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        mesh_init(merged, normals, 1);
+        for (size_t i = 0; i < nitems; i++) {
+            value it = scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene;
+            mesh *m = lang_as_mesh(it), *t = NULL;
+            if (!m) {
+                if (lang_surf_mesh(I, lang_as_surf(it), &cam, w, h, a[10].u.n, &l, &t, W))
+                    goto done;
+                m = t;
+            }
+            tv += t ? (double)t->nv : 0;
+            if (tv >= 4294967295.0 || tv > I->lim.max_points) {
+                if (t) {
+                    mesh_free(t);
+                    mem_free(I, t);
+                }
+                err_at(I, NULL, ERR_LIMIT,
+                       "rasterize: the scene has more than %.0f vertices (raise it with --max-points)",
+                       fmin(I->lim.max_points, 4294967294.0));
+                goto done;
+            }
+            mesh_append(merged, m, ro.colour);
+            if (t) {
+                mesh_free(t);
+                mem_free(I, t);
+            }
+            if (merged->failed) {
+                err_at(I, NULL, ERR_MEMORY, "out of memory merging the scene");
+                goto done;
+            }
+        }
+        single = merged;
+    }
+    if (lang_image_new(I, w, h, &im))
+        goto done;
+    rt_run run = lang_run(I);
+    rt_error e;
+    rt_code c = raster_render(single, &cam, &ro, &run, im, &e);
+    if (c) {
+        lang_rt_error(I, c, &e, W);
+        goto done;
+    }
+    rc = lang_image_value(I, im, out);
+    im = NULL;
+done:
+    lang_image_discard(im);
+    if (merged) {
+        mesh_free(merged);
+        mem_free(I, merged);
+    }
+    return rc;
+}
+
+/* ---- registration ---------------------------------------------------------------------- */
+
+static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
+                                  {"camera", TY_CAMERA, "nil"},
+                                  {"size", TY_SIZE, "[256, 256]"},
+                                  {"background", TY_COLOUR, "0"},
+                                  {"light", "vec3", "nil"},
+                                  {"ambient", "num>=0", "0.2"},
+                                  {"diffuse", "num>=0", "0.8"},
+                                  {"flat", "bool", "false"},
+                                  {"unlit", "bool", "false"},
+                                  {"colour", TY_COLOUR, "1"},
+                                  {"pixel", "num>0", "1"},
+                                  {"kmax", TY_LOD_K, "8"}};
+
+static const builtin raster_builtins[] = {
+    BUILTIN("rasterize", b_rasterize, p_raster,
+            "Render a mesh, a wrinkly surface or a list of them with a Z-buffer into an image: camera (default: framing the scene), lights, background; surfaces are tessellated for this camera."),
+};
+
+int bind_raster_init(interp *I)
+{
+    return builtin_register(I, raster_builtins, (int)(sizeof raster_builtins / sizeof raster_builtins[0]));
+}

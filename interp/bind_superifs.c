@@ -1,0 +1,239 @@
+/* bind_superifs.c — V-variable super IFS in the language (seed 004 §5;
+ * engine superifs.h).
+ *
+ * Class "superifs": the V buffers of a super IFS after some steps.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtin.h"
+#include "fileio.h"
+#include "fset.h"
+#include "hist.h"
+#include "lang_fset.h"
+#include "lang_ifs.h"
+#include "lang_image.h"
+#include "lang_objects.h"
+#include "superifs.h"
+#include "tonemap.h"
+
+/* ---- super IFS ------------------------------------------------------------------------- */
+
+typedef struct lang_superifs {
+    superifs_state st;
+    int nifs;
+    uint64_t steps;
+} lang_superifs;
+
+static void superifs_destroy(void *pp)
+{
+    lang_superifs *s = pp;
+    superifs_free(&s->st);
+    rt_free(s);
+}
+
+static void superifs_summary(const void *pp, bytebuf *out)
+{
+    const lang_superifs *s = pp;
+    bytebuf_printf(out, "superifs: V = %d buffers of %zu points, %d IFSs, %llu steps; last step used", s->st.V,
+                   s->st.points, s->nifs, (unsigned long long)s->steps);
+    for (int v = 0; v < s->st.V && v < 16; v++) {
+        if (s->st.ifs_of[v] < 0)
+            bytebuf_printf(out, " -");
+        else
+            bytebuf_printf(out, " F%d", s->st.ifs_of[v] + 1);
+    }
+    if (s->st.V > 16)
+        bytebuf_printf(out, " …");
+}
+
+static int superifs_get(interp *I, const void *pp, const char *name, value *out)
+{
+    const lang_superifs *s = pp;
+    if (strcmp(name, "V") == 0)
+        *out = val_num(s->st.V);
+    else if (strcmp(name, "points") == 0)
+        *out = val_num((double)s->st.points);
+    else if (strcmp(name, "steps") == 0)
+        *out = val_num((double)s->steps);
+    else if (strcmp(name, "ifs") == 0) {
+        value l = val_list(I, (size_t)s->st.V);
+        if (l.k == V_NIL)
+            return -1;
+        for (int v = 0; v < s->st.V; v++)
+            if (val_list_push(I, AS_LIST(l), s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1))) {
+                val_unref(I, l);
+                return -1;
+            }
+        *out = l;
+        return 0;
+    } else
+        return 1;
+    return 0;
+}
+
+static const obj_class superifs_class = {
+    .name = "superifs",
+    .destroy = superifs_destroy,
+    .summary = superifs_summary,
+    .get = superifs_get,
+};
+
+/* superifs(sets, probabilities, V, points, steps, start, seed) */
+static int b_superifs(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    value fv;
+    if (lang_get_fset(I, a[0], 1, &fv, "superifs: sets"))
+        return -1;
+    const lang_fset *f = lang_as_fset(fv);
+    int rc = -1;
+    double *P = NULL;
+    superifs_opts so;
+    memset(&so, 0, sizeof so);
+    long V = (long)a[2].u.n, steps = (long)a[4].u.n; /* declared int[1,1024], int[0,100000] */
+    uint64_t pts = 0;
+    if (lang_points_arg(I, a[3], &pts, "superifs") || builtin_get_vec(I, a[5], so.start, 2, "superifs: start") ||
+        lang_arg_seed(I, a[6], &so.seed, "superifs"))
+        goto done;
+    if (f->dim != 2) {
+        err_arg(I, 0, ERR_VALUE, "superifs: the IFSs are 3-D; a super IFS needs 2-D maps");
+        goto done;
+    }
+    if (a[1].k != V_NIL) {
+        size_t np = AS_LIST(a[1])->n;
+        if ((int)np != f->n) {
+            err_arg(I, 1, ERR_VALUE, "superifs: probabilities must be a list of %d numbers (one per IFS), got %zu", f->n, np);
+            goto done;
+        }
+        P = mem_alloc(I, sizeof(double) * np);
+        if (!P) {
+            err_at(I, NULL, ERR_MEMORY, "out of memory");
+            goto done;
+        }
+        if (builtin_get_vec(I, a[1], P, np, "superifs: probabilities"))
+            goto done;
+        double sum = 0; /* each in [0, 1] (declared) */
+        for (size_t i = 0; i < np; i++)
+            sum += P[i];
+        if (fabs(sum - 1) > 1e-6) {
+            err_arg(I, 1, ERR_VALUE, "superifs: probabilities sum to %.9g (expected 1)", sum);
+            goto done;
+        }
+    }
+    if ((double)V * (double)pts > I->lim.max_points) {
+        err_at(I, NULL, ERR_LIMIT, "superifs: %ld buffers of %.0f points exceed the limit of %.0f points (raise it with --max-points)",
+               V, (double)pts, I->lim.max_points);
+        goto done;
+    }
+    so.V = (int)V;
+    so.points = (size_t)pts;
+    so.steps = (uint64_t)steps;
+    double bytes = (double)V * (double)pts * 16 * 2;
+    if (mem_precheck(I, bytes, "superifs: the buffers"))
+        goto done;
+    lang_superifs *ls = mem_calloc(I, 1, sizeof *ls);
+    if (!ls) {
+        err_at(I, NULL, ERR_MEMORY, "out of memory");
+        goto done;
+    }
+    rt_error e;
+    rt_run run = lang_run(I);
+    rt_code c = superifs_run(&f->fs, P, &so, &ls->st, &run, &e);
+    if (c) {
+        mem_free(I, ls);
+        lang_rt_error(I, c, &e, "superifs");
+        goto done;
+    }
+    ls->nifs = f->n;
+    ls->steps = so.steps;
+    *out = val_obj(I, &superifs_class, ls);
+    rc = out->k == V_NIL ? -1 : 0;
+done:
+    mem_free(I, P);
+    val_unref(I, fv);
+    return rc;
+}
+
+/* superifs_image(s, buffer, size, window, palette, curve, gamma, brightness, background) */
+static int b_superifs_image(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const lang_superifs *s = AS_OBJ(a[0])->payload;
+    long buf = (long)a[1].u.n; /* declared int>=1 */
+    int w, h;
+    ramp r;
+    tonemap_opts t;
+    if (buf > s->st.V)
+        return err_arg(I, 1, ERR_VALUE, "superifs_image: buffer must be between 1 and V = %d, got %ld", s->st.V, buf);
+    if (lang_arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
+        lang_tone_args(I, a[4], a[5], a[6], a[7], a[8], &t, &r, "superifs_image"))
+        return -1;
+    double lo[2], hi[2];
+    if (a[3].k != V_NIL) {
+        if (lang_window_arg(I, a[3], lo, hi, "superifs_image: window"))
+            return -1;
+    } else {
+        /* the bounds of all buffers, so every buffer is drawn at one scale */
+        lo[0] = lo[1] = INFINITY;
+        hi[0] = hi[1] = -INFINITY;
+        size_t np = (size_t)s->st.V * s->st.points;
+        for (size_t i = 0; i < np; i++)
+            for (int k = 0; k < 2; k++) {
+                double x = s->st.pts[2 * i + (size_t)k];
+                if (!isfinite(x))
+                    continue;
+                if (x < lo[k])
+                    lo[k] = x;
+                if (x > hi[k])
+                    hi[k] = x;
+            }
+        if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1]))
+            return err_at(I, NULL, ERR_VALUE, "superifs_image: the buffers hold no finite points; give window:");
+        lang_fit_aspect(lo, hi, w, h, 0.03);
+    }
+    if ((double)w * h > I->lim.max_pixels)
+        return err_at(I, NULL, ERR_LIMIT, "superifs_image: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);
+    hist2 hs;
+    rt_error e;
+    image *im = NULL;
+    rt_code c = hist2_init(&hs, w, h, lo, hi, 0, &e);
+    if (c)
+        return lang_rt_error(I, c, &e, "superifs_image");
+    c = superifs_render(&s->st, (int)buf - 1, &hs, &e);
+    if (!c && !lang_image_new(I, w, h, &im))
+        c = tonemap_apply(&hs, &t, im, &e);
+    hist2_free(&hs);
+    if (c || !im) {
+        lang_image_discard(im);
+        return I->err.active ? -1 : lang_rt_error(I, c, &e, "superifs_image");
+    }
+    return lang_image_value(I, im, out);
+}
+
+/* ---- registration ---------------------------------------------------------------------- */
+
+#define TY_CURVE "str{log,linear}"
+static const bparam p_superifs[] = {{"sets", "list|fset", NULL},   {"probabilities", "vec[0,1]", "nil"},
+                                    {"V", "int[1,1024]", "3"},     {"points", "int>=1", "1e5"},
+                                    {"steps", "int[0,100000]", "20"}, {"start", "vec2", "[0, 0]"},
+                                    {"seed", "int>=0", "nil"}};
+static const bparam p_superifs_image[] = {{"superifs", "superifs", NULL},   {"buffer", "int>=1", "1"},
+                                          {"size", TY_SIZE, "[512, 512]"},  {"window", "vec4", "nil"},
+                                          {"palette", "list", "nil"},       {"curve", TY_CURVE, "\"log\""},
+                                          {"gamma", "num>0", "2.2"},        {"brightness", "num>0", "1"},
+                                          {"background", TY_COLOUR, "[0, 0, 0, 1]"}};
+
+static const builtin superifs_builtins[] = {
+    BUILTIN("superifs", b_superifs, p_superifs,
+            "A V-variable super IFS (seed 004 §5): V buffers of points, each step replacing every buffer by the union of the maps of a randomly chosen IFS applied to randomly chosen buffers. sets: a list of IFSs or an fset; probabilities: of choosing each IFS (default equal). V = 1 is Asai's random function set."),
+    BUILTIN("superifs_image", b_superifs_image, p_superifs_image,
+            "An image of one buffer (1 .. V) of a super IFS, tone-mapped like chaos(…); the default window covers all buffers so they share one scale."),
+};
+
+int bind_superifs_init(interp *I)
+{
+    return builtin_register(I, superifs_builtins, (int)(sizeof superifs_builtins / sizeof superifs_builtins[0]));
+}
