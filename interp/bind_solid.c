@@ -25,25 +25,17 @@
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
+/* A vec3 argument (declared: 3 finite numbers) copied out. */
 static int get_vec3(interp *I, value v, double out[3], const char *what)
 {
-    if (builtin_get_vec(I, v, out, 3, what))
-        return -1;
-    for (int i = 0; i < 3; i++)
-        if (!isfinite(out[i]))
-            return err_at(I, NULL, ERR_VALUE, "%s must be finite numbers, got [%g, %g, %g]", what, out[0], out[1],
-                          out[2]);
-    return 0;
+    return builtin_get_vec(I, v, out, 3, what);
 }
 
 /* An axis: "x", "y", "z" or a non-zero vector; normalised. */
 static int get_axis(interp *I, value v, double a[3], const char *what)
 {
-    if (v.k == V_STR) {
+    if (v.k == V_STR) { /* declared str{x,y,z}|vec3 */
         const char *s = AS_STR(v)->s;
-        if (AS_STR(v)->len != 1 || !strchr("xyz", s[0]))
-            return err_at(I, NULL, ERR_VALUE, "%s must be \"x\", \"y\", \"z\" or a vector [x, y, z], got \"%s\"",
-                          what, s);
         a[0] = a[1] = a[2] = 0;
         a[s[0] - 'x'] = 1;
         return 0;
@@ -178,13 +170,6 @@ static field *kd_node(interp *I, value fluct, double k, const char *what)
     return kd;
 }
 
-static int check_k(interp *I, double k, const char *what)
-{
-    if (!isfinite(k))
-        return err_at(I, NULL, ERR_VALUE, "%s: k must be a finite number, got %g", what, k);
-    return 0;
-}
-
 /* A compiled texture program for (texture - lo) / (hi - lo). */
 static int texture_prog(interp *I, value v, double lo, double hi, field **tmp, field_prog **own,
                         const field_prog **prog, const char *who, const char *what)
@@ -279,21 +264,12 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     } else if (a[3].k != V_NIL && builtin_get_vec(I, a[3], p.corner, 8, "fractal: corners")) {
         return -1;
     }
-    for (int i = 0; i < 8; i++)
-        if (!isfinite(p.corner[i]))
-            return err_at(I, NULL, ERR_VALUE, "fractal: corner %d = %g is not a finite number", i, p.corner[i]);
-    int type = -1;
-    if (a[4].k == V_STR && strcmp(AS_STR(a[4])->s, "auto") == 0)
-        type = MPD_AUTO;
-    else if (a[4].k == V_NUM && a[4].u.n == floor(a[4].u.n) && a[4].u.n >= 1 && a[4].u.n <= 4)
-        type = (int)a[4].u.n;
-    if (type < 0) {
-        if (a[4].k == V_STR)
-            return err_at(I, NULL, ERR_VALUE,
-                          "fractal: strategy must be \"auto\" or 1, 2, 3, 4 (Types I-IV), got \"%s\"", AS_STR(a[4])->s);
-        return err_at(I, NULL, ERR_VALUE, "fractal: strategy must be \"auto\" or 1, 2, 3, 4 (Types I-IV), got %g",
-                      a[4].u.n);
-    }
+    /* declared str|int[1,4]: "auto" or Types I-IV (the message for a
+     * wrong string names both forms) */
+    if (a[4].k == V_STR && strcmp(AS_STR(a[4])->s, "auto") != 0)
+        return err_arg(I, 4, ERR_VALUE, "fractal: strategy must be \"auto\" or 1, 2, 3, 4 (Types I-IV), got \"%s\"",
+                       AS_STR(a[4])->s);
+    int type = a[4].k == V_STR ? MPD_AUTO : (int)a[4].u.n;
     int R2 = -1;
     if (a[5].k != V_NIL) {
         if (type != MPD_AUTO && type != MPD_TYPE4)
@@ -439,7 +415,7 @@ static int b_marble(interp *I, value *a, int n, value *out)
         mem_free(I, m);
         return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
     }
-    if (check_k(I, a[2].u.n, "marble") || get_axis(I, a[3], ax, "marble: axis")) {
+    if (get_axis(I, a[3], ax, "marble: axis")) {
         mem_free(I, m);
         return -1;
     }
@@ -474,8 +450,7 @@ static int b_wood(interp *I, value *a, int n, value *out)
     w->spacing = a[0].u.n;
     w->sharpness = a[1].u.n;
     rt_error e;
-    if (get_axis(I, a[2], w->axis, "wood: axis") || get_vec3(I, a[3], w->origin, "wood: origin") ||
-        check_k(I, a[5].u.n, "wood")) {
+    if (get_axis(I, a[2], w->axis, "wood: axis") || get_vec3(I, a[3], w->origin, "wood: origin")) {
         mem_free(I, w);
         return -1;
     }
@@ -504,10 +479,8 @@ static int b_perturb(interp *I, value *a, int n, value *out)
     (void)n;
     double ax[3], o[3];
     const char *mode = AS_STR(a[3])->s;
-    int radial = strcmp(mode, "radial") == 0;
-    if (!radial && strcmp(mode, "linear") != 0)
-        return err_at(I, NULL, ERR_VALUE, "perturb: mode must be \"linear\" or \"radial\", got \"%s\"", mode);
-    if (check_k(I, a[2].u.n, "perturb") || get_axis(I, a[4], ax, "perturb: axis") ||
+    int radial = strcmp(mode, "radial") == 0; /* declared str{linear,radial} */
+    if (get_axis(I, a[4], ax, "perturb: axis") ||
         get_vec3(I, a[5], o, "perturb: origin"))
         return -1;
     field *base = lang_to_field(I, a[0], "perturb: base");
@@ -531,13 +504,10 @@ static int b_textured(interp *I, value *a, int n, value *out)
     memset(&s, 0, sizeof s);
     const char *obj = AS_STR(a[1])->s;
     static const char *kinds[4] = {"sphere", "cube", "cylinder", "plane"};
-    s.kind = -1;
+    s.kind = 0; /* declared str{sphere,cube,cylinder,plane} */
     for (int i = 0; i < 4; i++)
         if (strcmp(obj, kinds[i]) == 0)
             s.kind = i;
-    if (s.kind < 0)
-        return err_at(I, NULL, ERR_VALUE,
-                      "textured: object must be \"sphere\", \"cube\", \"cylinder\" or \"plane\", got \"%s\"", obj);
     camera cam;
     int w, h;
     ramp r;
@@ -556,17 +526,11 @@ static int b_textured(interp *I, value *a, int n, value *out)
         return -1;
     if (o.light[0] == 0 && o.light[1] == 0 && o.light[2] == 0)
         return err_at(I, NULL, ERR_VALUE, "textured: light (0, 0, 0) has no direction");
-    o.ambient = a[12].u.n;
+    o.ambient = a[12].u.n; /* declared num[0,1] */
     o.diffuse = a[13].u.n;
-    if (!(o.ambient >= 0 && o.ambient <= 1) || !(o.diffuse >= 0 && o.diffuse <= 1))
-        return err_at(I, NULL, ERR_VALUE, "textured: ambient = %g and diffuse = %g must be between 0 and 1", o.ambient,
-                      o.diffuse);
     if (lang_get_colour(I, a[14], o.background, "textured: background"))
         return -1;
-    long ss;
-    if (builtin_get_int(I, a[15], 1, 8, &ss, "textured: supersample"))
-        return -1;
-    o.samples = (int)ss;
+    o.samples = (int)a[15].u.n; /* declared int[1,8] */
     field *tmp;
     field_prog *own;
     const field_prog *prog;
@@ -630,31 +594,37 @@ static int b_slice_plane(interp *I, value *a, int n, value *out)
 
 /* ---- registration --------------------------------------------------------------------- */
 
-static const bparam p_fractal[] = {{"R", TY_R, "8"},          {"beta", "num>=0", "0.5"},
-                                   {"seed", "num", "nil"},     {"corners", "vec|num", "nil"},
-                                   {"strategy", "str|num", "\"auto\""}, {"R2", "num", "nil"},
-                                   {"lo", "vec", "[-1, -1, -1]"}, {"hi", "vec", "[1, 1, 1]"}};
+/* an axis: "x", "y", "z" or a direction vector */
+#define TY_AXIS3 "str{x,y,z}|vec3"
+static const bparam p_fractal[] = {{"R", TY_R, "8"},
+                                   {"beta", "num>=0", "0.5"},
+                                   {"seed", "int[0,9007199254740992]", "nil"},
+                                   {"corners", "num|vec8", "nil"},
+                                   {"strategy", "str|int[1,4]", "\"auto\""},
+                                   {"R2", "int>=0", "nil"},
+                                   {"lo", "vec3", "[-1, -1, -1]"},
+                                   {"hi", "vec3", "[1, 1, 1]"}};
 static const bparam p_fmem[] = {{"R", TY_R, NULL}, {"R2", "int>=0", "nil"}};
 static const bparam p_marble[] = {{"layers", "list", NULL},
                                   {"fluct", "num|field|volume", "nil"},
                                   {"k", "num", "0.1"},
-                                  {"axis", "str|vec", "\"z\""}};
+                                  {"axis", TY_AXIS3, "\"z\""}};
 static const bparam p_wood[] = {{"spacing", "num", "0.1"},       {"sharpness", "num", "1"},
-                                {"axis", "str|vec", "\"z\""},    {"origin", "vec", "[0, 0, 0]"},
+                                {"axis", TY_AXIS3, "\"z\""},    {"origin", "vec3", "[0, 0, 0]"},
                                 {"fluct", "num|field|volume", "nil"}, {"k", "num", "0.02"}};
 static const bparam p_perturb[] = {{"base", "num|field|volume", NULL}, {"fluct", "num|field|volume", NULL},
-                                   {"k", "num", "0.1"},                {"mode", "str", "\"linear\""},
-                                   {"axis", "str|vec", "\"z\""},       {"origin", "vec", "[0, 0, 0]"}};
+                                   {"k", "num", "0.1"},                {"mode", "str{linear,radial}", "\"linear\""},
+                                   {"axis", TY_AXIS3, "\"z\""},        {"origin", "vec3", "[0, 0, 0]"}};
 static const bparam p_textured[] = {
-    {"texture", "num|field|volume", NULL}, {"object", "str", "\"sphere\""}, {"camera", TY_CAMERA, "orbit()"},
-    {"size", "vec|num", "[256, 256]"},     {"palette", "list", "nil"},      {"lo", "num", "0"},
-    {"hi", "num", "1"},                    {"center", "vec", "[0, 0, 0]"},  {"radius", "num", "1"},
-    {"height", "num", "2"},                {"normal", "vec", "[0, 0, 1]"},  {"light", "vec", "[1, 1, 1]"},
-    {"ambient", "num", "0.2"},             {"diffuse", "num", "0.8"},       {"background", TY_COLOUR, "0"},
-    {"supersample", "num", "1"}};
-static const bparam p_slice_plane[] = {{"field", "num|field|volume", NULL}, {"origin", "vec", "[0, 0, 0]"},
-                                       {"u", "vec", "[1, 0, 0]"},           {"v", "vec", "[0, 1, 0]"},
-                                       {"size", "vec|num", "[256, 256]"},   {"palette", "list", "nil"},
+    {"texture", "num|field|volume", NULL}, {"object", "str{sphere,cube,cylinder,plane}", "\"sphere\""},
+    {"camera", TY_CAMERA, "orbit()"},      {"size", TY_SIZE, "[256, 256]"},  {"palette", "list", "nil"},
+    {"lo", "num", "0"},                    {"hi", "num", "1"},               {"center", "vec3", "[0, 0, 0]"},
+    {"radius", "num", "1"},                {"height", "num", "2"},           {"normal", "vec3", "[0, 0, 1]"},
+    {"light", "vec3", "[1, 1, 1]"},        {"ambient", "num[0,1]", "0.2"},   {"diffuse", "num[0,1]", "0.8"},
+    {"background", TY_COLOUR, "0"},        {"supersample", "int[1,8]", "1"}};
+static const bparam p_slice_plane[] = {{"field", "num|field|volume", NULL}, {"origin", "vec3", "[0, 0, 0]"},
+                                       {"u", "vec3", "[1, 0, 0]"},          {"v", "vec3", "[0, 1, 0]"},
+                                       {"size", TY_SIZE, "[256, 256]"},     {"palette", "list", "nil"},
                                        {"lo", "num", "0"},                  {"hi", "num", "1"}};
 
 static const builtin solid_builtins[] = {
