@@ -19,8 +19,13 @@ int builtin_register(interp *I, const builtin *b, int n)
     while (root->parent)
         root = root->parent;
     for (int i = 0; i < n; i++) {
-        /* two builtins with one name would silently hide each other */
-        if (builtin_find(I, b[i].name))
+        /* two builtins with one name would silently hide each other; the
+         * builtin scope is hashed, so this costs one lookup, not a scan */
+        const char *name = interp_intern(I, b[i].name, strlen(b[i].name));
+        if (!name)
+            return -1;
+        const value *old = val_env_lookup(root, name);
+        if (old && old->k == V_BUILTIN)
             return err_at(I, NULL, ERR_RUNTIME, "internal error: builtin '%s' is defined twice", b[i].name);
         if (I->nbuiltins == I->cap_builtins) {
             int nc = I->cap_builtins ? I->cap_builtins * 2 : 256;
@@ -36,8 +41,7 @@ int builtin_register(interp *I, const builtin *b, int n)
         value v;
         v.k = V_BUILTIN;
         v.u.bi = &b[i];
-        const char *name = interp_intern(I, b[i].name, strlen(b[i].name));
-        if (!name || val_env_define(I, root, name, v))
+        if (val_env_define(I, root, name, v))
             return -1;
     }
     return 0;
