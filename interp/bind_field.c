@@ -343,10 +343,7 @@ static int b_cylinder(interp *I, value *a, int n, value *out)
 
 static int noise_common(interp *I, field *f, double freq, value *out)
 {
-    if (!(freq > 0) || !isfinite(freq)) {
-        field_unref(f);
-        return err_at(I, NULL, ERR_VALUE, "noise frequency must be positive, got %g", freq);
-    }
+    /* freq: declared num>0 */
     if (freq != 1)
         f = field_scale(f, 1.0 / freq); /* child evaluated at P * freq */
     return lang_field_value(I, f, out);
@@ -468,9 +465,7 @@ static int b_select(interp *I, value *a, int n, value *out)
 static int b_smooth_union(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    if (!(a[2].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "smooth_union: k must be positive, got %g", a[2].u.n);
-    field *x = lang_to_field(I, a[0], "smooth_union: a");
+    field *x = lang_to_field(I, a[0], "smooth_union: a"); /* k: declared num>0 */
     field *y = x ? lang_to_field(I, a[1], "smooth_union: b") : NULL;
     if (!y) {
         field_unref(x);
@@ -695,32 +690,20 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     camera cam;
     int w, h;
     double sz[2];
-    if (a[2].k == V_NUM)
+    if (a[2].k == V_NUM) /* declared TY_SIZE */
         sz[0] = sz[1] = a[2].u.n;
     else if (builtin_get_vec(I, a[2], sz, 2, "raymarch: size"))
         return -1;
-    if (sz[0] != floor(sz[0]) || sz[1] != floor(sz[1]) || sz[0] < 1 || sz[1] < 1 || sz[0] > 1e6 || sz[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "raymarch: size must be whole numbers of pixels");
     w = (int)sz[0];
     h = (int)sz[1];
     if (lang_get_camera(I, a[1], &cam, "raymarch") || get_bounds(I, a[3], a[4], o.lo, o.hi, "raymarch"))
         return -1;
-    const char *mode = AS_STR(a[5])->s;
-    if (strcmp(mode, "emission") == 0)
-        o.mode = RM_EMISSION;
-    else if (strcmp(mode, "solid") == 0)
-        o.mode = RM_SOLID;
-    else
-        return err_at(I, NULL, ERR_VALUE, "raymarch: mode must be \"emission\" or \"solid\", got \"%s\"", mode);
+    /* declared: mode str{emission,solid}, sigma num>0, step num>0 */
+    o.mode = strcmp(AS_STR(a[5])->s, "solid") == 0 ? RM_SOLID : RM_EMISSION;
     o.threshold = a[6].u.n;
-    if (!(a[7].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "raymarch: sigma must be positive, got %g", a[7].u.n);
     o.sigma = a[7].u.n;
-    if (a[8].k != V_NIL) {
-        if (!(a[8].u.n > 0))
-            return err_at(I, NULL, ERR_VALUE, "raymarch: step must be positive, got %g", a[8].u.n);
+    if (a[8].k != V_NIL)
         o.step = a[8].u.n;
-    }
     ramp r;
     if (a[9].k == V_LIST && AS_LIST(a[9])->n > 0 && AS_LIST(a[9])->items[0].k == V_LIST) {
         if (lang_get_ramp(I, a[9], &r, "raymarch: colour"))
@@ -774,40 +757,40 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
 }
 
 static const bparam p_value[] = {{"value", "num|field|volume", NULL}};
-static const bparam p_sphere[] = {{"center", "vec", "[0, 0, 0]"}, {"r", "num", "1"}, {"soft", "num", "0"}};
-static const bparam p_box[] = {{"center", "vec", "[0, 0, 0]"}, {"half", "vec", "[1, 1, 1]"}, {"soft", "num", "0"}};
-static const bparam p_torus[] = {{"center", "vec", "[0, 0, 0]"}, {"R", "num", "1"}, {"r", "num", "0.25"},
+static const bparam p_sphere[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num", "1"}, {"soft", "num", "0"}};
+static const bparam p_box[] = {{"center", "vec3", "[0, 0, 0]"}, {"half", "vec3", "[1, 1, 1]"}, {"soft", "num", "0"}};
+static const bparam p_torus[] = {{"center", "vec3", "[0, 0, 0]"}, {"R", "num", "1"}, {"r", "num", "0.25"},
                                  {"soft", "num", "0"}};
-static const bparam p_cylinder[] = {{"center", "vec", "[0, 0, 0]"}, {"r", "num", "1"}, {"half_height", "num", "1"},
+static const bparam p_cylinder[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num", "1"}, {"half_height", "num", "1"},
                                     {"soft", "num", "0"}};
-static const bparam p_perlin[] = {{"frequency", "num", "1"}, {"seed", "int", "nil"}};
-static const bparam p_fbm[] = {{"octaves", "int", "6"}, {"frequency", "num", "1"}, {"lacunarity", "num>0", "2"},
+static const bparam p_perlin[] = {{"frequency", "num>0", "1"}, {"seed", "int", "nil"}};
+static const bparam p_fbm[] = {{"octaves", "int", "6"}, {"frequency", "num>0", "1"}, {"lacunarity", "num>0", "2"},
                                {"gain", "num", "0.5"}, {"seed", "int", "nil"}};
-static const bparam p_turb[] = {{"octaves", "int", "6"}, {"frequency", "num", "1"}, {"seed", "int", "nil"}};
+static const bparam p_turb[] = {{"octaves", "int", "6"}, {"frequency", "num>0", "1"}, {"seed", "int", "nil"}};
 static const bparam p_bias[] = {{"t", "num|field|volume", NULL}, {"b", "num", NULL}};
 static const bparam p_gain[] = {{"t", "num|field|volume", NULL}, {"g", "num", NULL}};
 static const bparam p_smoothstep[] = {{"t", "num|field|volume", NULL}, {"e0", "num", "0"}, {"e1", "num", "1"}};
 static const bparam p_step[] = {{"t", "num|field|volume", NULL}, {"edge", "num", "0.5"}};
 static const bparam p_select[] = {{"cond", "any", NULL}, {"a", "any", NULL}, {"b", "any", NULL}};
-static const bparam p_sunion[] = {{"a", "num|field|volume", NULL}, {"b", "num|field|volume", NULL}, {"k", "num", "0.1"}};
-static const bparam p_translate[] = {{"field", "num|field|volume", NULL}, {"by", "vec", NULL}};
+static const bparam p_sunion[] = {{"a", "num|field|volume", NULL}, {"b", "num|field|volume", NULL}, {"k", "num>0", "0.1"}};
+static const bparam p_translate[] = {{"field", "num|field|volume", NULL}, {"by", "vec3", NULL}};
 static const bparam p_scale[] = {{"field", "num|field|volume", NULL}, {"by", "num", NULL}};
-static const bparam p_rotate[] = {{"field", "num|field|volume", NULL}, {"axis", "vec", NULL}, {"degrees", "num", NULL}};
+static const bparam p_rotate[] = {{"field", "num|field|volume", NULL}, {"axis", "vec3", NULL}, {"degrees", "num", NULL}};
 static const bparam p_warp[] = {{"field", "num|field|volume", NULL}, {"x", "num|field|volume", NULL},
                                 {"y", "num|field|volume", NULL}, {"z", "num|field|volume", NULL}};
-static const bparam p_at[] = {{"field", "num|field|volume", NULL}, {"point", "vec", NULL}};
+static const bparam p_at[] = {{"field", "num|field|volume", NULL}, {"point", "vec3", NULL}};
 static const bparam p_sample[] = {{"field", "num|field", NULL}, {"grid", "vec|num", "64"},
-                                  {"lo", "vec", "[-1, -1, -1]"}, {"hi", "vec", "[1, 1, 1]"}};
+                                  {"lo", "vec3", "[-1, -1, -1]"}, {"hi", "vec3", "[1, 1, 1]"}};
 static const bparam p_iso[] = {{"field", "num|field|volume", NULL}, {"level", "num", "0.5"}, {"grid", "vec|num", "64"},
-                               {"lo", "vec", "[-1, -1, -1]"},        {"hi", "vec", "[1, 1, 1]"},
+                               {"lo", "vec3", "[-1, -1, -1]"},       {"hi", "vec3", "[1, 1, 1]"},
                                {"colour", "num|field|volume", "nil"}, {"palette", "list", "nil"}};
 static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", TY_CAMERA, "orbit()"},
-                              {"size", TY_SIZE, "[256, 256]"},   {"lo", "vec", "[-1, -1, -1]"},
-                              {"hi", "vec", "[1, 1, 1]"},          {"mode", "str", "\"emission\""},
-                              {"threshold", "num", "0.5"},         {"sigma", "num", "8"},
+                              {"size", TY_SIZE, "[256, 256]"},   {"lo", "vec3", "[-1, -1, -1]"},
+                              {"hi", "vec3", "[1, 1, 1]"},         {"mode", "str{emission,solid}", "\"emission\""},
+                              {"threshold", "num", "0.5"},         {"sigma", "num>0", "8"},
                               {"step", "num>0", "nil"},            {"colour", TY_COLOUR "|list", "1"},
                               {"background", TY_COLOUR, "0"},          {"lighting", "bool", "true"},
-                              {"light", "vec", "nil"}};
+                              {"light", "vec3", "nil"}};
 
 static const builtin field_builtins[] = {
     BUILTIN("field", b_field, p_value, "A field from a number (constant) or a volume (trilinear samples)."),
