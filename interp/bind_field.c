@@ -831,5 +831,5 @@ int bind_field_init(interp *I)
         if (lang_field_value(I, field_coord(i), &v) || val_env_define(I, root, interp_intern(I, names[i], 1), v))
             return -1;
     }
-    return builtin_register(I, field_builtins, (int)(sizeof field_builtins / sizeof field_builtins[0]));
+    return BUILTIN_REGISTER(I, field_builtins);
 }

@@ -633,5 +633,5 @@ static const builtin fset_builtins[] = {
 
 int bind_fset_init(interp *I)
 {
-    return builtin_register(I, fset_builtins, (int)(sizeof fset_builtins / sizeof fset_builtins[0]));
+    return BUILTIN_REGISTER(I, fset_builtins);
 }

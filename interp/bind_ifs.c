@@ -993,5 +993,5 @@ static const builtin ifs_builtins[] = {
 
 int bind_ifs_init(interp *I)
 {
-    return builtin_register(I, ifs_builtins, (int)(sizeof ifs_builtins / sizeof ifs_builtins[0]));
+    return BUILTIN_REGISTER(I, ifs_builtins);
 }

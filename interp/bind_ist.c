@@ -350,5 +350,5 @@ static const builtin ist_builtins[] = {
 
 int bind_ist_init(interp *I)
 {
-    return builtin_register(I, ist_builtins, (int)(sizeof ist_builtins / sizeof ist_builtins[0]));
+    return BUILTIN_REGISTER(I, ist_builtins);
 }

@@ -206,5 +206,5 @@ static const builtin raster_builtins[] = {
 
 int bind_raster_init(interp *I)
 {
-    return builtin_register(I, raster_builtins, (int)(sizeof raster_builtins / sizeof raster_builtins[0]));
+    return BUILTIN_REGISTER(I, raster_builtins);
 }

@@ -553,5 +553,5 @@ static const builtin shape_builtins[] = {
 
 int bind_shape_init(interp *I)
 {
-    return builtin_register(I, shape_builtins, (int)(sizeof shape_builtins / sizeof shape_builtins[0]));
+    return BUILTIN_REGISTER(I, shape_builtins);
 }

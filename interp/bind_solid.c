@@ -656,5 +656,5 @@ static const builtin solid_builtins[] = {
 
 int bind_solid_init(interp *I)
 {
-    return builtin_register(I, solid_builtins, (int)(sizeof solid_builtins / sizeof solid_builtins[0]));
+    return BUILTIN_REGISTER(I, solid_builtins);
 }

@@ -235,5 +235,5 @@ static const builtin superifs_builtins[] = {
 
 int bind_superifs_init(interp *I)
 {
-    return builtin_register(I, superifs_builtins, (int)(sizeof superifs_builtins / sizeof superifs_builtins[0]));
+    return BUILTIN_REGISTER(I, superifs_builtins);
 }

@@ -74,5 +74,5 @@ static const builtin tiles_builtins[] = {
 
 int bind_tiles_init(interp *I)
 {
-    return builtin_register(I, tiles_builtins, (int)(sizeof tiles_builtins / sizeof tiles_builtins[0]));
+    return BUILTIN_REGISTER(I, tiles_builtins);
 }

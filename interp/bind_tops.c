@@ -283,5 +283,5 @@ static const builtin tops_builtins[] = {
 
 int bind_tops_init(interp *I)
 {
-    return builtin_register(I, tops_builtins, (int)(sizeof tops_builtins / sizeof tops_builtins[0]));
+    return BUILTIN_REGISTER(I, tops_builtins);
 }

@@ -504,5 +504,5 @@ static const builtin volume_builtins[] = {
 
 int bind_volume_init(interp *I)
 {
-    return builtin_register(I, volume_builtins, (int)(sizeof volume_builtins / sizeof volume_builtins[0]));
+    return BUILTIN_REGISTER(I, volume_builtins);
 }

@@ -844,5 +844,5 @@ static const builtin wrinkly_builtins[] = {
 
 int bind_wrinkly_init(interp *I)
 {
-    return builtin_register(I, wrinkly_builtins, (int)(sizeof wrinkly_builtins / sizeof wrinkly_builtins[0]));
+    return BUILTIN_REGISTER(I, wrinkly_builtins);
 }

@@ -69,6 +69,8 @@ typedef struct builtin {
 } builtin;
 
 #define BUILTIN(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 0, doc}
+/* Register a static table of builtins: BUILTIN_REGISTER(I, field_builtins). */
+#define BUILTIN_REGISTER(I, table) builtin_register((I), (table), (int)(sizeof(table) / sizeof((table)[0])))
 #define BUILTIN_VAR(name, fn, params, doc) {name, fn, params, (int)(sizeof params / sizeof params[0]), 1, doc}
 
 /* The registry (builtin.c). Register a table of builtins (static storage) as globals. */

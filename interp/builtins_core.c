@@ -732,5 +732,5 @@ int builtin_core_init(interp *I)
     if (!pi || !tau || !inf || val_env_define(I, root, pi, val_num(3.14159265358979323846)) ||
         val_env_define(I, root, tau, val_num(6.28318530717958647692)) || val_env_define(I, root, inf, val_num(INFINITY)))
         return -1;
-    return builtin_register(I, core, (int)(sizeof core / sizeof core[0]));
+    return BUILTIN_REGISTER(I, core);
 }

@@ -428,5 +428,5 @@ static const builtin image_builtins[] = {
 
 int builtin_image_init(interp *I)
 {
-    return builtin_register(I, image_builtins, (int)(sizeof image_builtins / sizeof image_builtins[0]));
+    return BUILTIN_REGISTER(I, image_builtins);
 }

@@ -84,6 +84,19 @@ void check_names_free(interp *I, check_names *b)
     memset(b, 0, sizeof *b);
 }
 
+/* The arguments of a call as the evaluator passes them: positional ones
+ * first, then named ones (anames[i] NULL for a positional argument). */
+static void call_args(const node *call, int na, const char **anames, const node **anodes)
+{
+    int k = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int i = 1; i <= na; i++)
+            if ((call->names[i] != NULL) == pass) {
+                anames[k] = call->names[i];
+                anodes[k++] = call->kids[i];
+            }
+}
+
 static int check_builtin(interp *I, const builtin *b, const node *call)
 {
     const bspec *spec = contract_spec(I, b);
@@ -97,14 +110,7 @@ static int check_builtin(interp *I, const builtin *b, const node *call)
         pnames[j] = spec->p[j].name;
         required[j] = spec->p[j].required;
     }
-    /* the evaluator passes positional arguments first, then named ones */
-    int k = 0;
-    for (int pass = 0; pass < 2; pass++)
-        for (int i = 1; i <= na; i++)
-            if ((call->names[i] != NULL) == pass) {
-                anames[k] = call->names[i];
-                anodes[k++] = call->kids[i];
-            }
+    call_args(call, na, anames, anodes);
     if (contract_match(I, b->name, pnames, required, spec->n, b->variadic, "at most ", anames, anodes, na, call,
                        slot))
         return -1;
@@ -143,13 +149,7 @@ static int check_lambda(interp *I, const char *fname, const node *l, const node 
     int required[MAX_ARGS], slot[MAX_ARGS];
     for (int j = 0; j < l->nparams; j++)
         required[j] = l->kids[j] == NULL;
-    int k = 0;
-    for (int pass = 0; pass < 2; pass++)
-        for (int i = 1; i <= na; i++)
-            if ((call->names[i] != NULL) == pass) {
-                anames[k] = call->names[i];
-                anodes[k++] = call->kids[i];
-            }
+    call_args(call, na, anames, anodes);
     return contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, na, call, slot);
 }
 

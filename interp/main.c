@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "builtin.h"
+#include "contract.h"
 #include "cstack.h"
 #include "eval.h"
 #include "fileio.h"
@@ -58,7 +59,8 @@ static const char usage_text[] =
     "                        ([0, 2]), a string param the text as it is (or a\n"
     "                        quoted \"string\"). VALUE may use builtins, not the\n"
     "                        script's names. Checked before anything runs (for a\n"
-    "                        computed default, when the script reaches the param);\n"
+    "                        default computed from the script's names, when the\n"
+    "                        script reaches the param);\n"
     "                        an unknown NAME is an error\n"
     "  --seed N              global random seed, a whole number 0 ≤ N ≤ 2^53\n"
     "                        (default 1)\n"
@@ -410,30 +412,8 @@ static void print_params(interp *I)
     }
 }
 
-/* A default whose type is known without running the script. */
-static int is_literal(const node *n)
-{
-    switch (n->kind) {
-    case N_NUM:
-    case N_STR:
-    case N_BOOL:
-    case N_NIL:
-        return 1;
-    case N_UNARY:
-        return n->op != 'n' && n->kids[0]->kind == N_NUM;
-    case N_LIST:
-    case N_RECORD:
-        for (int i = 0; i < n->nkids; i++)
-            if (!is_literal(n->kids[i]))
-                return 0;
-        return 1;
-    default:
-        return 0;
-    }
-}
-
 /* -D before anything runs: each NAME must be a top-level param of the script,
- * and where the param's default is a literal, its value is checked now, by
+ * and where the param's default is a constant expression, its value is checked now, by
  * evaluating that one `param` statement on its own — the same code, and so
  * the same messages, as when the script reaches it (apply_param_override in
  * eval.c). Params with computed defaults are checked there. */
@@ -463,7 +443,7 @@ static int check_overrides(interp *I, const char *name, const char *text, size_t
                            ovname, s ? " (did you mean '" : nc ? "" : " (it declares none)",
                            s ? s : "", s ? "'?)" : "");
         }
-        if (!is_literal(decl->kids[0]))
+        if (!contract_is_constant(decl->kids[0])) /* its type is known without running */
             continue;
         node *blk = mem_arena_alloc(I, sizeof *blk);
         node **kids = mem_arena_alloc(I, sizeof *kids);
