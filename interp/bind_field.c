@@ -264,11 +264,8 @@ static int get_grid(interp *I, value v, int n[3], const char *what)
     } else if (builtin_get_vec(I, v, g, 3, what)) {
         return -1;
     }
-    for (int i = 0; i < 3; i++) {
-        if (g[i] != floor(g[i]) || g[i] < 2 || g[i] > 65536)
-            return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers from 2 to 65536, got %g", what, g[i]);
+    for (int i = 0; i < 3; i++) /* declared TY_GRID3: whole numbers 2 to 65536 */
         n[i] = (int)g[i];
-    }
     if ((double)n[0] * n[1] * n[2] > I->lim.max_voxels)
         return err_at(I, NULL, ERR_LIMIT, "%s of %d×%d×%d exceeds the limit of %.0f voxels (raise it with --max-voxels)",
                       what, n[0], n[1], n[2], I->lim.max_voxels);
@@ -423,7 +420,7 @@ static int b_smoothstep(interp *I, value *a, int n, value *out)
     (void)n;
     double e0 = a[1].u.n, e1 = a[2].u.n;
     if (!(e1 > e0))
-        return err_at(I, NULL, ERR_VALUE, "smoothstep: needs e0 < e1, got %g and %g", e0, e1);
+        return err_arg(I, 2, ERR_VALUE, "smoothstep: needs e0 < e1, got %g and %g", e0, e1);
     if (a[0].k == V_NUM) {
         *out = val_num(dmf_smoothstep(e0, e1, a[0].u.n));
         return 0;
@@ -487,8 +484,8 @@ static int b_translate(interp *I, value *a, int n, value *out)
 static int b_scale(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    if (!(a[1].u.n != 0) || !isfinite(a[1].u.n))
-        return err_at(I, NULL, ERR_VALUE, "scale: the factor must be a non-zero number, got %g", a[1].u.n);
+    if (a[1].u.n == 0)
+        return err_arg(I, 1, ERR_VALUE, "scale: the factor must be a non-zero number, got 0");
     field *f = lang_to_field(I, a[0], "scale: field");
     return f ? lang_field_value(I, field_scale(f, a[1].u.n), out) : -1;
 }
@@ -503,7 +500,7 @@ static int b_rotate(interp *I, value *a, int n, value *out)
         return -1;
     double l = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
     if (!(l > 0))
-        return err_at(I, NULL, ERR_VALUE, "rotate: the axis must not be zero");
+        return err_arg(I, 1, ERR_VALUE, "rotate: the axis must not be zero");
     for (int i = 0; i < 3; i++)
         ax[i] /= l;
     double t = -a[2].u.n * 3.14159265358979323846 / 180.0; /* inverse */
@@ -756,19 +753,22 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     return 0;
 }
 
+/* a grid of cells: one whole number for every axis, or one per axis */
+#define TY_GRID3 "ivec3[2,65536]|int[2,65536]"
+
 static const bparam p_value[] = {{"value", "num|field|volume", NULL}};
-static const bparam p_sphere[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num", "1"}, {"soft", "num", "0"}};
-static const bparam p_box[] = {{"center", "vec3", "[0, 0, 0]"}, {"half", "vec3", "[1, 1, 1]"}, {"soft", "num", "0"}};
-static const bparam p_torus[] = {{"center", "vec3", "[0, 0, 0]"}, {"R", "num", "1"}, {"r", "num", "0.25"},
-                                 {"soft", "num", "0"}};
-static const bparam p_cylinder[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num", "1"}, {"half_height", "num", "1"},
-                                    {"soft", "num", "0"}};
+static const bparam p_sphere[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num>0", "1"}, {"soft", "num>=0", "0"}};
+static const bparam p_box[] = {{"center", "vec3", "[0, 0, 0]"}, {"half", "vec3>0", "[1, 1, 1]"}, {"soft", "num>=0", "0"}};
+static const bparam p_torus[] = {{"center", "vec3", "[0, 0, 0]"}, {"R", "num>0", "1"}, {"r", "num>0", "0.25"},
+                                 {"soft", "num>=0", "0"}};
+static const bparam p_cylinder[] = {{"center", "vec3", "[0, 0, 0]"}, {"r", "num>0", "1"}, {"half_height", "num>0", "1"},
+                                    {"soft", "num>=0", "0"}};
 static const bparam p_perlin[] = {{"frequency", "num>0", "1"}, {"seed", "int", "nil"}};
-static const bparam p_fbm[] = {{"octaves", "int", "6"}, {"frequency", "num>0", "1"}, {"lacunarity", "num>0", "2"},
+static const bparam p_fbm[] = {{"octaves", "int[1,30]", "6"}, {"frequency", "num>0", "1"}, {"lacunarity", "num>0", "2"},
                                {"gain", "num", "0.5"}, {"seed", "int", "nil"}};
-static const bparam p_turb[] = {{"octaves", "int", "6"}, {"frequency", "num>0", "1"}, {"seed", "int", "nil"}};
-static const bparam p_bias[] = {{"t", "num|field|volume", NULL}, {"b", "num", NULL}};
-static const bparam p_gain[] = {{"t", "num|field|volume", NULL}, {"g", "num", NULL}};
+static const bparam p_turb[] = {{"octaves", "int[1,30]", "6"}, {"frequency", "num>0", "1"}, {"seed", "int", "nil"}};
+static const bparam p_bias[] = {{"t", "num|field|volume", NULL}, {"b", "num(0,1)", NULL}};
+static const bparam p_gain[] = {{"t", "num|field|volume", NULL}, {"g", "num(0,1)", NULL}};
 static const bparam p_smoothstep[] = {{"t", "num|field|volume", NULL}, {"e0", "num", "0"}, {"e1", "num", "1"}};
 static const bparam p_step[] = {{"t", "num|field|volume", NULL}, {"edge", "num", "0.5"}};
 static const bparam p_select[] = {{"cond", "any", NULL}, {"a", "any", NULL}, {"b", "any", NULL}};
@@ -779,9 +779,9 @@ static const bparam p_rotate[] = {{"field", "num|field|volume", NULL}, {"axis", 
 static const bparam p_warp[] = {{"field", "num|field|volume", NULL}, {"x", "num|field|volume", NULL},
                                 {"y", "num|field|volume", NULL}, {"z", "num|field|volume", NULL}};
 static const bparam p_at[] = {{"field", "num|field|volume", NULL}, {"point", "vec3", NULL}};
-static const bparam p_sample[] = {{"field", "num|field", NULL}, {"grid", "vec|num", "64"},
+static const bparam p_sample[] = {{"field", "num|field", NULL}, {"grid", TY_GRID3, "64"},
                                   {"lo", "vec3", "[-1, -1, -1]"}, {"hi", "vec3", "[1, 1, 1]"}};
-static const bparam p_iso[] = {{"field", "num|field|volume", NULL}, {"level", "num", "0.5"}, {"grid", "vec|num", "64"},
+static const bparam p_iso[] = {{"field", "num|field|volume", NULL}, {"level", "num", "0.5"}, {"grid", TY_GRID3, "64"},
                                {"lo", "vec3", "[-1, -1, -1]"},       {"hi", "vec3", "[1, 1, 1]"},
                                {"colour", "num|field|volume", "nil"}, {"palette", "list", "nil"}};
 static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", TY_CAMERA, "orbit()"},

@@ -379,14 +379,20 @@ static int b_map(interp *I, value *a, int n, value *out)
 {
     (void)n;
     /* map(a, b, c, d, e, f): Fractint order; or named transforms */
-    int coef = 0;
-    for (int i = 0; i < 6; i++)
+    int coef = 0, missing = -1;
+    for (int i = 0; i < 6; i++) {
         coef += a[i].k == V_NUM;
+        if (a[i].k != V_NUM && missing < 0)
+            missing = i;
+    }
     if (coef && coef != 6)
-        return err_at(I, NULL, ERR_VALUE, "affine: give all six coefficients a b c d e f, or use scale/rotate/shear/translate");
+        return err_at(I, NULL, ERR_VALUE,
+                      "affine: give all six coefficients a b c d e f (%c is missing), or use scale/rotate/shear/translate",
+                      "abcdef"[missing]);
     if (coef == 6) {
-        if (a[6].k != V_NIL || a[7].k != V_NIL || a[8].k != V_NIL || a[9].k != V_NIL)
-            return err_at(I, NULL, ERR_VALUE, "affine: coefficients and transforms cannot be mixed");
+        for (int i = 6; i < 10; i++)
+            if (a[i].k != V_NIL)
+                return err_arg(I, i, ERR_VALUE, "affine: coefficients and transforms cannot be mixed");
         return map_value(I, affine_from_2d(a[0].u.n, a[1].u.n, a[2].u.n, a[3].u.n, a[4].u.n, a[5].u.n), out);
     }
     /* scale, then shear, then rotate, then translate */
@@ -566,11 +572,9 @@ static int colour_mode(interp *I, value v, chaos_colour *c, const char *what)
         *c = CHAOS_COLOUR_NONE;
     else if (strcmp(s, "map") == 0)
         *c = CHAOS_COLOUR_LAST;
-    else if (strcmp(s, "blend") == 0)
+    else /* declared str{none,density,map,blend} */
         *c = CHAOS_COLOUR_BLEND;
-    else
-        return err_at(I, NULL, ERR_VALUE, "%s: colour must be \"density\", \"map\" or \"blend\", got %s", what,
-                      v.k == V_STR ? s : val_type_name(v));
+    (void)I, (void)what;
     return 0;
 }
 
@@ -597,14 +601,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     tonemap_opts t;
     memset(&t, 0, sizeof t);
     const char *curve = AS_STR(a[6])->s;
-    if (strcmp(curve, "log") == 0)
-        t.curve = TONEMAP_LOG;
-    else if (strcmp(curve, "linear") == 0)
-        t.curve = TONEMAP_LINEAR;
-    else
-        return err_at(I, NULL, ERR_VALUE, "chaos: curve must be \"log\" or \"linear\", got \"%s\"", curve);
-    if (!(a[7].u.n > 0) || !(a[8].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "chaos: gamma and brightness must be positive");
+    t.curve = strcmp(curve, "log") == 0 ? TONEMAP_LOG : TONEMAP_LINEAR; /* declared str{log,linear} */
     t.gamma = a[7].u.n;
     t.brightness = a[8].u.n;
     t.colour = o.colour == CHAOS_COLOUR_NONE ? TONEMAP_RAMP : TONEMAP_MEAN;
@@ -660,10 +657,9 @@ static int norm_arg(interp *I, value v, chaos_norm *nm, const char *what)
         *nm = CHAOS_NORM_TOTAL;
     else if (strcmp(s, "max") == 0)
         *nm = CHAOS_NORM_MAX;
-    else if (strcmp(s, "count") == 0)
+    else /* declared str{total,max,count} */
         *nm = CHAOS_NORM_COUNT;
-    else
-        return err_at(I, NULL, ERR_VALUE, "%s: normalize must be \"total\", \"max\" or \"count\", got \"%s\"", what, s);
+    (void)I, (void)what;
     return 0;
 }
 
@@ -685,9 +681,6 @@ static int b_measure(interp *I, value *a, int n, value *out)
         g[0] = g[1] = g[2] = a[1].u.n;
     else if (builtin_get_vec(I, a[1], g, (size_t)dim, "measure: grid"))
         return -1;
-    for (int i = 0; i < dim; i++)
-        if (g[i] != floor(g[i]) || g[i] < 1 || g[i] > 65536)
-            return err_at(I, NULL, ERR_VALUE, "measure: grid must be whole numbers from 1 to 65536");
     double lo[3], hi[3];
     rt_error e;
     rt_code c;
@@ -948,28 +941,28 @@ static int b_load_ifs(interp *I, value *a, int n, value *out)
 
 static const bparam p_map[] = {{"a", "num", "nil"},      {"b", "num", "nil"},     {"c", "num", "nil"},
                                {"d", "num", "nil"},      {"e", "num", "nil"},     {"f", "num", "nil"},
-                               {"scale", "num|vec", "nil"}, {"rotate", "num", "nil"}, {"shear", "num", "nil"},
-                               {"translate", "vec", "nil"}};
-static const bparam p_map3[] = {{"matrix", "list", NULL}, {"translate", "vec", "nil"}};
+                               {"scale", "num|vec2", "nil"}, {"rotate", "num", "nil"}, {"shear", "num", "nil"},
+                               {"translate", "vec2", "nil"}};
+static const bparam p_map3[] = {{"matrix", "list", NULL}, {"translate", "vec3", "nil"}};
 static const bparam p_ifs[] = {{"maps", "list|ifs", NULL}, {"probabilities", "vec[0,1]", "nil"},
                                {"normalize", "bool", "false"}, {"allow_expanding", "bool", "false"}};
 static const bparam p_rifs[] = {{"maps", "list|ifs", NULL}, {"matrix", "list", NULL}, {"order", "int{1,2}", "1"},
                                 {"normalize", "bool", "false"}, {"allow_expanding", "bool", "false"}};
 static const bparam p_chaos[] = {{"system", "ifs|rifs", NULL},   {"points", "int>=1", "1e6"},
                                  {"size", TY_SIZE, "[512, 512]"}, {"window", "vec4", "nil"},
-                                 {"colour", "str", "nil"},          {"palette", "list", "nil"},
-                                 {"curve", "str", "\"log\""},        {"gamma", "num>0", "2.2"},
-                                 {"brightness", "num>=0", "1"},      {"background", TY_COLOUR, "[0, 0, 0, 1]"},
+                                 {"colour", "str{none,density,map,blend}", "nil"},          {"palette", "list", "nil"},
+                                 {"curve", "str{log,linear}", "\"log\""},        {"gamma", "num>0", "2.2"},
+                                 {"brightness", "num>0", "1"},      {"background", TY_COLOUR, "[0, 0, 0, 1]"},
                                  {"supersample", "int[1,8]", "1"},   {"seed", "int>=0", "nil"}};
-static const bparam p_measure[] = {{"system", "ifs|rifs", NULL}, {"grid", "vec|num", "64"},
-                                   {"points", "int>=1", "1e6"},  {"normalize", "str", "\"total\""},
+static const bparam p_measure[] = {{"system", "ifs|rifs", NULL}, {"grid", "ivec[1,65536]|int[1,65536]", "64"},
+                                   {"points", "int>=1", "1e6"},  {"normalize", "str{total,max,count}", "\"total\""},
                                    {"lo", "vec", "nil"},          {"hi", "vec", "nil"},
                                    {"seed", "int>=0", "nil"}};
-static const bparam p_points[] = {{"system", "ifs|rifs", NULL}, {"points", "int>=1", "1e5"}, {"colour", "str", "nil"},
+static const bparam p_points[] = {{"system", "ifs|rifs", NULL}, {"points", "int>=1", "1e5"}, {"colour", "str{none,density,map,blend}", "nil"},
                                   {"palette", "list", "nil"},    {"seed", "int>=0", "nil"}};
 static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", TY_CAMERA, "orbit()"},
                                 {"size", TY_SIZE, "[512, 512]"}, {"points", "int>=1", "1e6"},
-                                {"colour", "str", "nil"},          {"palette", "list", "nil"},
+                                {"colour", "str{none,density,map,blend}", "nil"},          {"palette", "list", "nil"},
                                 {"background", TY_COLOUR, "[0, 0, 0, 1]"}, {"seed", "int>=0", "nil"}};
 static const bparam p_load_ifs[] = {{"path", "str", NULL}};
 

@@ -49,12 +49,8 @@ static int b_orbit(interp *I, value *a, int n, value *out)
     double target[3];
     if (builtin_get_vec(I, a[3], target, 3, "orbit: target"))
         return -1;
-    if (!(a[2].u.n > 0))
-        return err_at(I, NULL, ERR_VALUE, "orbit: distance must be positive, got %g", a[2].u.n);
     camera c;
     camera_orbit(&c, target, a[2].u.n, a[0].u.n, a[1].u.n, a[4].u.n);
-    if (fabs(a[1].u.n) >= 90)
-        return err_at(I, NULL, ERR_VALUE, "orbit: elevation must be between -90 and 90 degrees, got %g", a[1].u.n);
     return camera_record(I, c.eye, c.target, c.up, a[4].u.n, out);
 }
 
@@ -430,22 +426,11 @@ static int b_mesh_stats(interp *I, value *a, int n, value *out)
     return 0;
 }
 
-static int axis_of(interp *I, value v, int *axis)
-{
-    if (v.k == V_STR && AS_STR(v)->len == 1 && strchr("xyz", AS_STR(v)->s[0])) {
-        *axis = AS_STR(v)->s[0] - 'x';
-        return 0;
-    }
-    return err_at(I, NULL, ERR_VALUE, "axis must be \"x\", \"y\" or \"z\"");
-}
-
 static int b_slice(interp *I, value *a, int n, value *out)
 {
     (void)n;
     volume *v = lang_as_volume(a[0]);
-    int axis = 2;
-    if (axis_of(I, a[1], &axis))
-        return -1;
+    int axis = AS_STR(a[1])->s[0] - 'x'; /* declared str{x,y,z} */
     int len = axis == 0 ? v->nx : axis == 1 ? v->ny : v->nz;
     long index = len / 2;
     if (a[2].k != V_NIL && builtin_get_int(I, a[2], 0, len - 1, &index, "slice: index"))
@@ -481,10 +466,10 @@ static int b_slice(interp *I, value *a, int n, value *out)
 static const bparam p_path[] = {{"path", "str", NULL}};
 static const bparam p_load_volume[] = {{"path", "str", NULL}, {"grid", "str", "nil"}};
 static const bparam p_mesh[] = {{"mesh", "mesh", NULL}};
-static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str", "\"z\""}, {"index", "int", "nil"},
+static const bparam p_slice[] = {{"volume", "volume", NULL}, {"axis", "str{x,y,z}", "\"z\""}, {"index", "int", "nil"},
                                  {"palette", "list", "nil"},  {"lo", "num", "nil"},    {"hi", "num", "nil"}};
 
-static const bparam p_orbit[] = {{"azimuth", "num", "30"}, {"elevation", "num", "20"}, {"distance", "num>0", "3"},
+static const bparam p_orbit[] = {{"azimuth", "num", "30"}, {"elevation", "num(-90,90)", "20"}, {"distance", "num>0", "3"},
                                  {"target", "vec3", "[0, 0, 0]"}, {"fov", "num(0,179)", "40"}};
 static const bparam p_look_at[] = {{"eye", "vec3", NULL}, {"target", "vec3", "[0, 0, 0]"}, {"up", "vec3", "[0, 1, 0]"},
                                    {"fov", "num(0,179)", "40"}};

@@ -10,6 +10,7 @@
  * Types: '|'-separated alternatives, each a base name with optional parts:
  *   num int str bool list vec rec func nil any, or an engine class (image, ifs…)
  *   vec3            a list of exactly 3 numbers
+ *   ivec3           a list of exactly 3 whole numbers (ivec: any length)
  *   [lo,hi] (lo,hi) a range ('(' ')' open ends), also >=x >x <=x <x;
  *                   for vec it applies to every item
  *   {8,16}          choices (num/int), {log,linear} (str, with did-you-mean)

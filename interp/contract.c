@@ -22,6 +22,7 @@ typedef struct ckey {
 typedef struct calt {
     int kind;
     int len;                 /* K_VEC: exact length, 0 any */
+    int whole;               /* K_VEC written "ivec": whole-number items */
     int has_lo, has_hi, lo_open, hi_open;
     double lo, hi;
     int inf, nan;            /* non-finite numbers allowed */
@@ -273,8 +274,9 @@ static int tp_alt(tparser *t, calt *a)
     size_t n = (size_t)(t->p - s);
     static const struct { const char *w; int k; } words[] = {
         {"any", K_ANY}, {"num", K_NUM}, {"int", K_INT}, {"str", K_STR}, {"bool", K_BOOL}, {"list", K_LIST},
-        {"vec", K_VEC}, {"rec", K_REC}, {"func", K_FUNC}, {"nil", K_NIL}};
+        {"vec", K_VEC}, {"ivec", K_VEC}, {"rec", K_REC}, {"func", K_FUNC}, {"nil", K_NIL}};
     a->kind = K_CLASS;
+    a->whole = n == 4 && memcmp(s, "ivec", 4) == 0;
     for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
         if (strlen(words[i].w) == n && memcmp(words[i].w, s, n) == 0)
             a->kind = words[i].k;
@@ -692,9 +694,9 @@ static void describe_alt(const calt *a, sbuf *out)
     case K_LIST: sb_printf(out, "a list"); break;
     case K_VEC:
         if (a->len)
-            sb_printf(out, "a list of %d numbers", a->len);
+            sb_printf(out, "a list of %d %s", a->len, a->whole ? "whole numbers" : "numbers");
         else
-            sb_printf(out, "a list of numbers");
+            sb_printf(out, "a list of %s", a->whole ? "whole numbers" : "numbers");
         break;
     case K_REC: sb_printf(out, "a record"); break;
     case K_FUNC: sb_printf(out, "a function"); break;
@@ -829,6 +831,13 @@ static int check_alt(cctx *c, const calt *a, value v, const char *what, cpos at)
             snprintf(w, sizeof w, "%s item %zu", what, i + 1);
             if (check_num(c, a, AS_LIST(v)->items[i].u.n, w, item_pos(at, i)))
                 return -1;
+            double x = AS_LIST(v)->items[i].u.n;
+            if (a->whole && x != floor(x)) {
+                char got[40];
+                fmt_num(x, got, sizeof got);
+                return err_cpos(c->I, item_pos(at, i), ERR_VALUE, "%s: %s must be a whole number, got %s", c->who, w,
+                                got);
+            }
         }
         return 0;
     case K_LIST:

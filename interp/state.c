@@ -6,6 +6,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "fileio.h"
 
@@ -491,6 +492,9 @@ const char *interp_suggest_name(const char *name, const char *const *cands, size
     size_t bestd = 99;
     size_t len = strlen(name);
     size_t maxd = len <= 3 ? 1 : len <= 6 ? 2 : 3;
+    for (size_t i = 0; i < n; i++) /* a candidate differing only in case wins */
+        if (cands[i] && strcmp(cands[i], name) != 0 && strcasecmp(cands[i], name) == 0)
+            return cands[i];
     for (size_t i = 0; i < n; i++) {
         if (!cands[i] || strcmp(cands[i], name) == 0)
             continue;
