@@ -70,11 +70,11 @@ int builtin_arg_error(interp *I, const builtin *b, const char *param, const char
 int builtin_get_vec(interp *I, value v, double *out, size_t n, const char *what)
 {
     if (v.k != V_LIST)
-        return err_at(I, NULL, ERR_TYPE, "%s must be a list of %zu numbers, got %s", what, n,
-                      val_type_name(v));
+        return err_value(I, v, ERR_TYPE, "%s must be a list of %zu numbers, got %s", what, n,
+                         val_type_name(v));
     vlist *l = AS_LIST(v);
     if (n && l->n != n)
-        return err_at(I, NULL, ERR_VALUE, "%s must be a list of %zu numbers, got %zu items", what, n, l->n);
+        return err_value(I, v, ERR_VALUE, "%s must be a list of %zu numbers, got %zu items", what, n, l->n);
     for (size_t i = 0; i < l->n; i++) {
         if (l->items[i].k != V_NUM)
             return err_item(I, v, i, ERR_TYPE, "%s must contain numbers, but item %zu is %s", what, i + 1,

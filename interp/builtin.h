@@ -130,6 +130,10 @@ int err_item(interp *I, value container, size_t index, err_kind k, const char *f
  * several arguments: the caret goes on that argument when it was written
  * at the call, else on the call. */
 int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* An error about the argument whose value is v (a list, record, string or
+ * object passed to the current builtin; the caret lands on it), or at the
+ * call when v is not one of its arguments. */
+int err_value(interp *I, value v, err_kind k, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 /* Check an option record whose keys depend on the value it goes with (save
  * of an image, a mesh…) against a declared type text "rec{…}" (compiled
  * once); nil passes. Errors point at the record's key when it is written at

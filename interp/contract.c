@@ -1074,6 +1074,16 @@ int err_item(interp *I, value container, size_t index, err_kind k, const char *f
     return err_cpos(I, at, k, "%s", msg);
 }
 
+int err_value(interp *I, value v, err_kind k, const char *fmt, ...)
+{
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return err_at(I, arg_node_of(I, v), k, "%s", msg);
+}
+
 int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...)
 {
     char msg[900];
