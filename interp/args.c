@@ -15,7 +15,7 @@ int lang_arg_seed(interp *I, value v, uint64_t *seed, const char *what)
         return 0;
     }
     if (v.k != V_NUM || !(v.u.n >= 0) || v.u.n != floor(v.u.n) || v.u.n > 9007199254740992.0)
-        return err_at(I, NULL, ERR_VALUE, "%s%sseed must be a whole number >= 0, got %g", what ? what : "",
+        return err_value(I, v, ERR_VALUE, "%s%sseed must be a whole number >= 0, got %g", what ? what : "",
                       what ? ": " : "", v.k == V_NUM ? v.u.n : NAN);
     *seed = (uint64_t)v.u.n;
     return 0;
@@ -29,7 +29,7 @@ int lang_arg_size2(interp *I, value v, int *w, int *h, const char *what)
     else if (builtin_get_vec(I, v, s, 2, what))
         return -1;
     if (s[0] != floor(s[0]) || s[1] != floor(s[1]) || s[0] < 1 || s[1] < 1 || s[0] > 1e6 || s[1] > 1e6)
-        return err_at(I, NULL, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
+        return err_value(I, v, ERR_VALUE, "%s must be whole numbers of pixels between 1 and 1000000, got [%g, %g]",
                       what, s[0], s[1]);
     *w = (int)s[0];
     *h = (int)s[1];

@@ -123,7 +123,7 @@ field *lang_to_field(interp *I, value v, const char *what)
             err_at(I, NULL, ERR_MEMORY, "out of memory");
         return f;
     }
-    err_at(I, NULL, ERR_TYPE, "%s must be a field, a number or a volume, got %s", what, val_type_name(v));
+    err_value(I, v, ERR_TYPE, "%s must be a field, a number or a volume, got %s", what, val_type_name(v));
     return NULL;
 }
 

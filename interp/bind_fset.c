@@ -147,7 +147,7 @@ int lang_get_fset(interp *I, value v, int list_is_sets, value *out, const char *
             one = 1;
     }
     if (!one && v.k != V_LIST)
-        return err_at(I, NULL, ERR_TYPE, "%s must be a list of IFSs (ifs values or tables), got %s", what,
+        return err_value(I, v, ERR_TYPE, "%s must be a list of IFSs (ifs values or tables), got %s", what,
                       val_type_name(v));
     int n = one ? 1 : (int)AS_LIST(v)->n;
     if (n < 1)

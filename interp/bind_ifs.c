@@ -166,13 +166,13 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         return 1;
     }
     if (v.k != V_LIST)
-        return err_at(I, NULL, ERR_TYPE, "%s must be a table of map rows, a list of maps or an ifs, got %s", what,
+        return err_value(I, v, ERR_TYPE, "%s must be a table of map rows, a list of maps or an ifs, got %s", what,
                       val_type_name(v));
     vlist *l = AS_LIST(v);
     if (l->n == 0)
-        return err_at(I, NULL, ERR_VALUE, "%s: IFS has no maps", what);
+        return err_value(I, v, ERR_VALUE, "%s: IFS has no maps", what);
     if (l->n > IFS_MAX_MAPS)
-        return err_at(I, NULL, ERR_VALUE, "%s: %zu maps, at most %d", what, l->n, IFS_MAX_MAPS);
+        return err_value(I, v, ERR_VALUE, "%s: %zu maps, at most %d", what, l->n, IFS_MAX_MAPS);
     *maps = mem_alloc(I, sizeof(affine) * l->n);
     *p = mem_alloc(I, sizeof(double) * l->n);
     if (!*maps || !*p) {
@@ -367,7 +367,7 @@ int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what)
     s->ifs = li ? &li->f : NULL;
     s->rifs = as_rifs(v);
     if (!s->ifs && !s->rifs)
-        return err_at(I, NULL, ERR_TYPE, "%s must be an ifs or a rifs, got %s", what, val_type_name(v));
+        return err_value(I, v, ERR_TYPE, "%s must be an ifs or a rifs, got %s", what, val_type_name(v));
     return 0;
 }
 

@@ -44,7 +44,7 @@ static int get_axis(interp *I, value v, double a[3], const char *what)
         return -1;
     double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     if (!(l > 0))
-        return err_at(I, NULL, ERR_VALUE, "%s: the vector (0, 0, 0) has no direction", what);
+        return err_value(I, v, ERR_VALUE, "%s: the vector (0, 0, 0) has no direction", what);
     for (int i = 0; i < 3; i++)
         a[i] /= l;
     return 0;

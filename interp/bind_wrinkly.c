@@ -89,7 +89,7 @@ static int fill_scalar(interp *I, value v, int rows, int cols, wrinkly_point *p,
         if (v.k == V_NUM) {
             x = v.u.n;
         } else if (v.k != V_LIST) {
-            return err_at(I, NULL, ERR_TYPE, "%s: %s must be a number or a %s, got %s", what, name,
+            return err_value(I, v, ERR_TYPE, "%s: %s must be a number or a %s, got %s", what, name,
                           rows ? "grid (list of rows) of numbers" : "list of numbers, one per point", val_type_name(v));
         } else {
             vlist *l = AS_LIST(v);
@@ -109,7 +109,7 @@ static int fill_scalar(interp *I, value v, int rows, int cols, wrinkly_point *p,
                 it = l->items[i];
             }
             if (it.k != V_NUM)
-                return err_at(I, NULL, ERR_TYPE, "%s: %s must contain numbers, found %s", what, name, val_type_name(it));
+                return err_value(I, v, ERR_TYPE, "%s: %s must contain numbers, found %s", what, name, val_type_name(it));
             x = it.u.n; /* declared: finite */
         }
         if (which == 0)
@@ -148,7 +148,7 @@ static int fill_colours(interp *I, value v, int rows, int cols, wrinkly_point *p
         return 0;
     }
     if (v.k != V_LIST)
-        return err_at(I, NULL, ERR_TYPE, "%s must be a colour or a %s of colours, got %s", w,
+        return err_value(I, v, ERR_TYPE, "%s must be a colour or a %s of colours, got %s", w,
                       rows ? "grid" : "list", val_type_name(v));
     vlist *l = AS_LIST(v);
     for (size_t i = 0; i < n; i++) {

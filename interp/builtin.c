@@ -94,13 +94,13 @@ int builtin_get_int(interp *I, value v, long lo, long hi, long *out, const char 
         if (v.k == V_NUM) {
             char got[40];
             val_fmt_number(v.u.n, got, sizeof got);
-            return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what,
+            return err_value(I, v, ERR_TYPE, "%s must be a whole number, got %s", what,
                           isnan(v.u.n) ? "nan" : isinf(v.u.n) ? (v.u.n < 0 ? "-inf" : "inf") : got);
         }
-        return err_at(I, NULL, ERR_TYPE, "%s must be a whole number, got %s", what, val_type_name(v));
+        return err_value(I, v, ERR_TYPE, "%s must be a whole number, got %s", what, val_type_name(v));
     }
     if (v.u.n < (double)lo || v.u.n > (double)hi)
-        return err_at(I, NULL, ERR_VALUE, "%s must be between %ld and %ld, got %.17g", what, lo, hi, v.u.n);
+        return err_value(I, v, ERR_VALUE, "%s must be between %ld and %ld, got %.17g", what, lo, hi, v.u.n);
     *out = (long)v.u.n;
     return 0;
 }

@@ -105,7 +105,7 @@ int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
 {
     if (v.k == V_NUM) {
         if (!isfinite(v.u.n))
-            return err_at(I, NULL, ERR_VALUE, "%s must be a finite number, got %s", what,
+            return err_value(I, v, ERR_VALUE, "%s must be a finite number, got %s", what,
                           isnan(v.u.n) ? "nan" : v.u.n < 0 ? "-inf" : "inf");
         rgba[0] = rgba[1] = rgba[2] = (float)v.u.n;
         rgba[3] = 1;
@@ -127,14 +127,14 @@ int lang_get_colour(interp *I, value v, float rgba[4], const char *what)
             char *end;
             x[i] = (unsigned)strtoul(hex, &end, 16);
             if (*end)
-                return err_at(I, NULL, ERR_VALUE, "%s: \"%s\" is not a colour like \"#ff8800\"", what,
+                return err_value(I, v, ERR_VALUE, "%s: \"%s\" is not a colour like \"#ff8800\"", what,
                               AS_STR(v)->s);
         }
         for (int i = 0; i < 4; i++)
             rgba[i] = (float)x[i] / 255.0f;
         return 0;
     }
-    return err_at(I, NULL, ERR_TYPE,
+    return err_value(I, v, ERR_TYPE,
                   "%s must be a colour: a grey level, [r, g, b], [r, g, b, a] or \"#rrggbb\", got %s", what,
                   val_type_name(v));
 }

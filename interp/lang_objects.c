@@ -17,7 +17,7 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
         return 0;
     }
     if (v.k != V_LIST || AS_LIST(v)->n < 1 || AS_LIST(v)->n > RAMP_MAX_STOPS)
-        return err_at(I, NULL, ERR_TYPE,
+        return err_value(I, v, ERR_TYPE,
                       "%s must be a palette: a list of 1 to %d colours [r, g, b], or rows [t, r, g, b]",
                       what, RAMP_MAX_STOPS);
     vlist *l = AS_LIST(v);
@@ -38,13 +38,13 @@ int lang_get_ramp(interp *I, value v, ramp *out, const char *what)
             if (k == 4)
                 c[4] = 1;
         } else {
-            return err_at(I, NULL, ERR_VALUE,
-                          "%s: stop %zu must be [r, g, b] or [t, r, g, b] or [t, r, g, b, a], got %s", what, i,
-                          it.k == V_LIST ? "a list of another length" : val_type_name(it));
+            return err_item(I, v, i, ERR_VALUE,
+                            "%s: stop %zu must be [r, g, b] or [t, r, g, b] or [t, r, g, b, a], got %s", what, i + 1,
+                            it.k == V_LIST ? "a list of another length" : val_type_name(it));
         }
         if (c[0] < prev)
-            return err_at(I, NULL, ERR_VALUE, "%s: stop positions must not decrease (stop %zu at %g after %g)",
-                          what, i, c[0], prev);
+            return err_item(I, v, i, ERR_VALUE, "%s: stop positions must not decrease (stop %zu at %g after %g)",
+                            what, i + 1, c[0], prev);
         prev = c[0];
         out->pos[i] = c[0];
         for (int j = 0; j < 4; j++)
