@@ -201,9 +201,8 @@ const obj_class lang_volume_class = {
     .save = volume_save,
 };
 
-int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3], volume **out)
+static int volume_checks(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3])
 {
-    *out = NULL;
     double voxels = (double)nx * ny * nz;
     if (nx < 1 || ny < 1 || nz < 1)
         return err_at(I, NULL, ERR_VALUE, "volume size %d×%d×%d must be at least 1 on each axis", nx, ny, nz);
@@ -214,8 +213,14 @@ int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const
     for (int i = 0; i < 3; i++)
         if (!(hi[i] > lo[i]) || !isfinite(lo[i]) || !isfinite(hi[i]))
             return err_at(I, NULL, ERR_VALUE, "volume bounds must have lo < hi on every axis");
-    double bytes = voxels * sizeof(float);
-    if (mem_precheck(I, bytes, "the volume"))
+    return 0;
+}
+
+int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const double hi[3], volume **out)
+{
+    *out = NULL;
+    if (volume_checks(I, nx, ny, nz, lo, hi) ||
+        mem_precheck(I, (double)nx * ny * nz * sizeof(float), "the volume"))
         return -1;
     vol_payload *vp = mem_calloc(I, 1, sizeof *vp);
     rt_error e;
@@ -225,6 +230,23 @@ int lang_volume_new(interp *I, int nx, int ny, int nz, const double lo[3], const
     }
     *out = &vp->v;
     return 0;
+}
+
+/* A volume value that takes over tmp's samples (a loader's result: no
+ * second copy); tmp is emptied either way. */
+static int volume_adopt(interp *I, volume *tmp, value *out)
+{
+    vol_payload *vp = NULL;
+    if (!volume_checks(I, tmp->nx, tmp->ny, tmp->nz, tmp->lo, tmp->hi) && !(vp = mem_calloc(I, 1, sizeof *vp)) &&
+        !I->err.active)
+        err_at(I, NULL, ERR_MEMORY, "out of memory");
+    if (!vp) {
+        volume_free(tmp);
+        return -1;
+    }
+    vp->v = *tmp;
+    tmp->v = NULL;
+    return lang_volume_value(I, &vp->v, out);
 }
 
 int lang_volume_value(interp *I, volume *v, value *out)
@@ -328,13 +350,8 @@ static int load_vdb(interp *I, const char *path, value grid, value *out)
     value l = ch == 3 ? val_list(I, 3) : val_nil();
     int rc = ch == 3 && l.k == V_NIL ? -1 : 0;
     for (int i = 0; i < ch && !rc; i++) {
-        volume *v;
         value x;
-        rc = lang_volume_new(I, tmp[i].nx, tmp[i].ny, tmp[i].nz, tmp[i].lo, tmp[i].hi, &v);
-        if (!rc) {
-            memcpy(v->v, tmp[i].v, (size_t)tmp[i].nx * tmp[i].ny * tmp[i].nz * sizeof(float));
-            rc = lang_volume_value(I, v, ch == 3 ? &x : out) || (ch == 3 && val_list_push(I, AS_LIST(l), x));
-        }
+        rc = volume_adopt(I, &tmp[i], ch == 3 ? &x : out) || (ch == 3 && val_list_push(I, AS_LIST(l), x));
     }
     for (int i = 0; i < ch; i++)
         volume_free(&tmp[i]);
@@ -363,14 +380,7 @@ static int b_load_volume(interp *I, value *a, int n, value *out)
     rt_code c = strcmp(ext, "vtk") == 0 ? vio_load_vtk(path, &tmp, &e) : vio_load_nrrd(path, &tmp, &e);
     if (c)
         return lang_rt_error(I, c, &e, "load_volume");
-    volume *v;
-    if (lang_volume_new(I, tmp.nx, tmp.ny, tmp.nz, tmp.lo, tmp.hi, &v)) {
-        volume_free(&tmp);
-        return -1;
-    }
-    memcpy(v->v, tmp.v, (size_t)tmp.nx * tmp.ny * tmp.nz * sizeof(float));
-    volume_free(&tmp);
-    return lang_volume_value(I, v, out);
+    return volume_adopt(I, &tmp, out);
 }
 
 static int b_load_mesh(interp *I, value *a, int n, value *out)

@@ -334,15 +334,17 @@ static int make_out_dir(const char *dir)
     return 0;
 }
 
-static int read_script(const char *path, unsigned char **text, size_t *len)
+static int read_script(interp *I, const char *path, unsigned char **text, size_t *len)
 {
     rt_error e;
     if (strcmp(path, "-") == 0) {
         size_t cap = 1 << 16, n = 0;
         /* rt_malloc, like fileio_read_all below: the same hook as mem_alloc */
         unsigned char *buf = rt_malloc(cap + 1);
-        if (!buf)
-            return EX_SOFTWARE;
+        if (!buf) {
+            mem_engine_error(I, "reading the script from standard input", "out of memory");
+            return session_report(I);
+        }
         size_t r;
         while ((r = fread(buf + n, 1, cap - n, stdin)) > 0) {
             n += r;
@@ -355,7 +357,8 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
                 unsigned char *nb = rt_realloc(buf, cap * 2 + 1);
                 if (!nb) {
                     rt_free(buf);
-                    return EX_SOFTWARE;
+                    mem_engine_error(I, "reading the script from standard input", "out of memory");
+                    return session_report(I);
                 }
                 buf = nb;
                 cap *= 2;
@@ -367,9 +370,15 @@ static int read_script(const char *path, unsigned char **text, size_t *len)
         return 0;
     }
     rt_code c = fileio_read_all(path, 64u << 20, text, len, &e);
+    if (c == RT_ENOMEM) { /* the buffer goes through the allocation hook: say why it refused */
+        char what[80];
+        snprintf(what, sizeof what, "reading '%.60s%s'", path, strlen(path) > 60 ? "…" : "");
+        mem_engine_error(I, what, "out of memory");
+        return session_report(I);
+    }
     if (c) {
         fprintf(stderr, "frac: error: %s\n", e.msg);
-        return c == RT_ENOMEM ? EX_SOFTWARE : EX_IO; /* the buffer goes through the allocation hook */
+        return EX_IO;
     }
     if (memchr(*text, 0, *len)) {
         fprintf(stderr, "frac: error: '%s' is not a text file (it contains NUL bytes)\n", path);
@@ -542,7 +551,7 @@ static int run_frac(interp *I, opts *o)
     }
     unsigned char *text;
     size_t len;
-    rc = read_script(o->script, &text, &len);
+    rc = read_script(I, o->script, &text, &len);
     if (rc)
         return rc;
     const char *name = strcmp(o->script, "-") == 0 ? "<stdin>" : o->script;

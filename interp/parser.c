@@ -1220,8 +1220,13 @@ int parse_source(interp *I, int src, node **out)
     memset(&p, 0, sizeof p);
     p.I = I;
     *out = NULL;
-    if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl))
-        return err_pos(I, src, I->srcs[src].first_line, 1, ERR_MEMORY, "out of memory while reading the script");
+    if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl)) {
+        /* the token array goes through the hook: say why it was refused (the
+         * memory limit, --fail-alloc or the system), at the script's start */
+        mem_engine_error(I, "reading the script", "out of memory");
+        I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
+        return -1;
+    }
     node *b = parse_block_until(&p, NULL, 0);
     lex_free(&p.tl);
     if (!b || p.failed) {
