@@ -1074,26 +1074,30 @@ int err_item(interp *I, value container, size_t index, err_kind k, const char *f
     return err_cpos(I, at, k, "%s", msg);
 }
 
-int err_value(interp *I, value v, err_kind k, const char *fmt, ...)
+static int err_node_v(interp *I, const node *n, err_kind k, const char *fmt, va_list ap)
 {
     char msg[900];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    return err_at(I, n, k, "%s", msg);
+}
+
+int err_value(interp *I, value v, err_kind k, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    int rc = err_node_v(I, arg_node_of(I, v), k, fmt, ap);
     va_end(ap);
-    return err_at(I, arg_node_of(I, v), k, "%s", msg);
+    return rc;
 }
 
 int err_arg(interp *I, int slot, err_kind k, const char *fmt, ...)
 {
-    char msg[900];
+    const bcall *c = I->bcall;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    int rc = err_node_v(I, c && slot >= 0 && slot < c->n ? c->nodes[slot] : NULL, k, fmt, ap);
     va_end(ap);
-    const bcall *c = I->bcall;
-    const node *n = c && slot >= 0 && slot < c->n ? c->nodes[slot] : NULL;
-    return err_at(I, n, k, "%s", msg);
+    return rc;
 }
 
 int contract_check_opts(interp *I, value opts, const char *type, const char *who)
