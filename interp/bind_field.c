@@ -384,60 +384,29 @@ static int b_turbulence(interp *I, value *a, int n, value *out)
     return noise_common(I, field_turbulence(seed, oct), a[1].u.n, out);
 }
 
-/* DMFs: on numbers they compute, on fields they build nodes. */
-static int b_bias(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    double b = a[1].u.n;
-    rt_error e;
-    if (dmf_check_bias(b, &e))
-        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
-    if (a[0].k == V_NUM) {
-        *out = val_num(dmf_bias(b, a[0].u.n));
-        return 0;
+/* DMFs: on numbers they compute, on fields they build nodes; one line each.
+ * Their parameter ranges are declared (bias b and gain g in (0, 1)). */
+#define DMF_BUILTIN(name, who, on_number, on_field)                                 \
+    static int b_##name(interp *I, value *a, int n, value *out)                    \
+    {                                                                               \
+        (void)n;                                                                    \
+        if (a[0].k == V_NUM) {                                                      \
+            *out = val_num(on_number);                                              \
+            return 0;                                                               \
+        }                                                                           \
+        field *t = lang_to_field(I, a[0], who ": t");                               \
+        return t ? lang_field_value(I, on_field, out) : -1;                         \
     }
-    field *t = lang_to_field(I, a[0], "bias: t");
-    return t ? lang_field_value(I, field_bias(t, b), out) : -1;
-}
-
-static int b_gain(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    double g = a[1].u.n;
-    rt_error e;
-    if (dmf_check_gain(g, &e))
-        return err_at(I, NULL, ERR_VALUE, "%s", e.msg);
-    if (a[0].k == V_NUM) {
-        *out = val_num(dmf_gain(g, a[0].u.n));
-        return 0;
-    }
-    field *t = lang_to_field(I, a[0], "gain: t");
-    return t ? lang_field_value(I, field_gain(t, g), out) : -1;
-}
+DMF_BUILTIN(bias, "bias", dmf_bias(a[1].u.n, a[0].u.n), field_bias(t, a[1].u.n))
+DMF_BUILTIN(gain, "gain", dmf_gain(a[1].u.n, a[0].u.n), field_gain(t, a[1].u.n))
+DMF_BUILTIN(step, "step", dmf_step(a[1].u.n, a[0].u.n), field_step(t, a[1].u.n))
+DMF_BUILTIN(smoothstep_ordered, "smoothstep", dmf_smoothstep(a[1].u.n, a[2].u.n, a[0].u.n), field_smoothstep(t, a[1].u.n, a[2].u.n))
 
 static int b_smoothstep(interp *I, value *a, int n, value *out)
 {
-    (void)n;
-    double e0 = a[1].u.n, e1 = a[2].u.n;
-    if (!(e1 > e0))
-        return err_arg(I, 2, ERR_VALUE, "smoothstep: needs e0 < e1, got %g and %g", e0, e1);
-    if (a[0].k == V_NUM) {
-        *out = val_num(dmf_smoothstep(e0, e1, a[0].u.n));
-        return 0;
-    }
-    field *t = lang_to_field(I, a[0], "smoothstep: t");
-    return t ? lang_field_value(I, field_smoothstep(t, e0, e1), out) : -1;
-}
-
-static int b_step(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    if (a[0].k == V_NUM) {
-        *out = val_num(dmf_step(a[1].u.n, a[0].u.n));
-        return 0;
-    }
-    field *t = lang_to_field(I, a[0], "step: t");
-    return t ? lang_field_value(I, field_step(t, a[1].u.n), out) : -1;
+    if (!(a[2].u.n > a[1].u.n))
+        return err_arg(I, 2, ERR_VALUE, "smoothstep: needs e0 < e1, got %g and %g", a[1].u.n, a[2].u.n);
+    return b_smoothstep_ordered(I, a, n, out);
 }
 
 static int b_select(interp *I, value *a, int n, value *out)
