@@ -358,35 +358,57 @@ static int binop_prec(parser *p, const token *t, int *right)
     return -1;
 }
 
-/* args -> '(' [arg {',' arg}] ')' ; arg -> [NAME ':'] expr */
-static int parse_args(parser *p, nodevec *args)
+/* One comma-separated list, the shape every bracketed construct shares:
+ *   list -> [item {',' item} [',']] CLOSE
+ * (the opener is consumed by the caller). Inside it newlines are white space
+ * and table rows are off; item parses one entry and returns 0 to go on, or
+ * non-zero to stop (after an error, or when the list ends early: a
+ * comprehension). */
+typedef int (*list_item)(parser *p, void *ctx);
+
+static int parse_comma_list(parser *p, const token *open, tok_type close, list_item item, void *ctx)
 {
-    token *open = next(p); /* '(' */
     int save_nl = p->skip_nl, save_tm = p->table_mode;
     p->skip_nl = 1;
     p->table_mode = 0;
-    int named_seen = 0;
-    while (!check(p, T_RPAREN) && !check(p, T_EOF)) {
-        const char *name = NULL;
-        if (check(p, T_IDENT) && peek2(p)->type == T_COLON) {
-            name = tok_name(p, next(p));
-            next(p);
-            named_seen = 1;
-        } else if (named_seen) {
-            syntax_error(p, peek(p), "%s", "positional argument after a named argument");
+    while (!check(p, close) && !check(p, T_EOF))
+        if (item(p, ctx) || p->failed || !match(p, T_COMMA))
             break;
-        }
-        node *a = parse_expr(p);
-        if (!a || nv_push(p, args, a, name))
-            break;
-        if (!match(p, T_COMMA))
-            break;
-    }
     if (!p->failed)
-        expect_close(p, T_RPAREN, open);
+        expect_close(p, close, open);
     p->skip_nl = save_nl;
     p->table_mode = save_tm;
     return p->failed ? -1 : 0;
+}
+
+/* arg -> [NAME ':'] expr   (no positional argument after a named one) */
+typedef struct args_ctx {
+    nodevec *args;
+    int named_seen;
+} args_ctx;
+
+static int parse_arg(parser *p, void *ctx)
+{
+    args_ctx *c = ctx;
+    const char *name = NULL;
+    if (check(p, T_IDENT) && peek2(p)->type == T_COLON) {
+        name = tok_name(p, next(p));
+        next(p);
+        c->named_seen = 1;
+    } else if (c->named_seen) {
+        syntax_error(p, peek(p), "%s", "positional argument after a named argument");
+        return -1;
+    }
+    node *a = parse_expr(p);
+    return !a || nv_push(p, c->args, a, name) ? -1 : 0;
+}
+
+/* args -> '(' [arg {',' arg}] ')' */
+static int parse_args(parser *p, nodevec *args)
+{
+    token *open = next(p); /* '(' */
+    args_ctx c = {args, 0};
+    return parse_comma_list(p, open, T_RPAREN, parse_arg, &c);
 }
 
 static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
@@ -475,47 +497,41 @@ static node *parse_postfix(parser *p, node *e)
 }
 
 /* params -> '(' [NAME ['=' expr] {',' NAME ['=' expr]}] ')' */
+/* param -> NAME ['=' expr]   (unique names; no default-less one after a default) */
+static int parse_param(parser *p, void *ctx)
+{
+    nodevec *params = ctx;
+    token *t = peek(p);
+    if (t->type != T_IDENT) {
+        char buf[64];
+        syntax_error(p, t, "expected a parameter name, found %s", tok_desc(t, buf, sizeof buf));
+        return -1;
+    }
+    next(p);
+    const char *name = tok_name(p, t);
+    for (int i = 0; i < params->n; i++)
+        if (params->names[i] == name) {
+            syntax_error(p, t, "duplicate parameter '%s'", name);
+            return -1;
+        }
+    node *def = NULL;
+    if (match(p, T_ASSIGN)) {
+        if (!(def = parse_expr(p)))
+            return -1;
+    } else if (params->n && params->v[params->n - 1]) {
+        syntax_error(p, t, "parameter '%s' without a default follows one with a default", name);
+        return -1;
+    }
+    return nv_push(p, params, def, name) ? -1 : 0;
+}
+
+/* params -> '(' [param {',' param}] ')' */
 static int parse_params(parser *p, nodevec *params)
 {
     token *open = peek(p);
     if (expect(p, T_LPAREN, "to start the parameter list"))
         return -1;
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 1;
-    p->table_mode = 0;
-    while (!check(p, T_RPAREN)) {
-        token *t = peek(p);
-        if (t->type != T_IDENT) {
-            char buf[64];
-            syntax_error(p, t, "expected a parameter name, found %s", tok_desc(t, buf, sizeof buf));
-            break;
-        }
-        next(p);
-        const char *name = tok_name(p, t);
-        for (int i = 0; i < params->n; i++)
-            if (params->names[i] == name) {
-                syntax_error(p, t, "duplicate parameter '%s'", name);
-                break;
-            }
-        node *def = NULL;
-        if (match(p, T_ASSIGN)) {
-            def = parse_expr(p);
-            if (!def)
-                break;
-        } else if (params->n && params->v[params->n - 1]) {
-            syntax_error(p, t, "parameter '%s' without a default follows one with a default", name);
-            break;
-        }
-        if (p->failed || nv_push(p, params, def, name))
-            break;
-        if (!match(p, T_COMMA))
-            break;
-    }
-    if (!p->failed)
-        expect_close(p, T_RPAREN, open);
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
-    return p->failed ? -1 : 0;
+    return parse_comma_list(p, open, T_RPAREN, parse_param, params);
 }
 
 static node *make_lambda(parser *p, const token *at, nodevec *params, node *body, const char *name)
@@ -585,6 +601,36 @@ static int is_paren_lambda(parser *p)
     return p->tl.toks[i].type == T_ARROW;
 }
 
+/* field -> (NAME | STRING) ':' expr   (unique keys) */
+static int parse_field(parser *p, void *ctx)
+{
+    nodevec *fields = ctx;
+    token *k = peek(p);
+    const char *key;
+    if (k->type == T_IDENT) {
+        key = tok_name(p, k);
+    } else if (k->type == T_STRING) {
+        node *s = string_node(p, k);
+        key = s ? interp_intern(p->I, s->str, s->slen) : NULL;
+    } else {
+        char buf[64];
+        syntax_error(p, k, "expected a field name in record, found %s", tok_desc(k, buf, sizeof buf));
+        return -1;
+    }
+    next(p);
+    if (expect(p, T_COLON, "after the field name"))
+        return -1;
+    node *v = parse_expr(p);
+    if (!v)
+        return -1;
+    for (int j = 0; j < fields->n; j++)
+        if (fields->names[j] == key) {
+            syntax_error(p, k, "duplicate field '%s' in record", key);
+            return -1;
+        }
+    return nv_push(p, fields, v, key) ? -1 : 0;
+}
+
 /* brace -> '{' '}' | '{' NAME ':' expr {',' NAME ':' expr} '}' | '{' rows '}' */
 static node *parse_brace(parser *p)
 {
@@ -600,40 +646,9 @@ static node *parse_brace(parser *p)
                     (first == T_STRING && p->tl.toks[i + 1].type == T_COLON);
     node *n;
     if (is_record) {
-        p->skip_nl = 1;
         n = mk(p, N_RECORD, open);
         nodevec fields = {0};
-        while (n && !check(p, T_RBRACE)) {
-            token *k = peek(p);
-            const char *key;
-            if (k->type == T_IDENT) {
-                key = tok_name(p, k);
-            } else if (k->type == T_STRING) {
-                node *s = string_node(p, k);
-                key = s ? interp_intern(p->I, s->str, s->slen) : NULL;
-            } else {
-                char buf[64];
-                syntax_error(p, k, "expected a field name in record, found %s", tok_desc(k, buf, sizeof buf));
-                break;
-            }
-            next(p);
-            if (expect(p, T_COLON, "after the field name"))
-                break;
-            node *v = parse_expr(p);
-            if (!v)
-                break;
-            for (int j = 0; j < fields.n; j++)
-                if (fields.names[j] == key) {
-                    syntax_error(p, k, "duplicate field '%s' in record", key);
-                    break;
-                }
-            if (p->failed || nv_push(p, &fields, v, key))
-                break;
-            if (!match(p, T_COMMA))
-                break;
-        }
-        if (n && !p->failed) {
-            expect_close(p, T_RBRACE, open);
+        if (n && !parse_comma_list(p, open, T_RBRACE, parse_field, &fields)) {
             n->kids = fields.v;
             n->names = fields.names;
             n->nkids = fields.n;
@@ -678,64 +693,59 @@ static node *parse_brace(parser *p)
     return p->failed ? NULL : n;
 }
 
+/* item -> expr, or for the first item: expr 'for' NAME 'in' expr ['if' expr]
+ * (a comprehension, which ends the list) */
+typedef struct list_ctx {
+    node *n;
+    nodevec items;
+} list_ctx;
+
+static int parse_list_item(parser *p, void *ctx)
+{
+    list_ctx *c = ctx;
+    node *e = parse_expr(p);
+    if (!e)
+        return -1;
+    if (c->items.n || !check(p, T_FOR))
+        return nv_push(p, &c->items, e, NULL) ? -1 : 0;
+    next(p);
+    token *var = peek(p);
+    if (var->type != T_IDENT) {
+        char buf[64];
+        syntax_error(p, var, "expected a variable name after 'for', found %s", tok_desc(var, buf, sizeof buf));
+        return -1;
+    }
+    next(p);
+    if (expect(p, T_IN, "after the loop variable"))
+        return -1;
+    node *it = parse_expr(p);
+    node *cond = NULL;
+    if (!it || (match(p, T_IF) && !(cond = parse_expr(p))))
+        return -1;
+    node *n = c->n;
+    n->kind = N_COMP;
+    n->str = tok_name(p, var);
+    n->nkids = 3;
+    if (!(n->kids = mem_arena_alloc(p->I, 3 * sizeof(node *))))
+        return -1;
+    n->kids[0] = e;
+    n->kids[1] = it;
+    n->kids[2] = cond;
+    return 1;
+}
+
 /* list -> '[' ']' | '[' expr {',' expr} [','] ']' | '[' expr 'for' NAME 'in' expr ['if' expr] ']' */
 static node *parse_list(parser *p)
 {
     token *open = next(p);
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 1;
-    p->table_mode = 0;
-    node *n = mk(p, N_LIST, open);
-    nodevec items = {0};
-    while (n && !check(p, T_RBRACKET) && !check(p, T_EOF)) {
-        node *e = parse_expr(p);
-        if (!e)
-            break;
-        if (items.n == 0 && check(p, T_FOR)) {
-            /* comprehension */
-            next(p);
-            token *var = peek(p);
-            if (var->type != T_IDENT) {
-                char buf[64];
-                syntax_error(p, var, "expected a variable name after 'for', found %s",
-                             tok_desc(var, buf, sizeof buf));
-                break;
-            }
-            next(p);
-            if (expect(p, T_IN, "after the loop variable"))
-                break;
-            node *it = parse_expr(p);
-            if (!it)
-                break;
-            node *cond = NULL;
-            if (match(p, T_IF) && !(cond = parse_expr(p)))
-                break;
-            n->kind = N_COMP;
-            n->str = tok_name(p, var);
-            n->nkids = 3;
-            n->kids = mem_arena_alloc(p->I, 3 * sizeof(node *));
-            if (!n->kids)
-                break;
-            n->kids[0] = e;
-            n->kids[1] = it;
-            n->kids[2] = cond;
-            break;
-        }
-        if (nv_push(p, &items, e, NULL))
-            break;
-        if (!match(p, T_COMMA))
-            break;
+    list_ctx c = {mk(p, N_LIST, open), {0}};
+    if (!c.n || parse_comma_list(p, open, T_RBRACKET, parse_list_item, &c))
+        return NULL;
+    if (c.n->kind == N_LIST) {
+        c.n->kids = c.items.v;
+        c.n->nkids = c.items.n;
     }
-    if (!p->failed && n) {
-        expect_close(p, T_RBRACKET, open);
-        if (n->kind == N_LIST) {
-            n->kids = items.v;
-            n->nkids = items.n;
-        }
-    }
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
-    return p->failed ? NULL : n;
+    return c.n;
 }
 
 /* if -> 'if' expr 'then' expr {'elif' expr 'then' expr} ['else' expr]
