@@ -458,3 +458,98 @@ done:
     rt_free(c.cum);
     return code;
 }
+
+/* ---- deterministic iteration of a mesh ------------------------------------ */
+
+#define MESH_COPY_CHUNK 4096 /* copies per parallel chunk */
+
+typedef struct mesh_iter_ctx {
+    const mesh *k0;
+    const affine *comp; /* one composed map per copy */
+    size_t copies;
+    mesh *out;
+} mesh_iter_ctx;
+
+static void mesh_iter_chunk(void *p, size_t chunk, int worker)
+{
+    (void)worker;
+    mesh_iter_ctx *c = p;
+    const mesh *k = c->k0;
+    size_t lo = chunk * MESH_COPY_CHUNK, hi = lo + MESH_COPY_CHUNK < c->copies ? lo + MESH_COPY_CHUNK : c->copies;
+    for (size_t cp = lo; cp < hi; cp++) {
+        const affine *a = &c->comp[cp];
+        size_t vb = cp * k->nv, tb = cp * k->nt;
+        for (size_t i = 0; i < k->nv; i++) {
+            double in[3] = {k->pos[3 * i], k->pos[3 * i + 1], k->pos[3 * i + 2]}, r[3];
+            affine_apply(a, in, r);
+            for (int d = 0; d < 3; d++)
+                c->out->pos[3 * (vb + i) + (size_t)d] = (float)r[d];
+            if (k->col)
+                memcpy(c->out->col + 4 * (vb + i), k->col + 4 * i, 4 * sizeof(float));
+        }
+        int flip = affine_det(a) < 0;
+        for (size_t t = 0; t < k->nt; t++) {
+            const uint32_t *s = k->tri + 3 * t;
+            uint32_t *d = c->out->tri + 3 * (tb + t);
+            d[0] = (uint32_t)vb + s[0];
+            d[1] = (uint32_t)vb + (flip ? s[2] : s[1]);
+            d[2] = (uint32_t)vb + (flip ? s[1] : s[2]);
+        }
+    }
+}
+
+rt_code fset_iterate_mesh(const fset *fs, const fset_order *o, size_t steps, size_t copies, const mesh *k0,
+                          mesh *out, const rt_run *run, rt_error *e)
+{
+    memset(out, 0, sizeof *out);
+    size_t nv = rt_mul_size(k0->nv, copies), nt = rt_mul_size(k0->nt, copies);
+    if ((k0->nv && !nv) || (k0->nt && !nt) || nv >= UINT32_MAX)
+        return rt_fail(e, RT_EINVAL, "K_%zu would have %zu copies of %zu vertices, more than 32-bit indices hold",
+                       steps, copies, k0->nv);
+    affine *cur = rt_mallocn(copies ? copies : 1, sizeof *cur), *nx = rt_mallocn(copies ? copies : 1, sizeof *nx);
+    rt_code code = RT_OK;
+    if (!cur || !nx) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory composing %zu maps", copies);
+        goto done;
+    }
+    cur[0] = affine_identity(3);
+    size_t n = 1;
+    for (size_t k = 0; k < steps; k++) {
+        const fset_ifs *w = &fs->sets[fset_order_at(o, fs->n, k)];
+        if (n * (size_t)w->n > copies) {
+            code = rt_fail(e, RT_EINVAL, "iterate: the copy count does not match the order");
+            goto done;
+        }
+        for (int j = 0; j < w->n; j++)
+            for (size_t r = 0; r < n; r++)
+                nx[(size_t)j * n + r] = affine_compose(&w->maps[j], &cur[r]);
+        n *= (size_t)w->n;
+        affine *t = cur;
+        cur = nx;
+        nx = t;
+    }
+    if (n != copies) {
+        code = rt_fail(e, RT_EINVAL, "iterate: the copy count does not match the order");
+        goto done;
+    }
+    out->pos = rt_mallocn(nv ? nv : 1, 3 * sizeof(float));
+    out->tri = rt_mallocn(nt ? nt : 1, 3 * sizeof(uint32_t));
+    out->col = k0->col ? rt_mallocn(nv ? nv : 1, 4 * sizeof(float)) : NULL;
+    if (!out->pos || !out->tri || (k0->col && !out->col)) {
+        mesh_free(out);
+        code = rt_fail(e, RT_ENOMEM, "out of memory for K_%zu (%zu vertices, %zu triangles)", steps, nv, nt);
+        goto done;
+    }
+    out->nv = out->cap_v = nv;
+    out->nt = out->cap_t = nt;
+    mesh_iter_ctx c = {k0, cur, copies, out};
+    code = par_for(run, "iterate", (copies + MESH_COPY_CHUNK - 1) / MESH_COPY_CHUNK, mesh_iter_chunk, &c);
+    if (code) {
+        mesh_free(out);
+        rt_fail(e, code, "interrupted");
+    }
+done:
+    rt_free(cur);
+    rt_free(nx);
+    return code;
+}

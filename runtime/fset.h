@@ -57,6 +57,7 @@
 
 #include "affine.h"
 #include "hist.h"
+#include "mesh.h"
 #include "rt.h"
 
 #define FSET_MAX_MAPS 256 /* maps per IFS */
@@ -147,5 +148,24 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
 /* Bin of a plane point in a histogram (hist.h conventions), or -1 if it
  * falls outside (or is NaN). */
 long fset_hist_bin(const hist2 *hs, double x, double y);
+
+/* ---- deterministic iteration of a triangle mesh (seed 003 §3-4) ----------
+ * The 3-D counterpart of detiter (detiter.h): one step with an IFS
+ * W = {ω_1 .. ω_M} replaces the mesh K by ω_1(K) ∪ … ∪ ω_M(K), laid out
+ * map-major (every vertex and triangle of K under ω_1 first, then under ω_2,
+ * …); step k uses W_σ(k) of the order. `copies` is M_σ(0)·…·M_σ(steps-1)
+ * (detiter_count with one vertex gives it), so K_n has |V(K0)|·copies
+ * vertices and |T(K0)|·copies triangles. Copy c is K0 under the composition
+ * of its maps, composed once per copy in double, so every vertex is one
+ * affine evaluation of a K0 vertex (not n rounded steps). A copy whose
+ * composed linear part has det < 0 (it mirrors) has its triangles' winding
+ * reversed: a K0 wound counter-clockwise seen from outside stays so, and a
+ * closed K0 of volume v gives closed pieces of volume |det|·v each. Vertex
+ * colours are carried along; normals are not (out has none; renderers then
+ * use face normals). 2-D maps act on x, y and keep z. Fails with RT_EINVAL
+ * when K_n would have 2^32 - 1 vertices or more (32-bit indices). Pure
+ * per-copy work in parallel chunks: the same result for any thread count. */
+rt_code fset_iterate_mesh(const fset *fs, const fset_order *o, size_t steps, size_t copies, const mesh *k0,
+                          mesh *out, const rt_run *run, rt_error *e);
 
 #endif
