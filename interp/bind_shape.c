@@ -727,7 +727,7 @@ static const builtin shape_builtins[] = {
     BUILTIN("polyhedron", b_polyhedron, p_polyhedron,
             "A polyhedron (a 3-D initial set K0) from vertices [[x, y, z], …] and faces [[i, j, k, …], …] (0-based vertex numbers, at least 3 per face, fan-triangulated); faces must wind one way, and a closed one wound inside out is reversed so it winds outward."),
     BUILTIN("iterate", b_iterate, p_iterate,
-            "Deterministic iteration K_n = W_σ(n) ∘ … ∘ W_σ(1)(K0) (seed 003 §2-2, §3-2): each step replaces the shape by the union of its images under every map of the set the order names. system: an ifs, a table or an fset; start: a shape (default: the triangle (0,0), (1,0), (1/2, √3/6)); steps: default the length of a sequence order; order: default W1, W2, …, WN repeated. The vertex count is checked against --max-points first."),
+            "Deterministic iteration K_n = W_σ(n) ∘ … ∘ W_σ(1)(K0) (seed 003 §2-2, §3-2): each step replaces the shape by the union of its images under every map of the set the order names. system: an ifs, a table or an fset; start: a shape (default: the triangle (0,0), (1,0), (1/2, √3/6)) or a mesh (a 3-D K0 such as pyramid(): the result is the mesh K_n, each copy wound outward); steps: default the length of a sequence order; order: default W1, W2, …, WN repeated. The vertex count is checked against --max-points first."),
     BUILTIN("draw", b_draw, p_draw,
             "An antialiased image of a shape: strokes of width pixels in colour, points as discs of radius, closed polygons filled if fill is true or a colour; window [xmin, xmax, ymin, ymax] or fitted to the shape; onto: draw over a copy of an image instead of a background."),
 };
