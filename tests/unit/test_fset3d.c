@@ -72,6 +72,7 @@ int main(void)
     CHECK(fset_iterate_mesh(&fs, &o, 3, 27, &cube, &k1, &run1, &e) == RT_OK, "iterate 1 thread");
     CHECK(memcmp(k.pos, k1.pos, k.nv * 3 * sizeof(float)) == 0 && memcmp(k.tri, k1.tri, k.nt * 3 * sizeof(uint32_t)) == 0,
           "same mesh on 1 and 3 threads");
+    mesh_free(&k1);
     /* map-major layout (as detiter): K_3 lists K_2 under ω_1, then under ω_2,
      * …, so the first-applied map varies fastest. Copy 1 is ω_1 ∘ ω_1 ∘ ω_2
      * (x: 1 .. 1.5, then 0.5 .. 0.75, then 0.25 .. 0.375) and copy 9 is
@@ -100,6 +101,15 @@ int main(void)
     for (int i = 0; i < 40 * 30; i++)
         lit += im.px[4 * i] > 0;
     CHECK(lit == 3, "three lit pixels, got %d", lit);
+    /* orbits: the same picture on 1 and 3 threads (per-worker depth buffers
+     * merged by min) */
+    fset_chaos_opts oo = {FSET_ORBIT, 300000, 9, 20, 1, 0, {0, 0, 0}};
+    image im1;
+    CHECK(image_init(&im1, 40, 30, &e) == RT_OK, "image");
+    CHECK(fset_chaos_view(&fs, &o, &oo, &cam, bg, &im, &run3, &e) == RT_OK, "orbit view 3 threads");
+    CHECK(fset_chaos_view(&fs, &o, &oo, &cam, bg, &im1, &run1, &e) == RT_OK, "orbit view 1 thread");
+    CHECK(memcmp(im.px, im1.px, sizeof(float) * 4 * 40 * 30) == 0, "same picture on 1 and 3 threads");
+    image_free(&im1);
     image_free(&im);
 
     /* camera_frame_box: all 8 corners of a box inside the image, within the
