@@ -516,6 +516,40 @@ static rt_code fset_fit(const fset *fs, const fset_order *o, const fset_chaos_op
     return RT_OK;
 }
 
+/* chaos_fset of a 3-D set: the nearest point per pixel through a camera
+ * (default: frame(…) of the game's fitted box) */
+static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, const fset_chaos_opts *co, value camv,
+                           value sizev, value bgv, value *out)
+{
+    int w, h;
+    float bg[4];
+    camera cam;
+    rt_error e;
+    rt_code c;
+    if (lang_arg_size2(I, sizev, &w, &h, "chaos_fset: size") || lang_get_colour(I, bgv, bg, "chaos_fset: background"))
+        return -1;
+    if (camv.k != V_NIL) {
+        if (lang_get_camera(I, camv, &cam, "chaos_fset"))
+            return -1;
+    } else {
+        double lo[3], hi[3];
+        if ((c = fset_chaos_box(&f->fs, o, co, lo, hi, &e)))
+            return lang_rt_error(I, c, &e, "chaos_fset");
+        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
+            return err_at(I, NULL, ERR_VALUE, "chaos_fset: cannot frame the set (its box is not finite)");
+    }
+    image *im;
+    if (lang_image_new(I, w, h, &im))
+        return -1;
+    if (mem_precheck(I, (double)w * h * 8 * (I->threads + 1), "chaos_fset: the depth buffers")) {
+        lang_image_discard(im);
+        return -1;
+    }
+    rt_run run = lang_run(I);
+    c = fset_chaos_view(&f->fs, o, co, &cam, bg, im, &run, &e);
+    return lang_image_finish(I, im, c, &e, "chaos_fset", out);
+}
+
 /* chaos_fset(system, order, points, size, window, mode, depth, burn, start,
  *            palette, curve, gamma, brightness, background, seed) */
 static int b_chaos_fset(interp *I, value *a, int n, value *out)
@@ -537,10 +571,22 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
         goto done;
     if (lang_points_arg(I, a[2], &co.points, "chaos_fset") || lang_arg_size2(I, a[3], &w, &h, "chaos_fset: size") ||
         lang_tone_args(I, a[9], a[10], a[11], a[12], a[13], &t, &r, "chaos_fset") || lang_arg_seed(I, a[14], &co.seed, "chaos_fset") ||
-        builtin_get_vec(I, a[8], co.start, 2, "chaos_fset: start"))
+        builtin_get_vec(I, a[8], co.start, AS_LIST(a[8])->n, "chaos_fset: start"))
         goto done;
-    if (f->dim != 2) {
-        err_arg(I, 0, ERR_VALUE, "chaos_fset: the function set is 3-D; the chaos game draws 2-D sets (use iterate for 3-D shapes)");
+    if (f->dim == 2 && AS_LIST(a[8])->n != 2) {
+        err_arg(I, 8, ERR_VALUE, "chaos_fset: start of a 2-D function set is [x, y]");
+        goto done;
+    }
+    if (f->dim == 2 && a[15].k != V_NIL) {
+        err_arg(I, 15, ERR_VALUE, "chaos_fset: camera applies to a 3-D function set (a 2-D one is drawn in a window)");
+        goto done;
+    }
+    if (f->dim == 3 && a[4].k != V_NIL) {
+        err_arg(I, 4, ERR_VALUE, "chaos_fset: window applies to a 2-D function set (a 3-D one is seen through camera:)");
+        goto done;
+    }
+    if (f->dim == 3 && a[9].k != V_NIL) {
+        err_arg(I, 9, ERR_VALUE, "chaos_fset: palette applies to a 2-D function set (a 3-D one is shaded by depth)");
         goto done;
     }
     if (strcmp(AS_STR(a[5])->s, "orbit") == 0) { /* declared str{orbit,walk} */
@@ -568,6 +614,10 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code c;
     rt_run run = lang_run(I);
+    if (f->dim == 3) {
+        rc = chaos_fset_view(I, f, &o, &co, a[15], a[3], a[13], out);
+        goto done;
+    }
     if (a[4].k != V_NIL) {
         if (lang_window_arg(I, a[4], lo, hi, "chaos_fset: window"))
             goto done;
@@ -617,10 +667,10 @@ static const bparam p_chaos_fset[] = {{"system", "fset|ifs|list", NULL},   {"ord
                                       {"points", "int>=1", "1e6"},          {"size", TY_SIZE, "[512, 512]"},
                                       {"window", "vec4", "nil"},            {"mode", "str{orbit,walk}", "\"orbit\""},
                                       {"depth", "int[1,1000000]", "nil"},   {"burn", "int[0,1000000]", "20"},
-                                      {"start", "vec2", "[0, 0]"},          {"palette", "list", "nil"},
+                                      {"start", "vec2|vec3", "[0, 0]"},     {"palette", "list", "nil"},
                                       {"curve", TY_CURVE, "\"log\""},       {"gamma", "num>0", "2.2"},
                                       {"brightness", "num>0", "1"},         {"background", TY_COLOUR, "[0, 0, 0, 1]"},
-                                      {"seed", "int>=0", "nil"}};
+                                      {"seed", "int>=0", "nil"},            {"camera", TY_CAMERA, "nil"}};
 
 static const builtin fset_builtins[] = {
     BUILTIN("fset", b_fset, p_fset,
@@ -628,7 +678,7 @@ static const builtin fset_builtins[] = {
     BUILTIN("order", b_order, p_order,
             "Which set each step uses: order([1, 2, 1, 2]) lists set numbers in application order (the first is applied first, to K0); order(\"W2 ∘ W1 ∘ W2 ∘ W1\") is the paper's composition notation (rightmost applied first); repeat: true cycles the sequence; order(probabilities: [p1, …], seed:) picks W_n with probability p_n at every step (seed 003 def. 3.2)."),
     BUILTIN("chaos_fset", b_chaos_fset, p_chaos_fset,
-            "The chaos game of a function set with an order, tone-mapped like chaos(…). mode \"orbit\": one long orbit per chunk; with a sequence or periodic order a point is plotted after each full period (the attractor of the composition); with a random order after every step. mode \"walk\": every point is the end of a fresh walk of depth steps from start (a sample of K_depth)."),
+            "The chaos game of a function set with an order, tone-mapped like chaos(…). mode \"orbit\": one long orbit per chunk; with a sequence or periodic order a point is plotted after each full period (the attractor of the composition); with a random order after every step. mode \"walk\": every point is the end of a fresh walk of depth steps from start (a sample of K_depth). A 3-D set is seen through camera (default: framed as frame(…) does), nearest point per pixel shaded by depth, as view(…)."),
 };
 
 int bind_fset_init(interp *I)

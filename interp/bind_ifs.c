@@ -769,7 +769,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     camera cam;
     int w, h;
     ramp r;
-    if (lang_get_sys(I, a[0], &s, "view: system") || lang_get_camera(I, a[1], &cam, "view") ||
+    if (lang_get_sys(I, a[0], &s, "view: system") || (a[1].k != V_NIL && lang_get_camera(I, a[1], &cam, "view")) ||
         lang_arg_size2(I, a[2], &w, &h, "view: size") || points_arg(I, a[3], &o.points, "view") ||
         colour_mode(I, a[4], &o.colour, "view") || lang_get_ramp(I, a[5], &r, "view: palette") ||
         lang_get_colour(I, a[6], o.bg, "view: background") || lang_arg_seed(I, a[7], &o.seed, NULL))
@@ -777,6 +777,15 @@ static int b_view(interp *I, value *a, int n, value *out)
     if (sys_dim(&s) != 3)
         return err_at(I, NULL, ERR_VALUE, "view: the system is 2-D; use chaos(…) to draw it");
     o.ramp = &r;
+    rt_error e;
+    rt_code c;
+    if (a[1].k == V_NIL) { /* the default framing (camera.h) of the fitted box */
+        double lo[3], hi[3];
+        if ((c = chaos_fit(&s, &o, w, h, lo, hi, &e)))
+            return lang_rt_error(I, c, &e, "view");
+        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
+            return err_at(I, NULL, ERR_VALUE, "view: cannot frame the attractor (its box is not finite)");
+    }
     image *im;
     if (lang_image_new(I, w, h, &im))
         return -1;
@@ -787,8 +796,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     }
     rt_run run = lang_run(I);
     chaos_stats st;
-    rt_error e;
-    rt_code c = chaos_project(&s, &o, &cam, im, &st, &run, &e);
+    c = chaos_project(&s, &o, &cam, im, &st, &run, &e);
     return lang_image_finish(I, im, c, &e, "view", out);
 }
 
@@ -840,14 +848,10 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
         return -1;
     if (sys_dim(s) == 3) {
         camera cam;
-        double lo[3], hi[3], ctr[3], rad = 0;
+        double lo[3], hi[3];
         if ((c = chaos_fit(s, &o, 256, 256, lo, hi, &e)))
             goto fail;
-        for (int i = 0; i < 3; i++) {
-            ctr[i] = (lo[i] + hi[i]) / 2;
-            rad += (hi[i] - lo[i]) * (hi[i] - lo[i]) / 4;
-        }
-        camera_orbit(&cam, ctr, 3 * sqrt(rad), 30, 20, 40);
+        camera_frame_box(&cam, lo, hi, 256, 256, 30, 20, 40);
         chaos_stats st;
         o.bg[3] = 1;
         if ((c = chaos_project(s, &o, &cam, im, &st, &run, &e)))
@@ -960,7 +964,7 @@ static const bparam p_measure[] = {{"system", "ifs|rifs", NULL}, {"grid", "ivec[
                                    {"seed", "int>=0", "nil"}};
 static const bparam p_points[] = {{"system", "ifs|rifs", NULL}, {"points", "int>=1", "1e5"}, {"colour", "str{none,density,map,blend}", "nil"},
                                   {"palette", "list", "nil"},    {"seed", "int>=0", "nil"}};
-static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", TY_CAMERA, "orbit()"},
+static const bparam p_view[] = {{"system", "ifs|rifs", NULL}, {"camera", TY_CAMERA, "nil"},
                                 {"size", TY_SIZE, "[512, 512]"}, {"points", "int>=1", "1e6"},
                                 {"colour", "str{none,density,map,blend}", "nil"},          {"palette", "list", "nil"},
                                 {"background", TY_COLOUR, "[0, 0, 0, 1]"}, {"seed", "int>=0", "nil"}};
@@ -979,7 +983,7 @@ static const builtin ifs_builtins[] = {
     BUILTIN("measure", b_measure, p_measure,
             "The invariant measure (seed 001 §5): the fraction of chaos-game points per cell, into a volume (3-D systems; the fractal solid noise) or an image (2-D); normalize \"total\" (measures sum to 1), \"max\" (densest cell 1) or \"count\"."),
     BUILTIN("points", b_points, p_points, "Chaos-game points as a point cloud (a mesh without triangles; save as .ply)."),
-    BUILTIN("view", b_view, p_view, "A 3-D IFS or RIFS seen through a camera: nearest point per pixel, shaded by depth."),
+    BUILTIN("view", b_view, p_view, "A 3-D IFS or RIFS seen through a camera (default: framing the whole attractor, as frame(…) does for its fitted box): nearest point per pixel, shaded by depth."),
     BUILTIN("load_ifs", b_load_ifs, p_load_ifs,
             "The entries of a Fractint .ifs file (2-D and (3D) entries, ; comments) as a record name -> ifs."),
 };

@@ -95,23 +95,14 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
         if (lang_get_camera(I, a[1], &cam, W))
             return -1;
     } else {
-        /* frame the scene: orbit(30, 20) around the centre of its box */
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
+        /* frame the scene's box: the one default framing (camera.h) */
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t i = 0; i < nitems; i++)
             item_box(scene.k == V_LIST ? AS_LIST(scene)->items[i] : scene, lo, hi);
-        double r = 0;
-        for (int d = 0; d < 3; d++) {
+        for (int d = 0; d < 3; d++)
             if (!(hi[d] >= lo[d]))
                 lo[d] = hi[d] = 0;
-            c[d] = 0.5 * (lo[d] + hi[d]);
-            r += 0.25 * (hi[d] - lo[d]) * (hi[d] - lo[d]);
-        }
-        r = sqrt(r);
-        double fov = 40, half = 0.5 * fov * 3.14159265358979323846 / 180;
-        if (w < h)
-            half = atan(tan(half) * w / h);
-        camera_orbit(&cam, c, r > 0 ? 1.05 * r / sin(half) : 1, 30, 20, fov);
-        if (camera_setup(&cam))
+        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
             return err_at(I, NULL, ERR_VALUE, "rasterize: cannot frame the scene");
     }
     /* one mesh to draw: a mesh as given, or the tessellations (LOD from this
@@ -184,6 +175,42 @@ done:
     return rc;
 }
 
+/* ---- the default framing as a camera record ------------------------------------------- */
+
+/* frame(lo, hi, size, azimuth, elevation, fov): the camera every default
+ * view uses (camera_frame_box), as a record {eye, target, up, fov} */
+static int b_frame(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double lo[3], hi[3];
+    int w, h;
+    if (builtin_get_vec(I, a[0], lo, 3, "frame: lo") || builtin_get_vec(I, a[1], hi, 3, "frame: hi") ||
+        lang_arg_size2(I, a[2], &w, &h, "frame: size"))
+        return -1;
+    for (int d = 0; d < 3; d++)
+        if (hi[d] < lo[d])
+            return err_arg(I, 1, ERR_VALUE, "frame: hi must not be below lo, but on axis %c %g < %g", "xyz"[d], hi[d],
+                           lo[d]);
+    camera cam;
+    if (camera_frame_box(&cam, lo, hi, w, h, a[3].u.n, a[4].u.n, a[5].u.n))
+        return err_arg(I, 4, ERR_VALUE, "frame: elevation %g looks straight along the up axis [0, 1, 0]", a[4].u.n);
+    value r = val_rec(I);
+    if (r.k == V_NIL)
+        return -1;
+    const char *keys[3] = {"eye", "target", "up"};
+    const double *vals[3] = {cam.eye, cam.target, cam.up};
+    for (int i = 0; i < 4; i++) {
+        const char *k = interp_intern(I, i < 3 ? keys[i] : "fov", i < 3 ? strlen(keys[i]) : 3);
+        value v = val_num(cam.fov);
+        if (!k || (i < 3 && lang_num_list_value(I, vals[i], 3, &v)) || val_rec_set(I, AS_REC(r), k, v)) {
+            val_unref(I, r);
+            return -1;
+        }
+    }
+    *out = r;
+    return 0;
+}
+
 /* ---- registration ---------------------------------------------------------------------- */
 
 static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
@@ -199,9 +226,18 @@ static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
                                   {"pixel", "num>0", "1"},
                                   {"kmax", TY_LOD_K, "8"}};
 
+static const bparam p_frame[] = {{"lo", "vec3", NULL},
+                                 {"hi", "vec3", NULL},
+                                 {"size", TY_SIZE, "[256, 256]"},
+                                 {"azimuth", "num", "30"},
+                                 {"elevation", "num[-89.9,89.9]", "20"},
+                                 {"fov", "num(0,179)", "40"}};
+
 static const builtin raster_builtins[] = {
     BUILTIN("rasterize", b_rasterize, p_raster,
             "Render a mesh, a wrinkly surface or a list of them with a Z-buffer into an image: camera (default: framing the scene), lights, background; surfaces are tessellated for this camera."),
+    BUILTIN("frame", b_frame, p_frame,
+            "The default camera of view, rasterize and chaos_fset in 3-D for the box [lo, hi] and an image of size: looking at the box's centre from azimuth/elevation (degrees, as orbit) and far enough that the box's bounding sphere plus 5 % fits the field of view. Returns a record {eye, target, up, fov}."),
 };
 
 int bind_raster_init(interp *I)

@@ -267,6 +267,171 @@ static int b_polygon(interp *I, value *a, int n, value *out) { return make_shape
 static int b_polyline(interp *I, value *a, int n, value *out) { return make_shape(I, a, n, DETITER_POLYLINE, "polyline", out); }
 static int b_pointset(interp *I, value *a, int n, value *out) { return make_shape(I, a, n, DETITER_POINTS, "pointset", out); }
 
+/* ---- polyhedra: 3-D initial sets K0 (seed 003 §3-4) ------------------------------------ */
+
+/* A mesh from nv vertices (3 doubles each) and nf polygon faces, face f
+ * being idx[off[f] .. off[f+1]-1] (0-based vertex numbers, already checked),
+ * fan-triangulated, then oriented outward (mesh_orient_outward). */
+static int poly_mesh(interp *I, const double *v, size_t nv, const size_t *off, const uint32_t *idx, size_t nf,
+                     const char *what, value *out)
+{
+    mesh *m = mem_alloc(I, sizeof *m);
+    if (!m)
+        return -1;
+    mesh_init(m, 0, 0);
+    for (size_t i = 0; i < nv; i++) {
+        float p[3] = {(float)v[3 * i], (float)v[3 * i + 1], (float)v[3 * i + 2]};
+        mesh_add_vertex(m, p, NULL, NULL);
+    }
+    for (size_t f = 0; f < nf; f++)
+        for (size_t k = off[f] + 1; k + 1 < off[f + 1]; k++)
+            mesh_add_tri(m, idx[off[f]], idx[k], idx[k + 1]);
+    int closed;
+    rt_error e;
+    rt_code c = m->failed ? RT_ENOMEM : mesh_orient_outward(m, &closed, &e);
+    if (c) {
+        mesh_free(m);
+        mem_free(I, m);
+        return c == RT_ENOMEM ? err_at(I, NULL, ERR_MEMORY, "out of memory") : err_arg(I, 1, ERR_VALUE, "%s: %s", what, e.msg);
+    }
+    return lang_mesh_value(I, m, out);
+}
+
+/* pyramid(): seed 003 Fig. 5's K0, the four-sided pyramid on the five points
+ * the paper lists. Its scan prints them as (0,0,0) (1,0,0) (1/2, ρ, 3/6)
+ * (1/2, ρ, -3/6) (1/2, 3/6, ρ); our reading (ρ a garbled 0, 3/6 a √3/6 that
+ * lost its root, as in the Koch triangle (1/2, √3/6) of the same paper) is a
+ * rhombus base in the plane y = 0 and the apex (1/2, √3/6, 0). It contains
+ * the gasket's four fixed points (Table 4b: twice its translations). */
+static int b_pyramid(interp *I, value *a, int n, value *out)
+{
+    (void)a;
+    (void)n;
+    const double r = sqrt(3.0) / 6;
+    const double v[15] = {0, 0, 0, 1, 0, 0, 0.5, 0, r, 0.5, 0, -r, 0.5, r, 0};
+    /* base 0 3 1 2 (seen from below), sides to the apex 4 */
+    static const uint32_t idx[16] = {0, 3, 1, 2, 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4};
+    static const size_t off[6] = {0, 4, 7, 10, 13, 16};
+    return poly_mesh(I, v, 5, off, idx, 5, "pyramid", out);
+}
+
+/* cube(lo, hi): the box [lo, hi], 8 corners, 6 faces as 12 triangles */
+static int b_cube(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    double lo[3], hi[3];
+    if (builtin_get_vec(I, a[0], lo, 3, "cube: lo") || builtin_get_vec(I, a[1], hi, 3, "cube: hi"))
+        return -1;
+    for (int d = 0; d < 3; d++)
+        if (!(lo[d] < hi[d]))
+            return err_arg(I, 1, ERR_VALUE, "cube: hi must be above lo on every axis, but on axis %c %g <= %g",
+                           "xyz"[d], hi[d], lo[d]);
+    double v[24];
+    for (int i = 0; i < 8; i++) /* corner i: bit 0 x, bit 1 y, bit 2 z */
+        for (int d = 0; d < 3; d++)
+            v[3 * i + d] = (i >> d) & 1 ? hi[d] : lo[d];
+    static const uint32_t idx[24] = {0, 2, 3, 1, 4, 5, 7, 6, 0, 1, 5, 4, 2, 6, 7, 3, 0, 4, 6, 2, 1, 3, 7, 5};
+    static const size_t off[7] = {0, 4, 8, 12, 16, 20, 24};
+    return poly_mesh(I, v, 8, off, idx, 6, "cube", out);
+}
+
+/* polyhedron(vertices, faces): faces are lists of 0-based vertex numbers */
+static int b_polyhedron(interp *I, value *a, int n, value *out)
+{
+    (void)n;
+    const char *W = "polyhedron";
+    vlist *vl = AS_LIST(a[0]), *fl = AS_LIST(a[1]);
+    if (vl->n < 4)
+        return err_arg(I, 0, ERR_VALUE, "%s: needs at least 4 vertices [x, y, z], got %zu", W, vl->n);
+    if (fl->n < 1)
+        return err_arg(I, 1, ERR_VALUE, "%s: needs at least 1 face", W);
+    if ((double)vl->n > I->lim.max_points)
+        return err_arg(I, 0, ERR_LIMIT, "%s: %zu vertices exceed the limit of %.0f (raise it with --max-points)", W,
+                       vl->n, I->lim.max_points);
+    size_t total = 0;
+    for (size_t f = 0; f < fl->n; f++) {
+        value fv = fl->items[f];
+        if (fv.k != V_LIST || AS_LIST(fv)->n < 3)
+            return err_item(I, a[1], f, ERR_VALUE, "%s: face %zu must be a list of at least 3 vertex numbers", W, f);
+        total += AS_LIST(fv)->n;
+    }
+    if ((double)total > I->lim.max_points)
+        return err_arg(I, 1, ERR_LIMIT, "%s: %zu face corners exceed the limit of %.0f (raise it with --max-points)",
+                       W, total, I->lim.max_points);
+    double *v = mem_alloc(I, sizeof(double) * 3 * vl->n);
+    size_t *off = mem_alloc(I, sizeof(size_t) * (fl->n + 1));
+    uint32_t *idx = mem_alloc(I, sizeof(uint32_t) * total);
+    int rc = -1;
+    if (!v || !off || !idx)
+        goto done;
+    for (size_t i = 0; i < vl->n; i++) {
+        value p = vl->items[i];
+        if (p.k != V_LIST || AS_LIST(p)->n != 3) {
+            err_item(I, a[0], i, ERR_VALUE, "%s: vertex %zu must be [x, y, z]", W, i);
+            goto done;
+        }
+        char w[64];
+        snprintf(w, sizeof w, "%s: vertex %zu", W, i);
+        if (builtin_get_vec(I, p, v + 3 * i, 3, w))
+            goto done;
+    }
+    off[0] = 0;
+    for (size_t f = 0; f < fl->n; f++) {
+        vlist *face = AS_LIST(fl->items[f]);
+        off[f + 1] = off[f] + face->n;
+        for (size_t k = 0; k < face->n; k++) {
+            value x = face->items[k];
+            if (x.k != V_NUM || !(x.u.n >= 0 && x.u.n < (double)vl->n) || x.u.n != floor(x.u.n)) {
+                err_item(I, a[1], f, ERR_VALUE, "%s: face %zu: corner %zu must be a vertex number 0 .. %zu, got %s", W,
+                         f, k, vl->n - 1, x.k == V_NUM ? "another number" : val_type_name(x));
+                goto done;
+            }
+            idx[off[f] + k] = (uint32_t)x.u.n;
+            for (size_t j = 0; j < k; j++)
+                if (idx[off[f] + j] == idx[off[f] + k]) {
+                    err_item(I, a[1], f, ERR_VALUE, "%s: face %zu uses vertex %u twice", W, f, idx[off[f] + k]);
+                    goto done;
+                }
+        }
+    }
+    rc = poly_mesh(I, v, vl->n, off, idx, fl->n, W, out);
+done:
+    if (rc && !I->err.active)
+        err_at(I, NULL, ERR_MEMORY, "out of memory");
+    mem_free(I, v);
+    mem_free(I, off);
+    mem_free(I, idx);
+    return rc;
+}
+
+/* iterate of a mesh K0: the mesh K_n (fset_iterate_mesh) */
+static int iterate_mesh(interp *I, const lang_fset *f, const fset_order *o, long steps, const mesh *k0, value *out)
+{
+    size_t copies;
+    rt_error e;
+    rt_code c = detiter_count(&f->fs, o, (size_t)steps, 1, &copies, &e);
+    if (c)
+        return lang_rt_error(I, c, &e, "iterate");
+    double nv = (double)copies * (double)k0->nv, nt = (double)copies * (double)k0->nt;
+    if (nv > I->lim.max_points)
+        return err_at(I, NULL, ERR_LIMIT,
+                      "iterate: K_%ld would have %.0f vertices, more than the limit of %.0f points (raise it with --max-points, or lower steps)",
+                      steps, nv, I->lim.max_points);
+    if (mem_precheck(I, nv * (12 + (k0->col ? 16 : 0)) + nt * 12 + (double)copies * 2 * sizeof(affine),
+                     "iterate: the mesh"))
+        return -1;
+    mesh *m = mem_alloc(I, sizeof *m);
+    if (!m)
+        return -1;
+    rt_run run = lang_run(I);
+    c = fset_iterate_mesh(&f->fs, o, (size_t)steps, copies, k0, m, &run, &e);
+    if (c) {
+        mem_free(I, m);
+        return lang_rt_error(I, c, &e, "iterate");
+    }
+    return lang_mesh_value(I, m, out);
+}
+
 /* iterate(system, start, steps, order) */
 static int b_iterate(interp *I, value *a, int n, value *out)
 {
@@ -306,6 +471,14 @@ static int b_iterate(interp *I, value *a, int n, value *out)
         }
         k0 = &k0def;
         own_k0 = 1;
+    } else if (lang_as_mesh(a[1])) {
+        if (o.kind == FSET_SEQUENCE && steps > o.len) {
+            err_arg(I, 2, ERR_VALUE, "iterate: the order has %d step%s but steps is %ld (use order(…, repeat: true) to cycle)",
+                    o.len, o.len == 1 ? "" : "s", steps);
+            goto done;
+        }
+        rc = iterate_mesh(I, f, &o, steps, lang_as_mesh(a[1]), out);
+        goto done;
     } else {
         k0 = (detiter_shape *)as_shape(a[1]); /* declared shape */
     }
@@ -530,9 +703,12 @@ static int shape_preview(interp *I, const void *p, image **out)
 
 static const bparam p_shape[] = {{"points", "list", "nil"}};
 static const bparam p_iterate[] = {{"system", "ifs|fset|list", NULL},
-                                   {"start", "shape", "nil"},
+                                   {"start", "shape|mesh", "nil"},
                                    {"steps", "int[0,1000000]", "nil"},
                                    {"order", "order", "nil"}};
+static const bparam p_pyramid[] = {{"_unused", "nil", "nil"}};
+static const bparam p_cube[] = {{"lo", "vec3", "[0, 0, 0]"}, {"hi", "vec3", "[1, 1, 1]"}};
+static const bparam p_polyhedron[] = {{"vertices", "list", NULL}, {"faces", "list", NULL}};
 #define TY_FILL "bool|" TY_COLOUR
 static const bparam p_draw[] = {{"shape", "shape", NULL},            {"size", TY_SIZE, "[512, 512]"},
                                 {"window", "vec4", "nil"},           {"colour", TY_COLOUR, "1"},
@@ -545,8 +721,13 @@ static const builtin shape_builtins[] = {
                 "A closed polygon (an initial set K0): polygon([x, y], [x, y], [x, y], …) or polygon(list of points); 2-D or 3-D points."),
     BUILTIN_VAR("polyline", b_polyline, p_shape, "An open polyline (an initial set K0) through the given points."),
     BUILTIN_VAR("pointset", b_pointset, p_shape, "A set of separate points (an initial set K0)."),
+    BUILTIN("pyramid", b_pyramid, p_pyramid,
+            "Seed 003 Fig. 5's initial set K0: the four-sided pyramid on (0,0,0), (1,0,0), (1/2,0,√3/6), (1/2,0,-√3/6) and the apex (1/2,√3/6,0), a closed mesh of 6 triangles wound outward."),
+    BUILTIN("cube", b_cube, p_cube, "The box [lo, hi] as a closed mesh (8 vertices, 12 triangles, wound outward): a 3-D initial set K0."),
+    BUILTIN("polyhedron", b_polyhedron, p_polyhedron,
+            "A polyhedron (a 3-D initial set K0) from vertices [[x, y, z], …] and faces [[i, j, k, …], …] (0-based vertex numbers, at least 3 per face, fan-triangulated); faces must wind one way, and a closed one wound inside out is reversed so it winds outward."),
     BUILTIN("iterate", b_iterate, p_iterate,
-            "Deterministic iteration K_n = W_σ(n) ∘ … ∘ W_σ(1)(K0) (seed 003 §2-2, §3-2): each step replaces the shape by the union of its images under every map of the set the order names. system: an ifs, a table or an fset; start: a shape (default: the triangle (0,0), (1,0), (1/2, √3/6)); steps: default the length of a sequence order; order: default W1, W2, …, WN repeated. The vertex count is checked against --max-points first."),
+            "Deterministic iteration K_n = W_σ(n) ∘ … ∘ W_σ(1)(K0) (seed 003 §2-2, §3-2): each step replaces the shape by the union of its images under every map of the set the order names. system: an ifs, a table or an fset; start: a shape (default: the triangle (0,0), (1,0), (1/2, √3/6)) or a mesh (a 3-D K0 such as pyramid(): the result is the mesh K_n, each copy wound outward); steps: default the length of a sequence order; order: default W1, W2, …, WN repeated. The vertex count is checked against --max-points first."),
     BUILTIN("draw", b_draw, p_draw,
             "An antialiased image of a shape: strokes of width pixels in colour, points as discs of radius, closed polygons filled if fill is true or a colour; window [xmin, xmax, ymin, ymax] or fitted to the shape; onto: draw over a copy of an image instead of a background."),
 };

@@ -282,12 +282,22 @@ static void mesh_summary(const void *p, bytebuf *out)
 static int mesh_get(interp *I, const void *p, const char *name, value *out)
 {
     const mesh *m = p;
-    (void)I;
     if (strcmp(name, "vertices") == 0)
         *out = val_num((double)m->nv);
     else if (strcmp(name, "triangles") == 0)
         *out = val_num((double)m->nt);
-    else
+    else if (strcmp(name, "lo") == 0 || strcmp(name, "hi") == 0) {
+        /* the bounding box corners (nil for an empty mesh) */
+        int hi = name[0] == 'h';
+        double b[3] = {hi ? -INFINITY : INFINITY, hi ? -INFINITY : INFINITY, hi ? -INFINITY : INFINITY};
+        for (size_t i = 0; i < m->nv; i++)
+            for (int d = 0; d < 3; d++)
+                b[d] = hi ? fmax(b[d], m->pos[3 * i + d]) : fmin(b[d], m->pos[3 * i + d]);
+        if (m->nv == 0)
+            *out = val_nil();
+        else
+            return lang_num_list_value(I, b, 3, out);
+    } else
         return 1;
     return 0;
 }

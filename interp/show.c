@@ -32,15 +32,10 @@ static int mesh_preview(interp *I, const mesh *m, image **out)
             lo[k] = v < lo[k] ? v : lo[k];
             hi[k] = v > hi[k] ? v : hi[k];
         }
-    double c[3], r = 0;
-    for (int k = 0; k < 3; k++) {
-        c[k] = m->nv ? (lo[k] + hi[k]) / 2 : 0;
-        double h = m->nv ? (hi[k] - lo[k]) / 2 : 1;
-        r += h * h;
-    }
-    r = sqrt(r) > 0 ? sqrt(r) : 1;
+    if (!m->nv)
+        lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;
     camera cam;
-    camera_orbit(&cam, c, r * 3.0, 30, 20, 40);
+    camera_frame_box(&cam, lo, hi, 256, 256, 30, 20, 40); /* the one default framing */
     image *im;
     if (lang_image_new(I, 256, 256, &im))
         return -1;

@@ -34,4 +34,18 @@ void camera_ray(const camera *c, int w, int h, double sx, double sy, double dir[
  * the camera (z > 1e-9), -1 otherwise. */
 int camera_project(const camera *c, int w, int h, const double p[3], double *sx, double *sy, double *z);
 
+/* The one default framing of every renderer (view, rasterize, chaos_fset in
+ * 3-D, the REPL's previews): an orbit camera (camera_orbit's azimuth az and
+ * elevation el, vertical field of view fov degrees) looking at the centre of
+ * the box [lo, hi], from the distance at which the box's bounding sphere,
+ * widened by 5 %, fits inside both the vertical and the horizontal field of
+ * view of a w × h image: dist = 1.05 r / sin(min(fov_v, fov_h) / 2). Every
+ * point of the box then projects inside the image, at least
+ * 1 − tan(asin(sin(θ)/1.05)) / tan(θ) of the half-width from the border
+ * (θ the smaller half-angle; 5.3 % at θ = 20°). A box of zero size is framed
+ * as a sphere of radius 1 (or 1e-3 of its distance from the origin if
+ * larger). Returns -1 if a corner is not finite, 0 otherwise. */
+int camera_frame_box(camera *c, const double lo[3], const double hi[3], int w, int h, double az, double el,
+                     double fov);
+
 #endif

@@ -458,3 +458,330 @@ done:
     rt_free(c.cum);
     return code;
 }
+
+/* ---- deterministic iteration of a mesh ------------------------------------ */
+
+#define MESH_COPY_CHUNK 4096 /* copies per parallel chunk */
+
+typedef struct mesh_iter_ctx {
+    const mesh *k0;
+    const affine *comp; /* one composed map per copy */
+    size_t copies;
+    mesh *out;
+} mesh_iter_ctx;
+
+static void mesh_iter_chunk(void *p, size_t chunk, int worker)
+{
+    (void)worker;
+    mesh_iter_ctx *c = p;
+    const mesh *k = c->k0;
+    size_t lo = chunk * MESH_COPY_CHUNK, hi = lo + MESH_COPY_CHUNK < c->copies ? lo + MESH_COPY_CHUNK : c->copies;
+    for (size_t cp = lo; cp < hi; cp++) {
+        const affine *a = &c->comp[cp];
+        size_t vb = cp * k->nv, tb = cp * k->nt;
+        for (size_t i = 0; i < k->nv; i++) {
+            double in[3] = {k->pos[3 * i], k->pos[3 * i + 1], k->pos[3 * i + 2]}, r[3];
+            affine_apply(a, in, r);
+            for (int d = 0; d < 3; d++)
+                c->out->pos[3 * (vb + i) + (size_t)d] = (float)r[d];
+            if (k->col)
+                memcpy(c->out->col + 4 * (vb + i), k->col + 4 * i, 4 * sizeof(float));
+        }
+        int flip = affine_det(a) < 0;
+        for (size_t t = 0; t < k->nt; t++) {
+            const uint32_t *s = k->tri + 3 * t;
+            uint32_t *d = c->out->tri + 3 * (tb + t);
+            d[0] = (uint32_t)vb + s[0];
+            d[1] = (uint32_t)vb + (flip ? s[2] : s[1]);
+            d[2] = (uint32_t)vb + (flip ? s[1] : s[2]);
+        }
+    }
+}
+
+rt_code fset_iterate_mesh(const fset *fs, const fset_order *o, size_t steps, size_t copies, const mesh *k0,
+                          mesh *out, const rt_run *run, rt_error *e)
+{
+    memset(out, 0, sizeof *out);
+    size_t nv = rt_mul_size(k0->nv, copies), nt = rt_mul_size(k0->nt, copies);
+    if ((k0->nv && !nv) || (k0->nt && !nt) || nv >= UINT32_MAX)
+        return rt_fail(e, RT_EINVAL, "K_%zu would have %zu copies of %zu vertices, more than 32-bit indices hold",
+                       steps, copies, k0->nv);
+    affine *cur = rt_mallocn(copies ? copies : 1, sizeof *cur), *nx = rt_mallocn(copies ? copies : 1, sizeof *nx);
+    rt_code code = RT_OK;
+    if (!cur || !nx) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory composing %zu maps", copies);
+        goto done;
+    }
+    cur[0] = affine_identity(3);
+    size_t n = 1;
+    for (size_t k = 0; k < steps; k++) {
+        const fset_ifs *w = &fs->sets[fset_order_at(o, fs->n, k)];
+        if (n * (size_t)w->n > copies) {
+            code = rt_fail(e, RT_EINVAL, "iterate: the copy count does not match the order");
+            goto done;
+        }
+        for (int j = 0; j < w->n; j++)
+            for (size_t r = 0; r < n; r++)
+                nx[(size_t)j * n + r] = affine_compose(&w->maps[j], &cur[r]);
+        n *= (size_t)w->n;
+        affine *t = cur;
+        cur = nx;
+        nx = t;
+    }
+    if (n != copies) {
+        code = rt_fail(e, RT_EINVAL, "iterate: the copy count does not match the order");
+        goto done;
+    }
+    out->pos = rt_mallocn(nv ? nv : 1, 3 * sizeof(float));
+    out->tri = rt_mallocn(nt ? nt : 1, 3 * sizeof(uint32_t));
+    out->col = k0->col ? rt_mallocn(nv ? nv : 1, 4 * sizeof(float)) : NULL;
+    if (!out->pos || !out->tri || (k0->col && !out->col)) {
+        mesh_free(out);
+        code = rt_fail(e, RT_ENOMEM, "out of memory for K_%zu (%zu vertices, %zu triangles)", steps, nv, nt);
+        goto done;
+    }
+    out->nv = out->cap_v = nv;
+    out->nt = out->cap_t = nt;
+    mesh_iter_ctx c = {k0, cur, copies, out};
+    code = par_for(run, "iterate", (copies + MESH_COPY_CHUNK - 1) / MESH_COPY_CHUNK, mesh_iter_chunk, &c);
+    if (code) {
+        mesh_free(out);
+        rt_fail(e, code, "interrupted");
+    }
+done:
+    rt_free(cur);
+    rt_free(nx);
+    return code;
+}
+
+/* ---- chaos game in 3-D, seen through a camera ------------------------------- */
+
+typedef struct view_ctx {
+    const fset *fs;
+    const fset_order *o;
+    const fset_chaos_opts *opts;
+    const camera *cam; /* NULL: the box pre-pass, points into pts */
+    int w, h;
+    double *cum;
+    double **zb;  /* per worker depth buffers */
+    double *pts;  /* box pass: 3 per plotted point */
+    int failed;
+} view_ctx;
+
+static void view_plot(view_ctx *c, int worker, uint64_t idx, const double p[3])
+{
+    if (!c->cam) {
+        memcpy(c->pts + 3 * idx, p, 3 * sizeof(double));
+        return;
+    }
+    double sx, sy, z;
+    if (camera_project(c->cam, c->w, c->h, p, &sx, &sy, &z) != 0)
+        return;
+    if (!(sx >= 0 && sx < c->w && sy >= 0 && sy < c->h))
+        return;
+    size_t b = (size_t)(int)sy * (size_t)c->w + (size_t)(int)sx;
+    if (z < c->zb[worker][b])
+        c->zb[worker][b] = z;
+}
+
+static void view_step(const view_ctx *c, uint64_t k, rng *r, double p[3])
+{
+    int s = fset_order_at(c->o, c->fs->n, k);
+    const fset_ifs *w = &c->fs->sets[s];
+    int m = fset_pick(c->cum + (size_t)s * FSET_MAX_MAPS, w->n, rng_uniform(r));
+    double q[3];
+    affine_apply(&w->maps[m], p, q);
+    memcpy(p, q, sizeof q);
+}
+
+static void view_orbit(void *pp, size_t chunk, int worker)
+{
+    view_ctx *c = pp;
+    const fset_chaos_opts *op = c->opts;
+    uint64_t first = (uint64_t)chunk * CHAOS_CHUNK;
+    uint64_t npts = op->points - first < CHAOS_CHUNK ? op->points - first : CHAOS_CHUNK;
+    uint64_t period = (op->plot_period && c->o->kind != FSET_RANDOM) ? (uint64_t)c->o->len : 1;
+    rng r;
+    rng_init(&r, op->seed, chunk);
+    double p[3] = {op->start[0], op->start[1], op->start[2]};
+    uint64_t k = 0;
+    for (; k < op->burn; k++)
+        view_step(c, k, &r, p);
+    while (k % period)
+        view_step(c, k++, &r, p);
+    for (uint64_t done = 0; done < npts;) {
+        view_step(c, k++, &r, p);
+        if (k % period == 0)
+            view_plot(c, worker, first + done++, p);
+    }
+}
+
+static void view_walk(void *pp, size_t chunk, int worker)
+{
+    view_ctx *c = pp;
+    const fset_chaos_opts *op = c->opts;
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
+    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
+    double *pt = rt_malloc(n * 3 * sizeof *pt);
+    if (!pt) {
+        c->failed = 1;
+        return;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(pt + 3 * i, op->start, 3 * sizeof(double));
+    for (uint64_t k = 0; k < op->depth; k++) {
+        int s = fset_order_at(c->o, c->fs->n, k);
+        const fset_ifs *w = &c->fs->sets[s];
+        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
+        rng r;
+        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
+        for (size_t i = 0; i < n; i++) {
+            int m = fset_pick(cum, w->n, rng_uniform(&r));
+            double q[3];
+            affine_apply(&w->maps[m], pt + 3 * i, q);
+            memcpy(pt + 3 * i, q, sizeof q);
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        view_plot(c, worker, first + i, pt + 3 * i);
+    rt_free(pt);
+}
+
+static rt_code view_check(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, rt_error *e)
+{
+    rt_code code = fset_validate(fs, e);
+    if (code || (code = fset_order_validate(o, fs->n, e)))
+        return code;
+    for (int s = 0; s < fs->n; s++)
+        if (fs->sets[s].maps[0].dim != 3)
+            return rt_fail(e, RT_EINVAL, "a 3-D chaos game needs 3-D maps (W%d is %d-D)", s + 1,
+                           fs->sets[s].maps[0].dim);
+    if (opts->mode == FSET_WALK && opts->depth < 1)
+        return rt_fail(e, RT_EINVAL, "chaos game walk depth is 0 (expected at least 1)");
+    return RT_OK;
+}
+
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
+                       rt_error *e)
+{
+    rt_code code = view_check(fs, o, opts, e);
+    if (code)
+        return code;
+    fset_chaos_opts bo = *opts;
+    bo.points = FSET_BOX_POINTS; /* one chunk in either mode */
+    bo.seed = rng_hash3(opts->seed, 1ull << 63, 0, 0);
+    view_ctx c = {fs, o, &bo, NULL, 0, 0, NULL, NULL, NULL, 0};
+    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.pts = rt_malloc(3 * FSET_BOX_POINTS * sizeof *c.pts);
+    double *ax = rt_malloc(FSET_BOX_POINTS * sizeof *ax);
+    if (!c.cum || !c.pts || !ax) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory fitting the view");
+        goto done;
+    }
+    for (int s = 0; s < fs->n; s++)
+        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
+    uint64_t per = bo.mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
+    for (size_t ch = 0; ch * per < FSET_BOX_POINTS; ch++) {
+        if (bo.mode == FSET_WALK)
+            view_walk(&c, ch, 0);
+        else
+            view_orbit(&c, ch, 0);
+    }
+    if (c.failed) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory fitting the view");
+        goto done;
+    }
+    for (int a = 0; a < 3; a++) {
+        for (size_t i = 0; i < FSET_BOX_POINTS; i++)
+            ax[i] = c.pts[3 * i + (size_t)a];
+        qsort(ax, FSET_BOX_POINTS, sizeof *ax, cmp_dbl);
+        size_t cut = FSET_BOX_POINTS / 1000;
+        double l = ax[cut], u = ax[FSET_BOX_POINTS - 1 - cut];
+        if (!isfinite(l) || !isfinite(u)) {
+            code = rt_fail(e, RT_EINVAL, "the chaos game left every bound (a map is not contractive?)");
+            goto done;
+        }
+        lo[a] = l - 0.05 * (u - l);
+        hi[a] = u + 0.05 * (u - l);
+    }
+done:
+    rt_free(c.cum);
+    rt_free(c.pts);
+    rt_free(ax);
+    return code;
+}
+
+rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, const camera *cam,
+                        const float bg[4], image *im, const rt_run *run, rt_error *e)
+{
+    rt_code code = view_check(fs, o, opts, e);
+    if (code)
+        return code;
+    view_ctx c = {fs, o, opts, cam, im->w, im->h, NULL, NULL, NULL, 0};
+    uint64_t per = opts->mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
+    size_t nchunks = (size_t)((opts->points + per - 1) / per);
+    int nw = par_workers(run, nchunks ? nchunks : 1);
+    size_t nb = (size_t)im->w * (size_t)im->h;
+    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.zb = rt_calloc((size_t)nw, sizeof *c.zb);
+    if (!c.cum || !c.zb) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        goto done;
+    }
+    for (int s = 0; s < fs->n; s++)
+        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
+    for (int i = 0; i < nw; i++) {
+        if (!(c.zb[i] = rt_mallocn(nb, sizeof **c.zb))) {
+            code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread depth buffers", nw);
+            goto done;
+        }
+        for (size_t b = 0; b < nb; b++)
+            c.zb[i][b] = INFINITY;
+    }
+    if (nchunks)
+        code = par_for(run, "chaos", nchunks, opts->mode == FSET_WALK ? view_walk : view_orbit, &c);
+    if (code == RT_ECANCEL) {
+        rt_fail(e, code, "interrupted");
+        goto done;
+    }
+    if (c.failed) {
+        code = rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
+        goto done;
+    }
+    double zmin = INFINITY, zmax = -INFINITY;
+    for (size_t b = 0; b < nb; b++) {
+        for (int i = 1; i < nw; i++)
+            if (c.zb[i][b] < c.zb[0][b])
+                c.zb[0][b] = c.zb[i][b];
+        double z = c.zb[0][b];
+        if (z < INFINITY) {
+            zmin = z < zmin ? z : zmin;
+            zmax = z > zmax ? z : zmax;
+        }
+    }
+    double span = zmax > zmin ? zmax - zmin : 1;
+    for (size_t b = 0; b < nb; b++) {
+        float *px = im->px + 4 * b;
+        double z = c.zb[0][b];
+        if (!(z < INFINITY)) {
+            memcpy(px, bg, 4 * sizeof(float));
+            continue;
+        }
+        float br = (float)(1 + (0.25 - 1) * ((z - zmin) / span));
+        px[0] = px[1] = px[2] = br;
+        px[3] = 1;
+    }
+done:
+    if (c.zb)
+        for (int i = 0; i < nw; i++)
+            rt_free(c.zb[i]);
+    rt_free(c.zb);
+    rt_free(c.cum);
+    return code;
+}

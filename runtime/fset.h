@@ -56,7 +56,10 @@
 #include <stdint.h>
 
 #include "affine.h"
+#include "camera.h"
 #include "hist.h"
+#include "image.h"
+#include "mesh.h"
 #include "rt.h"
 
 #define FSET_MAX_MAPS 256 /* maps per IFS */
@@ -138,14 +141,52 @@ typedef struct fset_chaos_opts {
     uint64_t burn;    /* ORBIT: unplotted steps at the start of every chunk */
     int plot_period;  /* ORBIT: plot only after each full period */
     uint64_t depth;   /* WALK: steps per sample, >= 1 */
-    double start[2];  /* first point of every orbit / walk */
+    double start[3];  /* first point of every orbit / walk (z: 3-D sets only) */
 } fset_chaos_opts;
 
 rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, hist2 *hs,
                    const rt_run *run, rt_error *e);
 
+/* The chaos game of a 3-D function set (3×3 + 3 maps; seed 003 §3-4) seen
+ * through a camera (camera_setup done): the same orbits and walks as
+ * fset_chaos, chunk for chunk, with every plotted point projected by
+ * camera_project; each pixel keeps its nearest view depth (per-worker
+ * buffers merged by min, so the result does not depend on the thread
+ * count) and is shaded like chaos_project's view: white times 1 at the
+ * nearest pixel depth, 0.25 at the farthest, linear between; pixels no
+ * point reached get bg. im must be allocated (any size). */
+rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, const camera *cam,
+                        const float bg[4], image *im, const rt_run *run, rt_error *e);
+/* The box of a 3-D function set's chaos game for framing: FSET_BOX_POINTS
+ * plotted points of the same game (the first chunks of a game on a stream
+ * independent of the picture's), per axis the 0.1 % and 99.9 % quantiles widened by 5 % of
+ * the extent on each side (chaos_fit's rule for IFSs). */
+#define FSET_BOX_POINTS 16384
+rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
+                       rt_error *e);
+
 /* Bin of a plane point in a histogram (hist.h conventions), or -1 if it
  * falls outside (or is NaN). */
 long fset_hist_bin(const hist2 *hs, double x, double y);
+
+/* ---- deterministic iteration of a triangle mesh (seed 003 §3-4) ----------
+ * The 3-D counterpart of detiter (detiter.h): one step with an IFS
+ * W = {ω_1 .. ω_M} replaces the mesh K by ω_1(K) ∪ … ∪ ω_M(K), laid out
+ * map-major (every vertex and triangle of K under ω_1 first, then under ω_2,
+ * …; so the map applied first varies fastest along the copies); step k
+ * uses W_σ(k) of the order. `copies` is M_σ(0)·…·M_σ(steps-1)
+ * (detiter_count with one vertex gives it), so K_n has |V(K0)|·copies
+ * vertices and |T(K0)|·copies triangles. Copy c is K0 under the composition
+ * of its maps, composed once per copy in double, so every vertex is one
+ * affine evaluation of a K0 vertex (not n rounded steps). A copy whose
+ * composed linear part has det < 0 (it mirrors) has its triangles' winding
+ * reversed: a K0 wound counter-clockwise seen from outside stays so, and a
+ * closed K0 of volume v gives closed pieces of volume |det|·v each. Vertex
+ * colours are carried along; normals are not (out has none; renderers then
+ * use face normals). 2-D maps act on x, y and keep z. Fails with RT_EINVAL
+ * when K_n would have 2^32 - 1 vertices or more (32-bit indices). Pure
+ * per-copy work in parallel chunks: the same result for any thread count. */
+rt_code fset_iterate_mesh(const fset *fs, const fset_order *o, size_t steps, size_t copies, const mesh *k0,
+                          mesh *out, const rt_run *run, rt_error *e);
 
 #endif

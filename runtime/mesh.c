@@ -153,3 +153,57 @@ rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e)
     rt_free(used);
     return RT_OK;
 }
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+rt_code mesh_orient_outward(mesh *m, int *closed, rt_error *e)
+{
+    *closed = 0;
+    size_t ne = rt_mul_size(m->nt, 3);
+    uint64_t *d = rt_mallocn(ne ? ne : 1, sizeof *d);
+    if (!d)
+        return rt_fail(e, RT_ENOMEM, "out of memory checking the orientation");
+    for (size_t t = 0; t < m->nt; t++)
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = m->tri[3 * t + (size_t)k], b = m->tri[3 * t + (size_t)(k + 1) % 3];
+            d[3 * t + (size_t)k] = a << 32 | b;
+        }
+    qsort(d, ne, sizeof *d, cmp_u64);
+    int all_paired = ne > 0;
+    for (size_t i = 0; i < ne; i++) {
+        if (i + 1 < ne && d[i + 1] == d[i]) {
+            unsigned a = (unsigned)(d[i] >> 32), b = (unsigned)(d[i] & 0xffffffffu);
+            rt_free(d);
+            return rt_fail(e, RT_EINVAL,
+                           "the edge from vertex %u to vertex %u is used twice in the same direction (faces must all "
+                           "wind the same way, and an edge may join at most two faces)",
+                           a, b);
+        }
+        uint64_t rev = (d[i] & 0xffffffffu) << 32 | d[i] >> 32;
+        if (all_paired && !bsearch(&rev, d, ne, sizeof *d, cmp_u64))
+            all_paired = 0;
+    }
+    rt_free(d);
+    if (!all_paired)
+        return RT_OK;
+    *closed = 1;
+    double vol = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const float *p = m->pos + 3 * (size_t)m->tri[3 * t], *q = m->pos + 3 * (size_t)m->tri[3 * t + 1],
+                    *r = m->pos + 3 * (size_t)m->tri[3 * t + 2];
+        vol += (double)p[0] * ((double)q[1] * r[2] - (double)q[2] * r[1]) -
+               (double)p[1] * ((double)q[0] * r[2] - (double)q[2] * r[0]) +
+               (double)p[2] * ((double)q[0] * r[1] - (double)q[1] * r[0]);
+    }
+    if (vol < 0)
+        for (size_t t = 0; t < m->nt; t++) {
+            uint32_t x = m->tri[3 * t + 1];
+            m->tri[3 * t + 1] = m->tri[3 * t + 2];
+            m->tri[3 * t + 2] = x;
+        }
+    return RT_OK;
+}

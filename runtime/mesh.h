@@ -47,4 +47,14 @@ typedef struct mesh_stats {
 
 rt_code mesh_compute_stats(const mesh *m, mesh_stats *st, rt_error *e);
 
+/* Orientation of a polyhedron given by its faces (seed 003's K0): every
+ * undirected edge must be used at most once in each direction (else
+ * RT_EINVAL naming the edge: two faces disagree about the winding, or an edge
+ * has more than two faces). *closed is set when every edge is used exactly
+ * once in each direction (a closed, consistently wound surface); a closed
+ * mesh of negative signed volume (wound inside out) has every triangle
+ * reversed, so closed meshes come out wound counter-clockwise from outside
+ * (positive volume). Open meshes are left as given. */
+rt_code mesh_orient_outward(mesh *m, int *closed, rt_error *e);
+
 #endif

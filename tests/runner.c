@@ -997,18 +997,21 @@ static void run_fail_alloc(const char *frac, const char *script)
 
 /* ---- checks with outside tools --------------------------------------------------------
  * tests/tools/vdb_check.py opens frac's .vdb files with the OpenVDB library
- * (Debian python3-openvdb, for /usr/bin/python3). Its exit 77 (the module or
- * python missing) prints its "skipped: …" line and counts neither way. */
-static void run_vdb_check(const char *frac)
+ * (Debian python3-openvdb, for /usr/bin/python3); tests/tools/mesh_check.py
+ * reads the meshes of 3-D function sets with its own PLY/OBJ/STL readers. An
+ * exit 77 (a module or python missing) prints its "skipped: …" line and
+ * counts neither way. */
+static void run_tool_check(const char *frac, const char *label)
 {
-    const char *label = "tools/vdb_check.py";
     if (!matches_filter(label))
         return;
     if (access("/usr/bin/python3", X_OK) != 0) {
         printf("%s skipped: /usr/bin/python3 not installed\n", label);
         return;
     }
-    char *argv[] = {"/usr/bin/python3", "tests/tools/vdb_check.py", (char *)frac, NULL};
+    char script[256];
+    snprintf(script, sizeof script, "tests/%s", label);
+    char *argv[] = {"/usr/bin/python3", script, (char *)frac, NULL};
     buf out = {0}, err = {0}, why = {0};
     int rc = run(argv, NULL, &out, &err, 120);
     if (rc == 77) {
@@ -1354,7 +1357,8 @@ int main(int argc, char **argv)
         if (realpath(ptyrun, ptyabs))
             run_pty_dir(fracabs, ptyabs);
     }
-    run_vdb_check(fracabs);
+    run_tool_check(fracabs, "tools/vdb_check.py");
+    run_tool_check(fracabs, "tools/mesh_check.py");
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
