@@ -329,18 +329,30 @@ static size_t lidx(const iso_job *j, int x, int y)
     return (size_t)(y + 1) * (size_t)j->NXp + (size_t)(x + 1);
 }
 
-/* Inside flags of node layer z into buf (lsz bytes). */
+/* Inside flags of node layer z into buf (lsz bytes), then one byte per row
+ * (NYp): does the row hold an inside node? Rows of cells whose four node
+ * rows have none are skipped whole (the flying-edges trim, per row). */
 static void inside_layer(const iso_job *j, int z, unsigned char *buf)
 {
-    memset(buf, 0, j->lsz);
+    memset(buf, 0, j->lsz + (size_t)j->NYp);
     if (z < 0 || z >= j->n[2])
         return;
     for (int y = 0; y < j->n[1]; y++) {
         const float *row = volume_at(j->vol, 0, y, z);
-        unsigned char *b = buf + lidx(j, 0, y);
-        for (int x = 0; x < j->n[0]; x++)
+        unsigned char *b = buf + lidx(j, 0, y), any = 0;
+        for (int x = 0; x < j->n[0]; x++) {
             b[x] = (unsigned char)(row[x] >= j->level); /* NaN: outside */
+            any |= b[x];
+        }
+        buf[j->lsz + (size_t)(y + 1)] = any;
     }
+}
+
+/* Are node rows y and y + 1 of both layers all outside? */
+static int rows_empty(const iso_job *j, const unsigned char *in0, const unsigned char *in1, int y)
+{
+    const unsigned char *f0 = in0 + j->lsz + (y + 1), *f1 = in1 + j->lsz + (y + 1);
+    return !(f0[0] | f0[1] | f1[0] | f1[1]);
 }
 
 /* Does edge (node at idx, d) cross the surface? */
@@ -444,7 +456,9 @@ static void fill_layer(iso_job *j, int z, const unsigned char *in0, const unsign
                        uint32_t *ids, size_t base, size_t *counter, int write)
 {
     /* ids of edges that do not cross are never read, so they are not set */
-    for (int y = -1; y <= j->n[1]; y++)
+    for (int y = -1; y <= j->n[1]; y++) {
+        if (rows_empty(j, in0, in1, y))
+            continue;
         for (int x = -1; x <= j->n[0]; x++) {
             size_t idx = lidx(j, x, y);
             if (uniform(j, in0, in1, idx))
@@ -460,6 +474,7 @@ static void fill_layer(iso_job *j, int z, const unsigned char *in0, const unsign
                     make_vertex(j, x, y, z, d, id);
             }
         }
+    }
 }
 
 static int decisions(const iso_job *j, int x, int y, int z, int mask);
@@ -484,7 +499,8 @@ static void pass_count(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     int z0, z1;
     chunk_range(j, c, &z0, &z1);
-    unsigned char *in0 = rt_malloc(j->lsz), *in1 = rt_malloc(j->lsz);
+    size_t lb = j->lsz + (size_t)j->NYp;
+    unsigned char *in0 = rt_malloc(lb), *in1 = rt_malloc(lb);
     if (!in0 || !in1) {
         j->failed[c] = 1;
         rt_free(in0);
@@ -495,7 +511,9 @@ static void pass_count(void *ctx, size_t c, int worker)
     inside_layer(j, z0, in0);
     for (int z = z0; z < z1; z++) {
         inside_layer(j, z + 1, in1);
-        for (int y = -1; y <= j->n[1]; y++)
+        for (int y = -1; y <= j->n[1]; y++) {
+            if (rows_empty(j, in0, in1, y))
+                continue;
             for (int x = -1; x <= j->n[0]; x++) {
                 size_t idx = lidx(j, x, y);
                 if (uniform(j, in0, in1, idx))
@@ -503,12 +521,14 @@ static void pass_count(void *ctx, size_t c, int worker)
                 for (int d = 1; d <= 4; d <<= 1)
                     cnt += (size_t)crosses(j, in0, in1, idx, d);
             }
-        for (int y = -1; y < j->n[1]; y++)
-            for (int x = -1; x < j->n[0]; x++) {
+            if (y == j->n[1])
+                continue;
+            for (int x = -1; x < j->n[0]; x++) { /* the cells of row y */
                 int mask = cell_mask(j, in0, in1, lidx(j, x, y));
                 if (j->tb.cen[mask])
                     ncen += j->tb.cases[j->tb.base[mask] + decisions(j, x, y, z, mask)].nc;
             }
+        }
         unsigned char *t = in0;
         in0 = in1;
         in1 = t;
@@ -630,9 +650,9 @@ static void pass_build(void *ctx, size_t c, int worker)
     size_t lsz = j->lsz;
     unsigned char *ins[3];
     uint32_t *ids[2];
-    ins[0] = rt_malloc(lsz);
-    ins[1] = rt_malloc(lsz);
-    ins[2] = rt_malloc(lsz);
+    ins[0] = rt_malloc(lsz + (size_t)j->NYp);
+    ins[1] = rt_malloc(lsz + (size_t)j->NYp);
+    ins[2] = rt_malloc(lsz + (size_t)j->NYp);
     ids[0] = rt_malloc(lsz * 3 * sizeof(uint32_t));
     ids[1] = rt_malloc(lsz * 3 * sizeof(uint32_t));
     tri_list *L = &j->lists[c];
@@ -653,7 +673,9 @@ static void pass_build(void *ctx, size_t c, int worker)
             size_t c2 = 0, nb = c + 1 < j->nchunks ? j->counts[c + 1] : 0;
             fill_layer(j, z + 1, ins[1], ins[2], ids[1], nb, &c2, 0);
         }
-        for (int y = -1; y < j->n[1]; y++)
+        for (int y = -1; y < j->n[1]; y++) {
+            if (rows_empty(j, ins[0], ins[1], y))
+                continue;
             for (int x = -1; x < j->n[0]; x++) {
                 size_t idx = lidx(j, x, y);
                 int mask = cell_mask(j, ins[0], ins[1], idx);
@@ -686,6 +708,7 @@ static void pass_build(void *ctx, size_t c, int worker)
                     push_cen(&j->cens[c], rec);
                 }
             }
+        }
         unsigned char *tmp = ins[0];
         ins[0] = ins[1];
         ins[1] = ins[2];
