@@ -222,6 +222,8 @@ static int gen_case(const iso_table *tb, int mask, int dec, mc_case *out)
     return nt;
 }
 
+/* 0 on success, 1 out of memory, 2 if some case does not close into cycles
+ * (cannot happen: the unit tests build every case). */
 static int build_table(iso_table *tb)
 {
     memset(tb, 0, sizeof *tb);
@@ -256,7 +258,7 @@ static int build_table(iso_table *tb)
     tb->ncases = total;
     tb->cases = rt_calloc(total, sizeof(mc_case));
     if (!tb->cases)
-        return -1;
+        return 1;
     for (int m = 0; m < 256; m++) {
         int na = popcount8(tb->amb[m]);
         for (int ci = 0; ci < 1 << na; ci++) {
@@ -265,7 +267,7 @@ static int build_table(iso_table *tb)
                 if (tb->amb[m] >> f & 1)
                     dec |= (ci >> bit++ & 1) << f;
             if (gen_case(tb, m, dec, &tb->cases[tb->base[m] + ci]) < 0)
-                return -1;
+                return 2;
             tb->cen[m] |= tb->cases[tb->base[m] + ci].nc != 0;
         }
     }
@@ -972,8 +974,10 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     j->lsz = (size_t)j->NXp * (size_t)j->NYp;
     for (int d = 0; d < 8; d++)
         j->doff[d] = (size_t)(d & 1) + (size_t)(d >> 1 & 1) * (size_t)j->NXp;
-    if (build_table(&j->tb)) {
-        rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
+    int tbr = build_table(&j->tb);
+    if (tbr) {
+        rc = tbr == 1 ? rt_fail(e, RT_ENOMEM, "out of memory for the isosurface")
+                      : rt_fail(e, RT_EINVAL, "isosurface case table is inconsistent (internal error)");
         goto done;
     }
     for (int k = 0; k < 12; k++) {

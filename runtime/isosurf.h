@@ -10,9 +10,10 @@
  * no table is copied. A face with inside corners on one diagonal and
  * outside corners on the other is ambiguous: its inside corners are joined
  * across it when the saddle of the bilinear interpolant of its four samples
- * is inside (Nielson and Hamann's asymptotic decider, 1991). The decision
- * depends only on the face's samples, so the two cells sharing a face pair
- * its crossings alike. A surface vertex lives on a lattice edge (node, axis)
+ * is inside (Nielson and Hamann's asymptotic decider, Visualization '91);
+ * a face with a padding node or a non-finite sample keeps them apart. The
+ * decision depends only on the face's samples, so the two cells sharing a
+ * face pair its crossings alike. A surface vertex lives on a lattice edge (node, axis)
  * and is created once and shared by every cell touching that edge (welded,
  * indexed), so every mesh edge is used by exactly two triangles: the mesh
  * is closed, manifold and consistently oriented. Cycles are triangulated
@@ -40,7 +41,7 @@
  * Vertex position on an edge p–q (both real samples): linear interpolation
  * s = (level - f(p)) / (f(q) - f(p)), clamped to [1e-3, 1 - 1e-3] so that no
  * two surface vertices coincide and no triangle has zero area even where a
- * sample equals the level exactly (departure from plain MT: moves a vertex by
+ * sample equals the level exactly (departure from plain MC: moves a vertex by
  * at most 0.1% of an edge). NaN samples count as outside; an edge with a
  * non-finite sample gets s = 1/2.
  *
