@@ -2,8 +2,10 @@
  * like field (soft sphere × an analytic "noise" of products of sines).
  *
  * Reports, best of R runs each:
- *   - field sampling of an n³ grid, and marching tetrahedra on it, for
- *     n = 128 and 256, with 1 and 2 threads;
+ *   - field sampling of an n³ grid, and the marching-cubes extractor on it,
+ *     for n = 128 and 256, with 1 and 2 threads, against the previous
+ *     extractor (marching tetrahedra, bench/iso_tet_ref.inc) and a plain
+ *     marching-cubes loop (below: unwelded triangle soup, one thread);
  *   - ray marching a 512² image (emission–absorption with lighting, and the
  *     thresholded solid) with 1 and 2 threads;
  * with ratios against plain C baseline loops run in the same process:
@@ -24,6 +26,93 @@
 
 #include "isosurf.h"
 #include "raymarch.h"
+
+#include "iso_tet_ref.inc"
+
+/* Plain marching cubes, the textbook loop: per cell, the mask, the crossing
+ * edges interpolated, the case's triangles appended as a soup of 9 floats
+ * (no shared vertices, no padding, no normals). Its table separates inside
+ * corners on every ambiguous face and fans each cycle (generated below). */
+static unsigned char pm_nt[256], pm_e[256][12][3];
+static const int pm_lo[12] = {0, 2, 4, 6, 0, 1, 4, 5, 0, 1, 2, 3}, pm_ax[12] = {1, 1, 1, 1, 2, 2, 2, 2, 4, 4, 4, 4};
+
+static int pm_edge(int c0, int c1)
+{
+    for (int e = 0; e < 12; e++)
+        if (pm_lo[e] == (c0 & c1) && pm_ax[e] == (c0 ^ c1))
+            return e;
+    return -1;
+}
+
+static void pm_table(void)
+{
+    static const int face[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (int m = 0; m < 256; m++) {
+        int next[12];
+        for (int e = 0; e < 12; e++)
+            next[e] = -1;
+        for (int f = 0; f < 6; f++)
+            for (int k = 0; k < 4; k++) {
+                int a = face[f][k], b = face[f][(k + 1) & 3];
+                if ((m >> a & 1) || !(m >> b & 1))
+                    continue;
+                /* entry at (a, b): the exit is where the run of inside corners from b ends */
+                int i = (k + 1) & 3;
+                while (m >> face[f][(i + 1) & 3] & 1)
+                    i = (i + 1) & 3;
+                next[pm_edge(a, b)] = pm_edge(face[f][i], face[f][(i + 1) & 3]);
+            }
+        int seen[12] = {0}, nt = 0;
+        for (int e0 = 0; e0 < 12; e0++) {
+            if (next[e0] < 0 || seen[e0])
+                continue;
+            int cyc[12], k = 0;
+            for (int e = e0; e >= 0 && !seen[e]; e = next[e])
+                seen[e] = 1, cyc[k++] = e;
+            for (int i = 1; i + 1 < k && nt < 12; i++, nt++)
+                pm_e[m][nt][0] = (unsigned char)cyc[0], pm_e[m][nt][1] = (unsigned char)cyc[i],
+                pm_e[m][nt][2] = (unsigned char)cyc[i + 1];
+        }
+        pm_nt[m] = (unsigned char)nt;
+    }
+}
+
+static size_t plain_mc(const volume *v, float level, float **soup, size_t *cap)
+{
+    size_t n = 0;
+    for (int z = 0; z + 1 < v->nz; z++)
+        for (int y = 0; y + 1 < v->ny; y++)
+            for (int x = 0; x + 1 < v->nx; x++) {
+                float s[8];
+                int m = 0;
+                for (int c = 0; c < 8; c++) {
+                    s[c] = *volume_at(v, x + (c & 1), y + (c >> 1 & 1), z + (c >> 2 & 1));
+                    m |= (s[c] >= level) << c;
+                }
+                if (!pm_nt[m])
+                    continue;
+                float p[12][3];
+                for (int e = 0; e < 12; e++) {
+                    int a = pm_lo[e], b = a | pm_ax[e];
+                    if (((m >> a) ^ (m >> b)) & 1) {
+                        float t = (level - s[a]) / (s[b] - s[a]);
+                        p[e][0] = x + (a & 1) + t * (pm_ax[e] == 1);
+                        p[e][1] = y + (a >> 1 & 1) + t * (pm_ax[e] == 2);
+                        p[e][2] = z + (a >> 2 & 1) + t * (pm_ax[e] == 4);
+                    }
+                }
+                if (n + 12 > *cap) {
+                    *cap = *cap ? *cap * 2 : 1 << 16;
+                    *soup = realloc(*soup, *cap * 9 * sizeof(float));
+                    if (!*soup)
+                        exit(1);
+                }
+                for (int t = 0; t < pm_nt[m]; t++, n++)
+                    for (int r = 0; r < 3; r++)
+                        memcpy(*soup + 9 * n + 3 * r, p[pm_e[m][t][r]], 3 * sizeof(float));
+            }
+    return n;
+}
 
 static double now(void)
 {
@@ -85,8 +174,9 @@ int main(int argc, char **argv)
         volume v;
         if (volume_init(&v, n, n, n, lo, hi, &e))
             return 1;
-        double tsample[3] = {1e9, 1e9, 1e9}, tiso[3] = {1e9, 1e9, 1e9}, tbase = 1e9;
-        size_t nv = 0, nt = 0, sink = 0;
+        double tsample[3] = {1e9, 1e9, 1e9}, tiso[3] = {1e9, 1e9, 1e9}, ttet[3] = {1e9, 1e9, 1e9};
+        double tbase = 1e9, tplain = 1e9;
+        size_t nv = 0, nt = 0, sink = 0, tet_nt = 0, plain_nt = 0;
         for (int th = 1; th <= 2; th++) {
             rt_run run = {th, NULL, 0};
             for (int r = 0; r < runs; r++) {
@@ -106,8 +196,28 @@ int main(int argc, char **argv)
                     tsample[th] = t1 - t0;
                 if (t2 - t1 < tiso[th])
                     tiso[th] = t2 - t1;
+                if (tet_from_volume(&v, &o, &run, &m, &e)) {
+                    fprintf(stderr, "%s\n", e.msg);
+                    return 1;
+                }
+                double t3 = now();
+                tet_nt = m.nt;
+                mesh_free(&m);
+                if (t3 - t2 < ttet[th])
+                    ttet[th] = t3 - t2;
             }
         }
+        pm_table();
+        float *soup = NULL;
+        size_t cap = 0;
+        for (int r = 0; r < runs; r++) {
+            double t0 = now();
+            plain_nt = plain_mc(&v, 0.3f, &soup, &cap);
+            double t1 = now();
+            if (t1 - t0 < tplain)
+                tplain = t1 - t0;
+        }
+        free(soup);
         for (int r = 0; r < runs; r++) {
             double t0 = now();
             sink += baseline_scan(&v, 0.3f);
@@ -118,8 +228,12 @@ int main(int argc, char **argv)
         printf("%3d^3: %zu vertices, %zu triangles (sink %zu)\n", n, nv, nt, sink % 7);
         printf("  sample field   1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tsample[1], tsample[2],
                tsample[1] / tsample[2]);
-        printf("  march tets     1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tiso[1], tiso[2],
+        printf("  marching cubes 1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tiso[1], tiso[2],
                tiso[1] / tiso[2]);
+        printf("  old tets       1 thr %7.3f s   2 thr %7.3f s   %zu triangles; new/old time %.2f (1 thr) %.2f (2 thr)\n",
+               ttet[1], ttet[2], tet_nt, tiso[1] / ttet[1], tiso[2] / ttet[2]);
+        printf("  plain MC soup  1 thr %7.3f s   %zu triangles; new/plain time %.2f (1 thr), triangles %.3f\n",
+               tplain, plain_nt, tiso[1] / tplain, (double)nt / plain_nt);
         printf("  baseline scan  1 thr %7.3f s   ratio march/baseline (1 thr) %.1fx\n", tbase, tiso[1] / tbase);
         volume_free(&v);
     }

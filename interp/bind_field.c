@@ -784,7 +784,7 @@ static const builtin field_builtins[] = {
     BUILTIN("at", b_at, p_at, "The value of a field or volume at a point [x, y, z]."),
     BUILTIN("sample", b_sample, p_sample, "Sample a field into a volume of `grid` cells over the box lo..hi (values at cell centres)."),
     BUILTIN("isosurface", b_isosurface, p_iso,
-            "A closed triangle mesh of {field = level} (marching tetrahedra), from a field over a grid or from a volume; optional vertex colours from another field through a palette."),
+            "A closed triangle mesh of {field = level} (marching cubes, asymptotic decider), from a field over a grid or from a volume; optional vertex colours from another field through a palette."),
     BUILTIN("raymarch", b_raymarch, p_rm,
             "Render a field or volume with a camera: mode \"emission\" (density as opacity, extinction sigma) or \"solid\" (surfaces where density >= threshold)."),
 };

@@ -1,4 +1,5 @@
-/* isosurf.c — marching tetrahedra on a Kuhn split with shared edge vertices.
+/* isosurf.c — marching cubes with the asymptotic decider, shared edge
+ * vertices, a generated case table.
  *
  * Seed 001 renders hypertextures "as solids thresholded at density >= 0.3 and
  * >= 0.5"; this engine turns such a solid into a closed mesh (see isosurf.h
@@ -6,18 +7,20 @@
  *
  * Lattice: node indices run from -1 to n on each axis; nodes -1 and n are the
  * virtual padding (outside). Cells run from -1 to n-1. A lattice edge is
- * (node, d) with d in 1..7 a bit set of axes (x = 1, y = 2, z = 4): the edge
- * goes from node to node + d. Every edge of every Kuhn tetrahedron is of
- * this form, so surface vertices are keyed by (node, d).
+ * (node, d) with d in {1, 2, 4} the axis (x = 1, y = 2, z = 4): the edge
+ * goes from node to node + d. Surface vertices are keyed by (node, d).
  *
- * Parallel plan (deterministic): chunk c owns cell layers and node layers
- * [z0, z1) with z0 = -1 + 4c. Pass 1 counts the crossing edges each chunk
- * owns; prefix sums give each chunk its first vertex id. Pass 2 numbers the
- * edges of each node layer in (y, x, d) order, writes the vertices it owns,
- * and emits triangles cell by cell into a per-chunk list; the lists are
- * concatenated in chunk order. The top node layer z1 of a chunk belongs to
- * the next chunk, whose numbering of it starts at that chunk's first id, so
- * both agree without communicating.
+ * Parallel plan (deterministic, flying-edges style: edges first, then
+ * cells): chunk c owns cell layers and node layers [z0, z1) with z0 = -1 +
+ * 4c. Pass 1 counts the crossing edges each chunk owns and the centre
+ * vertices of its cells; prefix sums give each chunk its first vertex id.
+ * Pass 2 numbers the crossing edges of each node layer in (y, x, d) order
+ * and writes the vertices it owns, then emits the triangles of the cell
+ * layer below cell by cell into a per-chunk list; the lists are concatenated
+ * in chunk order. The top node layer z1 of a chunk belongs to the next
+ * chunk, whose numbering of it starts at that chunk's first id, so both
+ * agree without communicating. A last pass places the centre vertices once
+ * every edge vertex is final.
  */
 #include "isosurf.h"
 #include "rt_alloc.h"
@@ -31,106 +34,244 @@
 #define SLAB 4
 #define S_EPS 1e-3
 
-/* Triangle tables for the six Kuhn tetrahedra: for tetrahedron t and the
- * mask of its inside vertices, up to two triangles, each three edges, each
- * edge (lower corner, higher corner) as cube-corner bit sets. */
+/* The case table, generated here from the cube's topology (no table is
+ * copied from anywhere). Cube corners are bit sets (x = 1, y = 2, z = 4);
+ * the 12 cube edges are numbered a * 4 + k for axis a and the k-th of the
+ * four corners without bit a (in increasing order); face f = 2a + s is the
+ * face where bit a equals s.
+ *
+ * For a mask of inside corners and one connect/separate decision per face,
+ * each face's crossing edges are paired into segments: a face with two
+ * crossings has one segment; an ambiguous face (inside corners on one
+ * diagonal, outside on the other) has two, cutting off the outside corners
+ * when the decision is "connected" and the inside corners otherwise.
+ * Walking a face's corners counter-clockwise seen from outside the cube, a
+ * crossing edge is an entry (outside -> inside) or an exit; each segment
+ * runs from an entry to an exit. A crossing cube edge lies on two faces,
+ * walked in opposite directions, so it is the entry of exactly one segment
+ * and the exit of exactly one: the segments form disjoint directed cycles.
+ * Each cycle is fanned into triangles from its lowest edge; the direction
+ * makes the right-hand normal point from the inside corners to the outside.
+ *
+ * Neighbouring cells pair the crossings of a shared face the same way (the
+ * decision depends only on the face's four samples, see face_connected), so
+ * every segment is used by exactly one triangle on each side: the mesh is
+ * closed and manifold. A cycle of k edges gives k - 2 triangles, as in
+ * marching cubes. */
+#define MC_MAXT 12
+
+typedef struct mc_case {
+    unsigned char nt;
+    unsigned char e[MC_MAXT][3]; /* cube edges of each triangle */
+    unsigned char nc;            /* cycles fanned around a centre vertex */
+    unsigned char ck[4];         /* their lengths */
+    unsigned char ce[12];        /* their cube edges, in order, one cycle after another */
+} mc_case;
+
 typedef struct iso_table {
-    unsigned char ntri[6][16];
-    unsigned char edge[6][16][2][3][2];
-    /* the same, merged per cube: for each mask of the 8 inside corners, the
-     * triangles of the six tetrahedra in order, each corner as an edge
-     * (lower corner, direction = higher ^ lower) */
-    unsigned char cell_ntri[256];
-    unsigned char cell_edge[256][12][3][2];
+    unsigned char face[6][4];  /* corners of each face, counter-clockwise seen from outside */
+    unsigned char elo[12];     /* lower corner of each edge */
+    unsigned char eax[12];     /* axis of each edge */
+    unsigned char amb[256];    /* bit set of the ambiguous faces of each mask */
+    unsigned short base[256];  /* first entry of each mask in cases */
+    unsigned char cen[256];    /* some entry of the mask has a centre vertex */
+    size_t ncases;
+    mc_case *cases; /* per mask: one entry per combination of its ambiguous faces' decisions */
 } iso_table;
 
-static void build_table(iso_table *tb)
+static int popcount8(unsigned v)
 {
-    static const int perm[6][3] = {{1, 2, 4}, {1, 4, 2}, {2, 1, 4}, {2, 4, 1}, {4, 1, 2}, {4, 2, 1}};
+    int n = 0;
+    for (; v; v &= v - 1)
+        n++;
+    return n;
+}
+
+static int edge_index(const iso_table *tb, int c0, int c1)
+{
+    int lo = c0 & c1, ax = (c0 ^ c1) == 1 ? 0 : (c0 ^ c1) == 2 ? 1 : 2;
+    for (int e = 4 * ax; e < 4 * ax + 4; e++)
+        if (tb->elo[e] == lo)
+            return e;
+    return -1;
+}
+
+/* Do cube edges e and f lie on a common face? */
+static int common_face(const iso_table *tb, int e, int f)
+{
+    for (int a = 0; a < 3; a++)
+        if (tb->eax[e] != a && tb->eax[f] != a && (tb->elo[e] >> a & 1) == (tb->elo[f] >> a & 1))
+            return 1;
+    return 0;
+}
+
+/* Triangulate the cycle c[0..k-1] into k - 2 triangles (keeping its
+ * direction) by the least total chord length between edge midpoints,
+ * without a chord between two edges of one face: such a chord lies in the
+ * face, and the neighbouring cell could draw the same one, giving an edge of
+ * four triangles. (Two edges of one face are joined only by the face's own
+ * segments.) Dynamic programming over the sub-polygons c[i..j]. */
+static int triangulate(const iso_table *tb, const int *c, int k, unsigned char (*tri)[3])
+{
+    double mid[12][3], cost[12][12];
+    signed char best[12][12];
+    for (int i = 0; i < k; i++)
+        for (int a = 0; a < 3; a++)
+            mid[i][a] = tb->eax[c[i]] == a ? 0.5 : (tb->elo[c[i]] >> a & 1);
+    for (int len = 1; len < k; len++)
+        for (int i = 0; i + len < k; i++) {
+            int j = i + len;
+            cost[i][j] = len == 1 ? 0 : HUGE_VAL;
+            best[i][j] = -1;
+            if (len == 1)
+                continue;
+            int side = j - i < k - 1; /* (i, j) is a chord, not the closing edge (0, k-1) */
+            if (side && common_face(tb, c[i], c[j]))
+                continue;
+            double l = 0;
+            if (side)
+                for (int a = 0; a < 3; a++)
+                    l += (mid[i][a] - mid[j][a]) * (mid[i][a] - mid[j][a]);
+            for (int m = i + 1; m < j; m++) {
+                double t = cost[i][m] + cost[m][j] + sqrt(l);
+                if (t < cost[i][j]) {
+                    cost[i][j] = t;
+                    best[i][j] = (signed char)m;
+                }
+            }
+        }
+    if (!(cost[0][k - 1] < HUGE_VAL))
+        return -1;
+    /* emit the triangles (i, m, j) of the chosen split, depth first */
+    int stack[24][2], sp = 0, nt = 0;
+    stack[sp][0] = 0, stack[sp][1] = k - 1, sp++;
+    while (sp) {
+        sp--;
+        int i = stack[sp][0], j = stack[sp][1];
+        if (j - i < 2)
+            continue;
+        int m = best[i][j];
+        tri[nt][0] = (unsigned char)c[i];
+        tri[nt][1] = (unsigned char)c[m];
+        tri[nt][2] = (unsigned char)c[j];
+        nt++;
+        stack[sp][0] = i, stack[sp][1] = m, sp++;
+        stack[sp][0] = m, stack[sp][1] = j, sp++;
+    }
+    return 0;
+}
+
+/* The triangles of mask with decisions dec (bit f: face f connects its
+ * inside corners). Returns the triangle count, or -1 if the segments do
+ * not form cycles (cannot happen; checked once per table). */
+static int gen_case(const iso_table *tb, int mask, int dec, mc_case *out)
+{
+    int next[12];
+    for (int e = 0; e < 12; e++)
+        next[e] = -1;
+    for (int f = 0; f < 6; f++) {
+        int in[4], ed[4], n = 0;
+        for (int k = 0; k < 4; k++)
+            in[k] = mask >> tb->face[f][k] & 1;
+        for (int k = 0; k < 4; k++) {
+            ed[k] = edge_index(tb, tb->face[f][k], tb->face[f][(k + 1) & 3]);
+            n += in[k] != in[(k + 1) & 3];
+        }
+        for (int k = 0; k < 4; k++) {
+            if (in[k] || !in[(k + 1) & 3])
+                continue; /* not an entry */
+            int x;
+            if (n == 2) {
+                for (x = 0; x < 4; x++)
+                    if (in[x] && !in[(x + 1) & 3])
+                        break;
+            } else {
+                x = (dec >> f & 1) ? (k + 3) & 3 : (k + 1) & 3;
+            }
+            if (next[ed[k]] >= 0)
+                return -1;
+            next[ed[k]] = ed[x];
+        }
+    }
+    int seen[12] = {0}, nt = 0;
+    for (int e0 = 0; e0 < 12; e0++) {
+        if (next[e0] < 0 || seen[e0])
+            continue;
+        int cyc[12], k = 0;
+        for (int e = e0; !seen[e]; e = next[e]) {
+            if (next[e] < 0)
+                return -1;
+            seen[e] = 1;
+            cyc[k++] = e;
+        }
+        if (cyc[0] != e0 || next[cyc[k - 1]] != e0 || k < 3 || nt + k - 2 > MC_MAXT)
+            return -1;
+        if (triangulate(tb, cyc, k, out->e + nt) == 0) {
+            nt += k - 2;
+            continue;
+        }
+        /* no chord avoids the faces: a vertex at the cycle's centre */
+        int at = 0;
+        for (int c = 0; c < out->nc; c++)
+            at += out->ck[c];
+        out->ck[out->nc++] = (unsigned char)k;
+        for (int i = 0; i < k; i++)
+            out->ce[at + i] = (unsigned char)cyc[i];
+    }
+    out->nt = (unsigned char)nt;
+    return nt;
+}
+
+/* 0 on success, 1 out of memory, 2 if some case does not close into cycles
+ * (cannot happen: the unit tests build every case). */
+static int build_table(iso_table *tb)
+{
     memset(tb, 0, sizeof *tb);
-    for (int t = 0; t < 6; t++) {
-        int cv[4] = {0, perm[t][0], perm[t][0] | perm[t][1], 7};
-        for (int m = 1; m < 15; m++) {
-            int in[4], out[4], ni = 0, no = 0;
-            for (int k = 0; k < 4; k++) {
-                if (m >> k & 1)
-                    in[ni++] = k;
-                else
-                    out[no++] = k;
-            }
-            int q[4][2], nq; /* edges (tet vertex pairs) in cyclic order */
-            if (ni == 1 || no == 1) {
-                int s = ni == 1 ? in[0] : out[0], r = 0;
-                for (int k = 0; k < 4; k++)
-                    if (k != s) {
-                        q[r][0] = s;
-                        q[r][1] = k;
-                        r++;
-                    }
-                nq = 3;
-            } else { /* a, b inside; c, d outside: cycle ac, ad, bd, bc */
-                q[0][0] = in[0], q[0][1] = out[0];
-                q[1][0] = in[0], q[1][1] = out[1];
-                q[2][0] = in[1], q[2][1] = out[1];
-                q[3][0] = in[1], q[3][1] = out[0];
-                nq = 4;
-            }
-            /* Direction from inside to outside, on the unit cube. */
-            double dir[3] = {0, 0, 0};
-            for (int k = 0; k < 4; k++)
-                for (int a = 0; a < 3; a++) {
-                    double c = (cv[k] >> a) & 1;
-                    dir[a] += (m >> k & 1) ? -c / ni : c / no;
-                }
-            int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
-            int nt = nq == 3 ? 1 : 2;
-            tb->ntri[t][m] = (unsigned char)nt;
-            for (int ti = 0; ti < nt; ti++) {
-                double p[3][3];
-                for (int r = 0; r < 3; r++) {
-                    int *ed = q[tris[ti][r]];
-                    for (int a = 0; a < 3; a++)
-                        p[r][a] = 0.5 * (((cv[ed[0]] >> a) & 1) + ((cv[ed[1]] >> a) & 1));
-                }
-                double u[3], w[3];
-                for (int a = 0; a < 3; a++) {
-                    u[a] = p[1][a] - p[0][a];
-                    w[a] = p[2][a] - p[0][a];
-                }
-                double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                               u[0] * w[1] - u[1] * w[0]};
-                int order[3] = {0, 1, 2};
-                if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] < 0) {
-                    order[1] = 2;
-                    order[2] = 1;
-                }
-                for (int r = 0; r < 3; r++) {
-                    int *ed = q[tris[ti][order[r]]];
-                    int c0 = cv[ed[0]], c1 = cv[ed[1]];
-                    /* corners along a Kuhn path are nested: the lower is a subset */
-                    int lo = (c0 & c1) == c0 ? c0 : c1, hi = lo == c0 ? c1 : c0;
-                    tb->edge[t][m][ti][r][0] = (unsigned char)lo;
-                    tb->edge[t][m][ti][r][1] = (unsigned char)hi;
-                }
-            }
+    for (int e = 0; e < 12; e++) {
+        int a = e >> 2, k = e & 3, low = (1 << a) - 1;
+        tb->elo[e] = (unsigned char)((k & low) | (k & ~low) << 1);
+        tb->eax[e] = (unsigned char)a;
+    }
+    for (int a = 0; a < 3; a++) {
+        int B = 1 << (a + 1) % 3, C = 1 << (a + 2) % 3;
+        for (int s = 0; s < 2; s++) {
+            int b0 = s << a;
+            unsigned char *F = tb->face[2 * a + s];
+            F[0] = (unsigned char)b0;
+            F[2] = (unsigned char)(b0 | B | C);
+            /* (0,0) (1,0) (1,1) (0,1) in (b, c) turns about +e_a */
+            F[1] = (unsigned char)(b0 | (s ? B : C));
+            F[3] = (unsigned char)(b0 | (s ? C : B));
         }
     }
-    for (int mask = 0; mask < 256; mask++) {
-        int nt = 0;
-        for (int t = 0; t < 6; t++) {
-            int cv[4] = {0, perm[t][0], perm[t][0] | perm[t][1], 7};
-            int tm = 0;
-            for (int k = 0; k < 4; k++)
-                tm |= (mask >> cv[k] & 1) << k;
-            for (int ti = 0; ti < tb->ntri[t][tm]; ti++, nt++)
-                for (int r = 0; r < 3; r++) {
-                    int lo = tb->edge[t][tm][ti][r][0], hi = tb->edge[t][tm][ti][r][1];
-                    tb->cell_edge[mask][nt][r][0] = (unsigned char)lo;
-                    tb->cell_edge[mask][nt][r][1] = (unsigned char)(hi ^ lo);
-                }
+    size_t total = 0;
+    for (int m = 0; m < 256; m++) {
+        for (int f = 0; f < 6; f++) {
+            const unsigned char *F = tb->face[f];
+            int i0 = m >> F[0] & 1, i1 = m >> F[1] & 1, i2 = m >> F[2] & 1, i3 = m >> F[3] & 1;
+            if (i0 == i2 && i1 == i3 && i0 != i1)
+                tb->amb[m] |= (unsigned char)(1 << f);
         }
-        tb->cell_ntri[mask] = (unsigned char)nt;
+        tb->base[m] = (unsigned short)total;
+        total += (size_t)1 << popcount8(tb->amb[m]);
     }
+    tb->ncases = total;
+    tb->cases = rt_calloc(total, sizeof(mc_case));
+    if (!tb->cases)
+        return 1;
+    for (int m = 0; m < 256; m++) {
+        int na = popcount8(tb->amb[m]);
+        for (int ci = 0; ci < 1 << na; ci++) {
+            int dec = 0, bit = 0;
+            for (int f = 0; f < 6; f++)
+                if (tb->amb[m] >> f & 1)
+                    dec |= (ci >> bit++ & 1) << f;
+            if (gen_case(tb, m, dec, &tb->cases[tb->base[m] + ci]) < 0)
+                return 2;
+            tb->cen[m] |= tb->cases[tb->base[m] + ci].nc != 0;
+        }
+    }
+    return 0;
 }
 
 typedef struct tri_list {
@@ -138,6 +279,15 @@ typedef struct tri_list {
     size_t n, cap; /* in triangles */
     int failed;
 } tri_list;
+
+/* Centre vertices of one chunk: records of CEN_REC words (vertex id, cycle
+ * length k, the k vertices of the cycle). */
+#define CEN_REC 14
+typedef struct cen_list {
+    uint32_t *r;
+    size_t n, cap; /* in records */
+    int failed;
+} cen_list;
 
 typedef struct iso_job {
     const volume *vol;
@@ -148,9 +298,12 @@ typedef struct iso_job {
     int NXp, NYp;   /* layer array width and height */
     size_t lsz;     /* NXp * NYp */
     size_t doff[8]; /* index offset of node + d within a layer */
+    size_t eoff[12]; /* per cube edge: offset of its id from the cell's node, in a layer's ids */
     iso_table tb;
     size_t nchunks;
     size_t *counts;  /* pass 1: owned vertices per chunk; then first ids */
+    size_t *nedge;   /* per chunk: owned edge vertices (its centre vertices follow) */
+    cen_list *cens;
     float *pos, *nrm;
     unsigned char *cap; /* 1 = vertex on a box face (cap) */
     tri_list *lists;
@@ -178,18 +331,30 @@ static size_t lidx(const iso_job *j, int x, int y)
     return (size_t)(y + 1) * (size_t)j->NXp + (size_t)(x + 1);
 }
 
-/* Inside flags of node layer z into buf (lsz bytes). */
+/* Inside flags of node layer z into buf (lsz bytes), then one byte per row
+ * (NYp): does the row hold an inside node? Rows of cells whose four node
+ * rows have none are skipped whole (the flying-edges trim, per row). */
 static void inside_layer(const iso_job *j, int z, unsigned char *buf)
 {
-    memset(buf, 0, j->lsz);
+    memset(buf, 0, j->lsz + (size_t)j->NYp);
     if (z < 0 || z >= j->n[2])
         return;
     for (int y = 0; y < j->n[1]; y++) {
         const float *row = volume_at(j->vol, 0, y, z);
-        unsigned char *b = buf + lidx(j, 0, y);
-        for (int x = 0; x < j->n[0]; x++)
+        unsigned char *b = buf + lidx(j, 0, y), any = 0;
+        for (int x = 0; x < j->n[0]; x++) {
             b[x] = (unsigned char)(row[x] >= j->level); /* NaN: outside */
+            any |= b[x];
+        }
+        buf[j->lsz + (size_t)(y + 1)] = any;
     }
+}
+
+/* Are node rows y and y + 1 of both layers all outside? */
+static int rows_empty(const iso_job *j, const unsigned char *in0, const unsigned char *in1, int y)
+{
+    const unsigned char *f0 = in0 + j->lsz + (y + 1), *f1 = in1 + j->lsz + (y + 1);
+    return !(f0[0] | f0[1] | f1[0] | f1[1]);
 }
 
 /* Does edge (node at idx, d) cross the surface? */
@@ -293,21 +458,35 @@ static void fill_layer(iso_job *j, int z, const unsigned char *in0, const unsign
                        uint32_t *ids, size_t base, size_t *counter, int write)
 {
     /* ids of edges that do not cross are never read, so they are not set */
-    for (int y = -1; y <= j->n[1]; y++)
+    for (int y = -1; y <= j->n[1]; y++) {
+        if (rows_empty(j, in0, in1, y))
+            continue;
         for (int x = -1; x <= j->n[0]; x++) {
             size_t idx = lidx(j, x, y);
             if (uniform(j, in0, in1, idx))
                 continue;
-            uint32_t *row = ids + idx * 7;
-            for (int d = 1; d <= 7; d++) {
+            uint32_t *row = ids + idx * 3;
+            for (int a = 0; a < 3; a++) {
+                int d = 1 << a;
                 if (!crosses(j, in0, in1, idx, d))
                     continue;
                 uint32_t id = (uint32_t)(base + (*counter)++);
-                row[d - 1] = id;
+                row[a] = id;
                 if (write)
                     make_vertex(j, x, y, z, d, id);
             }
         }
+    }
+}
+
+static int decisions(const iso_job *j, int x, int y, int z, int mask);
+
+/* The mask of inside corners of the cell based at node idx. */
+static int cell_mask(const iso_job *j, const unsigned char *in0, const unsigned char *in1, size_t idx)
+{
+    size_t w = (size_t)j->NXp;
+    const unsigned char *a = in0 + idx, *b = in1 + idx;
+    return a[0] | a[1] << 1 | a[w] << 2 | a[w + 1] << 3 | b[0] << 4 | b[1] << 5 | b[w] << 6 | b[w + 1] << 7;
 }
 
 static void chunk_range(const iso_job *j, size_t c, int *z0, int *z1)
@@ -322,32 +501,77 @@ static void pass_count(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     int z0, z1;
     chunk_range(j, c, &z0, &z1);
-    unsigned char *in0 = rt_malloc(j->lsz), *in1 = rt_malloc(j->lsz);
+    size_t lb = j->lsz + (size_t)j->NYp;
+    unsigned char *in0 = rt_malloc(lb), *in1 = rt_malloc(lb);
     if (!in0 || !in1) {
         j->failed[c] = 1;
         rt_free(in0);
         rt_free(in1);
         return;
     }
-    size_t cnt = 0;
+    size_t cnt = 0, ncen = 0;
     inside_layer(j, z0, in0);
     for (int z = z0; z < z1; z++) {
         inside_layer(j, z + 1, in1);
-        for (int y = -1; y <= j->n[1]; y++)
+        for (int y = -1; y <= j->n[1]; y++) {
+            if (rows_empty(j, in0, in1, y))
+                continue;
             for (int x = -1; x <= j->n[0]; x++) {
                 size_t idx = lidx(j, x, y);
                 if (uniform(j, in0, in1, idx))
                     continue;
-                for (int d = 1; d <= 7; d++)
+                for (int d = 1; d <= 4; d <<= 1)
                     cnt += (size_t)crosses(j, in0, in1, idx, d);
             }
+            if (y == j->n[1])
+                continue;
+            for (int x = -1; x < j->n[0]; x++) { /* the cells of row y */
+                int mask = cell_mask(j, in0, in1, lidx(j, x, y));
+                if (j->tb.cen[mask])
+                    ncen += j->tb.cases[j->tb.base[mask] + decisions(j, x, y, z, mask)].nc;
+            }
+        }
         unsigned char *t = in0;
         in0 = in1;
         in1 = t;
     }
-    j->counts[c] = cnt;
+    j->nedge[c] = cnt;
+    j->counts[c] = cnt + ncen;
     rt_free(in0);
     rt_free(in1);
+}
+
+/* The asymptotic decider on face f of the cell at (x, y, z): the bilinear
+ * interpolant of the face's four samples v (relative to the level) has its
+ * saddle value (v0 v2 - v1 v3) / (v0 + v2 - v1 - v3); the inside corners
+ * are connected across the face when that value is inside (>= 0). With the
+ * inside pair's product P_in >= 0 and the outside pair's P_out > 0, that is
+ * P_in >= P_out, a symmetric expression of the four samples, so the two
+ * cells sharing the face decide alike. A face with a padding node or a
+ * non-finite sample keeps its inside corners separate. */
+static int face_connected(const iso_job *j, int x, int y, int z, int f)
+{
+    double v[4];
+    for (int k = 0; k < 4; k++) {
+        int c = j->tb.face[f][k], p = x + (c & 1), q = y + (c >> 1 & 1), r = z + (c >> 2 & 1);
+        if (!in_range(j, p, q, r))
+            return 0;
+        v[k] = (double)val(j, p, q, r) - j->level;
+        if (!isfinite(v[k]))
+            return 0;
+    }
+    double a = v[0] * v[2], b = v[1] * v[3];
+    return v[0] >= 0 ? a >= b : b >= a;
+}
+
+/* Index of the cell's decisions among its mask's table entries. */
+static int decisions(const iso_job *j, int x, int y, int z, int mask)
+{
+    int ci = 0, bit = 0, amb = j->tb.amb[mask];
+    for (int f = 0; f < 6; f++)
+        if (amb >> f & 1)
+            ci |= face_connected(j, x, y, z, f) << bit++;
+    return ci;
 }
 
 static void push_tri(tri_list *L, uint32_t a, uint32_t b, uint32_t c)
@@ -370,26 +594,75 @@ static void push_tri(tri_list *L, uint32_t a, uint32_t b, uint32_t c)
     t[2] = c;
 }
 
+static void push_cen(cen_list *L, const uint32_t *rec)
+{
+    if (L->failed)
+        return;
+    if (L->n == L->cap) {
+        size_t nc = L->cap ? L->cap * 2 : 64;
+        uint32_t *nr = rt_realloc(L->r, nc * CEN_REC * sizeof(uint32_t));
+        if (!nr) {
+            L->failed = 1;
+            return;
+        }
+        L->r = nr;
+        L->cap = nc;
+    }
+    memcpy(L->r + CEN_REC * L->n++, rec, CEN_REC * sizeof(uint32_t));
+}
+
+/* Centre vertices: the mean of their cycle's vertices (after any root
+ * finding), normal the normalised mean of theirs. */
+typedef struct cen_job {
+    iso_job *j;
+    mesh *m;
+} cen_job;
+
+static void pass_centres(void *ctx, size_t c, int worker)
+{
+    (void)worker;
+    cen_job *C = ctx;
+    const cen_list *L = &C->j->cens[c];
+    mesh *m = C->m;
+    for (size_t i = 0; i < L->n; i++) {
+        const uint32_t *rec = L->r + CEN_REC * i;
+        int n = (int)rec[1];
+        double p[3] = {0, 0, 0}, q[3] = {0, 0, 0};
+        for (int r = 0; r < n; r++)
+            for (int a = 0; a < 3; a++) {
+                p[a] += m->pos[3 * (size_t)rec[2 + r] + a];
+                if (m->nrm)
+                    q[a] += m->nrm[3 * (size_t)rec[2 + r] + a];
+            }
+        double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        for (int a = 0; a < 3; a++) {
+            m->pos[3 * (size_t)rec[0] + a] = (float)(p[a] / n);
+            if (m->nrm)
+                m->nrm[3 * (size_t)rec[0] + a] = (float)(l > 0 ? q[a] / l : 0);
+        }
+    }
+}
+
 static void pass_build(void *ctx, size_t c, int worker)
 {
     (void)worker;
     iso_job *j = ctx;
     int z0, z1;
     chunk_range(j, c, &z0, &z1);
-    size_t lsz = j->lsz, w = (size_t)j->NXp;
+    size_t lsz = j->lsz;
     unsigned char *ins[3];
     uint32_t *ids[2];
-    ins[0] = rt_malloc(lsz);
-    ins[1] = rt_malloc(lsz);
-    ins[2] = rt_malloc(lsz);
-    ids[0] = rt_malloc(lsz * 7 * sizeof(uint32_t));
-    ids[1] = rt_malloc(lsz * 7 * sizeof(uint32_t));
+    ins[0] = rt_malloc(lsz + (size_t)j->NYp);
+    ins[1] = rt_malloc(lsz + (size_t)j->NYp);
+    ins[2] = rt_malloc(lsz + (size_t)j->NYp);
+    ids[0] = rt_malloc(lsz * 3 * sizeof(uint32_t));
+    ids[1] = rt_malloc(lsz * 3 * sizeof(uint32_t));
     tri_list *L = &j->lists[c];
     if (!ins[0] || !ins[1] || !ins[2] || !ids[0] || !ids[1]) {
         j->failed[c] = 1;
         goto done;
     }
-    size_t counter = 0, base = j->counts[c];
+    size_t counter = 0, ncen = 0, base = j->counts[c];
     inside_layer(j, z0, ins[0]);
     inside_layer(j, z0 + 1, ins[1]);
     fill_layer(j, z0, ins[0], ins[1], ids[0], base, &counter, 1);
@@ -402,23 +675,42 @@ static void pass_build(void *ctx, size_t c, int worker)
             size_t c2 = 0, nb = c + 1 < j->nchunks ? j->counts[c + 1] : 0;
             fill_layer(j, z + 1, ins[1], ins[2], ids[1], nb, &c2, 0);
         }
-        for (int y = -1; y < j->n[1]; y++)
+        for (int y = -1; y < j->n[1]; y++) {
+            if (rows_empty(j, ins[0], ins[1], y))
+                continue;
             for (int x = -1; x < j->n[0]; x++) {
                 size_t idx = lidx(j, x, y);
-                const unsigned char *a = ins[0] + idx, *b = ins[1] + idx;
-                int mask = a[0] | a[1] << 1 | a[w] << 2 | a[w + 1] << 3 | b[0] << 4 | b[1] << 5 |
-                           b[w] << 6 | b[w + 1] << 7;
-                int nt = j->tb.cell_ntri[mask];
-                for (int ti = 0; ti < nt; ti++) {
+                int mask = cell_mask(j, ins[0], ins[1], idx);
+                if (mask == 0 || mask == 255)
+                    continue;
+                int ci = j->tb.base[mask];
+                if (j->tb.amb[mask])
+                    ci += decisions(j, x, y, z, mask);
+                const mc_case *K = &j->tb.cases[ci];
+                for (int ti = 0; ti < K->nt; ti++) {
                     uint32_t v[3];
                     for (int r = 0; r < 3; r++) {
-                        int lo = j->tb.cell_edge[mask][ti][r][0], d = j->tb.cell_edge[mask][ti][r][1];
-                        const uint32_t *I = ids[lo >> 2 & 1];
-                        v[r] = I[(idx + j->doff[lo & 3]) * 7 + (size_t)(d - 1)];
+                        int e = K->e[ti][r];
+                        v[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
                     }
                     push_tri(L, v[0], v[1], v[2]);
                 }
+                for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
+                    uint32_t rec[CEN_REC];
+                    int n = K->ck[k];
+                    rec[0] = (uint32_t)(base + j->nedge[c] + ncen++);
+                    rec[1] = (uint32_t)n;
+                    for (int r = 0; r < n; r++) {
+                        int e = K->ce[at + r];
+                        rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+                    }
+                    for (int r = 0; r < n; r++)
+                        push_tri(L, rec[2 + r], rec[2 + (r + 1) % n], rec[0]);
+                    j->cap[rec[0]] = 2;
+                    push_cen(&j->cens[c], rec);
+                }
             }
+        }
         unsigned char *tmp = ins[0];
         ins[0] = ins[1];
         ins[1] = ins[2];
@@ -491,7 +783,7 @@ static void pass_attr(void *ctx, size_t c, int worker)
                     g[ax][i] = (out[0][i] - out2[i]) / (2 * a->h[ax]);
             }
             for (size_t i = 0; i < n; i++) {
-                if (a->cap[b + i])
+                if (a->cap[b + i] == 1)
                     continue;
                 double l = sqrt(g[0][i] * g[0][i] + g[1][i] * g[1][i] + g[2][i] * g[2][i]);
                 if (!(l > 0) || !isfinite(l))
@@ -682,13 +974,24 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     j->lsz = (size_t)j->NXp * (size_t)j->NYp;
     for (int d = 0; d < 8; d++)
         j->doff[d] = (size_t)(d & 1) + (size_t)(d >> 1 & 1) * (size_t)j->NXp;
-    build_table(&j->tb);
+    int tbr = build_table(&j->tb);
+    if (tbr) {
+        rc = tbr == 1 ? rt_fail(e, RT_ENOMEM, "out of memory for the isosurface")
+                      : rt_fail(e, RT_EINVAL, "isosurface case table is inconsistent (internal error)");
+        goto done;
+    }
+    for (int k = 0; k < 12; k++) {
+        int lo = j->tb.elo[k];
+        j->eoff[k] = j->doff[lo & 3] * 3 + j->tb.eax[k];
+    }
     j->nchunks = (size_t)(vol->nz + 1 + SLAB - 1) / SLAB;
     j->counts = rt_calloc(j->nchunks + 1, sizeof(size_t));
     j->lists = rt_calloc(j->nchunks, sizeof(tri_list));
+    j->nedge = rt_calloc(j->nchunks, sizeof(size_t));
+    j->cens = rt_calloc(j->nchunks, sizeof(cen_list));
     j->failed = rt_calloc(j->nchunks, sizeof(int));
     size_t nv = 0, nt = 0;
-    if (!j->counts || !j->lists || !j->failed) {
+    if (!j->counts || !j->lists || !j->failed || !j->nedge || !j->cens) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
         goto done;
     }
@@ -722,7 +1025,7 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
     if (rc)
         goto fail_par;
     for (size_t c = 0; c < j->nchunks; c++) {
-        if (j->failed[c] || j->lists[c].failed) {
+        if (j->failed[c] || j->lists[c].failed || j->cens[c].failed) {
             rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface triangles");
             goto done;
         }
@@ -771,6 +1074,12 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         if (rc)
             goto fail_par;
     }
+    {
+        cen_job C = {j, out};
+        rc = par_for(run, "isosurface", j->nchunks, pass_centres, &C);
+        if (rc)
+            goto fail_par;
+    }
     if ((gf && j->want_normals) || colours) {
         attr_job aj;
         memset(&aj, 0, sizeof aj);
@@ -795,6 +1104,11 @@ done:
         for (size_t c = 0; c < j->nchunks; c++)
             rt_free(j->lists[c].t);
     rt_free(j->lists);
+    if (j->cens)
+        for (size_t c = 0; c < j->nchunks; c++)
+            rt_free(j->cens[c].r);
+    rt_free(j->cens);
+    rt_free(j->nedge);
     rt_free(j->tri_at);
     rt_free(j->counts);
     rt_free(j->failed);
@@ -802,6 +1116,7 @@ done:
     rt_free(j->nrm);
     rt_free(j->cap);
     rt_free(j->edges);
+    rt_free(j->tb.cases);
     rt_free(j);
     return rc;
 }

@@ -1,4 +1,4 @@
-/* test_isosurf.c — marching tetrahedra against geometric facts: closed
+/* test_isosurf.c — the iso-surface extractor against geometric facts: closed
  * manifold meshes (every edge in two triangles), Euler characteristics of a
  * sphere (2), a torus (0) and two spheres (4), area and enclosed volume of a
  * sphere against 4πr² and 4/3πr³, a box-filling solid capped by the padding
