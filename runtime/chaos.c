@@ -262,6 +262,7 @@ typedef struct job {
     size_t nchunks;
     worker *w;
     size_t nbins; /* bins/voxels/pixels */
+    uint64_t *direct; /* 2-D counts: worker 0 adds its hits here (the histogram) */
     /* 2-D window */
     int hw, hh;
     double lox, hiy, sx, sy;
@@ -325,7 +326,8 @@ INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t 
  * bin is 4 uint32 (count, r, g, b) in one 16-byte cell — one cache line per
  * hit; after 65536 hits of a bin (at most 65535 per channel each, so no
  * wrap) the cell is flushed into 64-bit side sums. */
-INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, const int colour)
+INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, const int colour,
+                       const int wide)
 {
     const sysdata *d = j->d;
     worker *w = &j->w[wid];
@@ -346,6 +348,7 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const double *const M = d->m, *const mc = d->mc;
     const uint32_t(*const pal)[3] = d->pal;
     uint32_t *const cnt = w->cnt;
+    uint64_t *const cnt64 = j->direct;
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, c = ob.c;
@@ -367,7 +370,11 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         double fx = (x - lox) * sx, fy = (hiy - y) * sy;
         if (colour == CHAOS_COLOUR_NONE) {
             if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-                bump(w, cnt, (size_t)(int)fy * hw + (size_t)(int)fx, j->nbins);
+                size_t b = (size_t)(int)fy * hw + (size_t)(int)fx;
+                if (wide)
+                    cnt64[b]++;
+                else
+                    bump(w, cnt, b, j->nbins);
                 inside++;
             }
             continue;
@@ -392,10 +399,16 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     w->plotted += count;
 }
 
+/* Counts only: worker 0 adds straight into the histogram's 64-bit counts
+ * (no private array, no merge pass, no carry); the others count privately. */
 #define HIST_FN(name, kind, colour)                                                              \
     static void name(void *ctx, size_t chunk, int wid)                                           \
     {                                                                                            \
-        hist_chunk((const job *)ctx, chunk, wid, kind, colour);                                  \
+        const job *j = ctx;                                                                      \
+        if (colour == CHAOS_COLOUR_NONE && wid == 0 && j->direct)                                \
+            hist_chunk(j, chunk, wid, kind, colour, 1);                                          \
+        else                                                                                     \
+            hist_chunk(j, chunk, wid, kind, colour, 0);                                          \
     }
 HIST_FN(hist_i0, KIND_IFS, CHAOS_COLOUR_NONE)
 HIST_FN(hist_i1, KIND_IFS, CHAOS_COLOUR_LAST)
@@ -561,6 +574,38 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The k-th smallest of a[0..n-1] (what a[k] is after sorting; a is
+ * reordered), by quickselect with a three-way partition, so runs of equal
+ * values (a stem on one line) cost one pass. Finite values only. */
+static double select_kth(double *a, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n; /* the answer's index lies in [lo, hi) */
+    while (hi - lo > 1) {
+        double x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
+        double piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+        size_t lt = lo, i = lo, gt = hi; /* [lo,lt) < piv, [lt,i) == piv, [gt,hi) > piv */
+        while (i < gt) {
+            double v = a[i];
+            if (v < piv) {
+                a[i++] = a[lt];
+                a[lt++] = v;
+            } else if (v > piv) {
+                a[i] = a[--gt];
+                a[gt] = v;
+            } else {
+                i++;
+            }
+        }
+        if (k < lt)
+            hi = lt;
+        else if (k >= gt)
+            lo = gt;
+        else
+            return piv;
+    }
+    return a[lo];
+}
+
 rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
                   rt_error *e)
 {
@@ -589,10 +634,18 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
     for (int a = 0; a < dim; a++) {
         for (size_t i = 0; i < np; i++)
             ax[i] = j.pos[3 * i + a];
-        qsort(ax, np, sizeof *ax, cmp_double);
         size_t cut = np / 1000; /* 0.1 % each side */
-        lo[a] = ax[cut];
-        hi[a] = ax[np - 1 - cut];
+        int finite = 1;
+        for (size_t i = 0; i < np; i++)
+            finite &= isfinite(ax[i]) != 0;
+        if (finite) { /* the two quantiles without sorting everything */
+            lo[a] = select_kth(ax, np, cut);
+            hi[a] = select_kth(ax, np, np - 1 - cut);
+        } else {
+            qsort(ax, np, sizeof *ax, cmp_double);
+            lo[a] = ax[cut];
+            hi[a] = ax[np - 1 - cut];
+        }
         if (!isfinite(lo[a]) || !isfinite(hi[a]))
             lo[a] = -1, hi[a] = 1;
         ext[a] = hi[a] - lo[a];
@@ -629,6 +682,7 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
 
 /* ---------- public evaluations ---------- */
 
+/* counts: 0 none, 1 every worker, 2 every worker but 0 (it counts into the result) */
 static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int colour, int zbuf,
                              rt_error *e)
 {
@@ -636,7 +690,7 @@ static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int
     int bad = !w;
     for (int i = 0; !bad && i < nw; i++) {
         /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
-        if (counts && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+        if (counts && !(counts == 2 && i == 0) && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
             bad = 1;
         if (zbuf) {
             w[i].zb = rt_malloc(sizeof *w[i].zb * nbins);
@@ -660,7 +714,8 @@ static uint64_t total_count(const worker *w, int nw, size_t b)
 {
     uint64_t t = 0;
     for (int i = 0; i < nw; i++)
-        t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
+        if (w[i].cnt)
+            t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
     return t;
 }
 
@@ -696,7 +751,9 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     j.sx = hs->w / (hs->hi[0] - hs->lo[0]);
     j.sy = hs->h / (hs->hi[1] - hs->lo[1]);
     int nw = par_workers(run, j.nchunks);
-    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    if (o->colour == CHAOS_COLOUR_NONE)
+        j.direct = hs->count;
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, j.direct ? 2 : 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
     if (rc) {
         sys_free(d);
         return rc;
@@ -704,7 +761,8 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     rc = par_for(run, "chaos game", j.nchunks, hist_fns[d->kind][o->colour], &j);
     rc = finish_par(rc, j.w, nw, e);
     if (!rc) {
-        for (size_t b = 0; b < j.nbins; b++) {
+        size_t merge = j.direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
+        for (size_t b = 0; b < merge; b++) {
             if (o->colour == CHAOS_COLOUR_NONE) {
                 hs->count[b] += total_count(j.w, nw, b);
                 continue;
