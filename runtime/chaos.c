@@ -440,7 +440,7 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
     const double sx = j->s3[0], sy = j->s3[1], sz = j->s3[2];
     const double fx_n = j->nx, fy_n = j->ny, fz_n = j->nz;
     const size_t nx = (size_t)j->nx, nxy = (size_t)j->nx * (size_t)j->ny;
-    const size_t trash = j->nbins, nbins = j->nbins; /* outside points go to an extra slot */
+    const size_t trash = j->nbins, nbins = j->nbins; /* outside points: an index past the end */
     const uint32_t n = (uint32_t)d->n;
     const uint32_t *const thr = d->thr, *const sel = d->sel;
     const double *const M = d->m;
@@ -462,14 +462,17 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
             b = (size_t)(int)fx + nx * (size_t)(int)fy + nxy * (size_t)(int)fz;
             inside++;
         }
-        /* prefetch this point's voxel, count the one RING points back */
+        /* prefetch this point's voxel, count the one RING points back
+         * (outside points: b = nbins, one past the counts, not counted) */
         PREFETCHW(&cnt[b]);
-        size_t slot = (size_t)(i % RING);
-        bump(w, cnt, ring[slot], nbins);
+        size_t slot = (size_t)(i % RING), old = ring[slot];
+        if (old != trash)
+            bump(w, cnt, old, nbins);
         ring[slot] = b;
     }
     for (int i = 0; i < RING; i++)
-        bump(w, cnt, ring[i], nbins);
+        if (ring[i] != trash)
+            bump(w, cnt, ring[i], nbins);
     w->inside += inside;
     w->plotted += count;
 }
@@ -803,11 +806,16 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
     }
     j.nbins = (size_t)vol->nx * (size_t)vol->ny * (size_t)vol->nz;
     int nw = par_workers(run, j.nchunks);
-    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, 0, 0, e);
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 2, 0, 0, e);
     if (rc) {
         sys_free(d);
         return rc;
     }
+    /* Worker 0 counts in the volume's own memory (uint32 where the floats
+     * will be; converted in place below), so one thread needs nothing but
+     * the volume. */
+    memset(vol->v, 0, j.nbins * sizeof *vol->v);
+    j.w[0].cnt = (uint32_t *)(void *)vol->v;
     rc = par_for(run, "chaos game", j.nchunks, vol_fns[d->kind], &j);
     rc = finish_par(rc, j.w, nw, e);
     if (!rc) {
@@ -824,9 +832,12 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
         double den = norm == CHAOS_NORM_TOTAL ? (double)plotted : norm == CHAOS_NORM_MAX ? (double)mx : 1;
         if (!(den > 0))
             den = 1;
-        for (size_t b = 0; b < j.nbins; b++)
-            vol->v[b] = (float)((double)total_count(j.w, nw, b) / den);
+        for (size_t b = 0; b < j.nbins; b++) {
+            uint64_t t = total_count(j.w, nw, b); /* read the count before the float replaces it */
+            vol->v[b] = (float)((double)t / den);
+        }
     }
+    j.w[0].cnt = NULL; /* the volume's memory */
     free_workers(j.w, nw);
     sys_free(d);
     return rc;

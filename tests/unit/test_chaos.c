@@ -656,6 +656,69 @@ static void test_fit_quantiles(void)
     ifs_free(&f);
 }
 
+/* The stage chain holds no copies (the allocation hook sees every block):
+ * counts without colour on one thread go straight into the histogram and a
+ * 3-D measure into the volume's own memory; tone mapping allocates nothing.
+ * With two threads one private array (the second worker's) is the largest
+ * block. */
+static void test_no_copies(void)
+{
+    rt_error e;
+    rifs r;
+    affine m[8];
+    octant_maps(m);
+    CHECK(rifs_build(&r, m, 8, 1, T1, RIFS_NORMALISE, &e) == RT_OK, "build: %s", e.msg);
+    chaos_sys s3 = {NULL, &r};
+    chaos_opts o = {0};
+    o.points = 1 << 18;
+    o.chunk = 1 << 14;
+    o.seed = 3;
+    double lo[3] = {0, 0, 0}, hi[3] = {256, 256, 256}; /* the maps' attractor */
+    volume vol;
+    CHECK(volume_init(&vol, 64, 64, 64, lo, hi, &e) == RT_OK, "volume");
+    size_t voxels = 64 * 64 * 64;
+    rt_run r1 = {1, NULL, 0}, r2 = {2, NULL, 0};
+    check_limits(-1, -1, -1);
+    CHECK(chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r1, &e) == RT_OK, "volume 1");
+    CHECK(check_hs.peak < voxels, "1 thread: a block of %zu bytes beside the %zu voxels", check_hs.peak, voxels);
+    float *one = malloc(voxels * sizeof *one);
+    memcpy(one, vol.v, voxels * sizeof *one);
+    check_hs.peak = 0;
+    CHECK(chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r2, &e) == RT_OK, "volume 2");
+    CHECK(check_hs.peak >= 4 * voxels && check_hs.peak < 4 * voxels + 64, "2 threads: largest block %zu", check_hs.peak);
+    CHECK(memcmp(one, vol.v, voxels * sizeof *one) == 0, "volume differs with 2 threads");
+    double sum = 0;
+    for (size_t i = 0; i < voxels; i++)
+        sum += vol.v[i];
+    CHECK_NEAR(sum, 1.0, 1e-5, "total measure");
+    check_limits_off();
+    free(one);
+    volume_free(&vol);
+    rifs_free(&r);
+
+    ifs f;
+    affine tri[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                     affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5)};
+    CHECK(ifs_build(&f, tri, 3, NULL, 0, &e) == RT_OK, "triangle");
+    chaos_sys s2 = {&f, NULL};
+    hist2 hs;
+    double lo2[2] = {0, 0}, hi2[2] = {1, 1};
+    CHECK(hist2_init(&hs, 256, 256, lo2, hi2, 0, &e) == RT_OK, "hist");
+    image im;
+    CHECK(image_init(&im, 128, 128, &e) == RT_OK, "image");
+    check_limits(-1, -1, -1);
+    CHECK(chaos_hist2(&s2, &o, &hs, NULL, &r1, &e) == RT_OK, "hist 1");
+    CHECK(check_hs.peak < 256 * 256, "1 thread: a block of %zu bytes beside the histogram", check_hs.peak);
+    check_hs.peak = 0;
+    tonemap_opts t = {0};
+    CHECK(tonemap_apply(&hs, &t, &im, &e) == RT_OK, "tonemap");
+    CHECK(check_hs.peak == 0, "tone mapping allocated %zu bytes", check_hs.peak);
+    check_limits_off();
+    image_free(&im);
+    hist2_free(&hs);
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -667,5 +730,6 @@ int main(void)
     test_tonemap();
     test_hist_adds();
     test_fit_quantiles();
+    test_no_copies();
     return check_done("test_chaos");
 }
