@@ -320,7 +320,11 @@ INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t 
     }
 }
 
-/* The 2-D loop keeps the orbit in locals and every pointer in a local: the
+/* Both 2-D loops prefetch the hit's bin and add the hit RING points later
+ * (the facts' prefetch ring): with it the counts-only loop runs faster than
+ * a plain loop into a private uint32 array, even with worker 0 adding into
+ * the 8-byte counts of the histogram itself.
+ * The 2-D loop keeps the orbit in locals and every pointer in a local: the
  * build uses -fno-strict-aliasing, so a store into the counts would otherwise
  * force the compiler to reload all of them after every hit. With colour a
  * bin is 4 uint32 (count, r, g, b) in one 16-byte cell — one cache line per
@@ -369,13 +373,23 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         }
         double fx = (x - lox) * sx, fy = (hiy - y) * sy;
         if (colour == CHAOS_COLOUR_NONE) {
+            /* prefetch this hit's bin, count the hit RING points back
+             * (outside: b = nbins, one past the end, not counted) */
+            size_t b = j->nbins;
             if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-                size_t b = (size_t)(int)fy * hw + (size_t)(int)fx;
-                if (wide)
-                    cnt64[b]++;
-                else
-                    bump(w, cnt, b, j->nbins);
+                b = (size_t)(int)fy * hw + (size_t)(int)fx;
                 inside++;
+            }
+            size_t slot = (size_t)(i % RING), old = ring[slot];
+            ring[slot] = b;
+            if (wide) {
+                PREFETCHW(cnt64 + b);
+                if (old != j->nbins)
+                    cnt64[old]++;
+            } else {
+                PREFETCHW(cnt + b);
+                if (old != j->nbins)
+                    bump(w, cnt, old, j->nbins);
             }
             continue;
         }
@@ -392,9 +406,14 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         ring[slot] = b;
         ringc[slot] = pc;
     }
-    if (colour != CHAOS_COLOUR_NONE)
-        for (int q = 0; q < RING; q++)
+    for (int q = 0; q < RING; q++) {
+        if (colour != CHAOS_COLOUR_NONE)
             add_cell(w, cnt, pal, ring[q], ringc[q], j->nbins);
+        else if (ring[q] != j->nbins && wide)
+            cnt64[ring[q]]++;
+        else if (ring[q] != j->nbins)
+            bump(w, cnt, ring[q], j->nbins);
+    }
     w->inside += inside;
     w->plotted += count;
 }
