@@ -283,7 +283,8 @@ int main(int argc, char **argv)
 
     const double *lo = FLO, *hi = FHI;
     uint32_t *cnt = calloc(1024 * 1024, 4);
-    double best_plain = 1e9, best_eng = 1e9, best_col = 1e9, best_2t = 1e9;
+    double best_plain = 1e9, best_eng = 1e9, best_col = 1e9, best_2t = 1e9, q_plain = 1e9, q_eng = 1e9;
+    uint64_t Nq = N / 4; /* rates as slopes between N/4 and N: fixed costs drop out */
     uint64_t sink = 0;
     chaos_sys s = {&g_fern, NULL};
     chaos_opts o = {0};
@@ -293,10 +294,14 @@ int main(int argc, char **argv)
     for (int rep = 0; rep < 3; rep++) {
         memset(cnt, 0, 1024 * 1024 * 4);
         TIME_BEST(best_plain, 1, sink += plain2(N, &g_fern.alias, lo, hi, cnt));
+        TIME_BEST(q_plain, 1, sink += plain2(Nq, &g_fern.alias, lo, hi, cnt));
         hist2 hs;
         hist2_init(&hs, 1024, 1024, lo, hi, 1, &e);
         o.colour = CHAOS_COLOUR_NONE;
         TIME_BEST(best_eng, 1, chaos_hist2(&s, &o, &hs, NULL, &r1, &e));
+        o.points = Nq;
+        TIME_BEST(q_eng, 1, chaos_hist2(&s, &o, &hs, NULL, &r1, &e));
+        o.points = N;
         o.colour = CHAOS_COLOUR_BLEND;
         TIME_BEST(best_col, 1, chaos_hist2(&s, &o, &hs, NULL, &r1, &e));
         o.colour = CHAOS_COLOUR_NONE;
@@ -307,6 +312,8 @@ int main(int argc, char **argv)
     printf("2-D fern, 1024^2 counts, %.0f M points (best of 3; 1 thread: CPU time, 2 threads: wall)\n", Mp);
     printf("  plain C loop           %7.1f M points/s\n", Mp / best_plain);
     printf("  chaos_hist2, 1 thread  %7.1f M points/s  (%.2fx plain)\n", Mp / best_eng, best_plain / best_eng);
+    printf("  slopes N/4..N: plain %.1f, chaos_hist2 %.1f M points/s (%.2fx plain)\n", 0.75 * Mp / (best_plain - q_plain),
+           0.75 * Mp / (best_eng - q_eng), (best_plain - q_plain) / (best_eng - q_eng));
     printf("  with colour (blend)    %7.1f M points/s  (%.2fx plain)\n", Mp / best_col, best_plain / best_col);
     printf("  2 threads              %7.1f M points/s  (%.2fx 1 thread)\n", Mp / best_2t, best_eng / best_2t);
     free(cnt);
@@ -317,11 +324,15 @@ int main(int argc, char **argv)
     volume_init(&vol, 256, 256, 256, vlo, vhi, &e);
     chaos_sys s3 = {NULL, &g_rifs};
     o.colour = CHAOS_COLOUR_NONE;
-    double bp = 1e9, bpp = 1e9, be = 1e9, b2 = 1e9;
+    double bp = 1e9, bpp = 1e9, be = 1e9, b2 = 1e9, qpp = 1e9, qe = 1e9;
     for (int rep = 0; rep < 3; rep++) {
         TIME_BEST(bp, 1, sink += plain3(N, &g_rifs, vc));
         TIME_BEST(bpp, 1, sink += plain3p(N, &g_rifs, vc));
         TIME_BEST(be, 1, chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r1, &e));
+        TIME_BEST(qpp, 1, sink += plain3p(Nq, &g_rifs, vc));
+        o.points = Nq;
+        TIME_BEST(qe, 1, chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r1, &e));
+        o.points = N;
         TIME_BEST(b2, 0, chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r2, &e));
     }
     printf("3-D RIFS (seed 001 Table 1), 256^3 voxels, %.0f M points (best of 3; engine time includes\n"
@@ -329,6 +340,8 @@ int main(int argc, char **argv)
     printf("  plain C loop           %7.1f M points/s\n", Mp / bp);
     printf("  plain, prefetch ring   %7.1f M points/s\n", Mp / bpp);
     printf("  chaos_volume, 1 thread %7.1f M points/s  (%.2fx prefetch loop)\n", Mp / be, bpp / be);
+    printf("  slopes N/4..N: prefetch loop %.1f, chaos_volume %.1f M points/s (%.2fx)\n", 0.75 * Mp / (bpp - qpp),
+           0.75 * Mp / (be - qe), (bpp - qpp) / (be - qe));
     printf("  2 threads              %7.1f M points/s  (%.2fx 1 thread)\n", Mp / b2, be / b2);
     volume_free(&vol);
     free(vc);

@@ -27,8 +27,8 @@
  * directly (hs->count), and a 3-D measure in the volume's own memory
  * (uint32 counts where the floats will be, converted in place), so one
  * thread needs no private array. All the 2-D and 3-D counting loops prefetch
- * the target cell and add
- * each hit 32 points later (a ring of pending indices).
+ * the target cell and add each hit 32 points later (a ring of pending
+ * indices).
  *
  * Colour (2-D histograms, point clouds, projections):
  *   CHAOS_COLOUR_NONE   counts only.
