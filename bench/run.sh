@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
-# Run every benchmark: the interpreter script and each build/bench/* program.
+# Run every benchmark: the interpreter script and each build/bench/* program
+# (each prints its engine's ratios against its plain-C baseline). The load
+# average is printed before and after each one: on the shared 2-core machine
+# a figure taken at a load above ~2 is not a figure of the code.
 set -u
 build=${1:-build}
 cd "$(dirname "$0")/.."
+load() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || uptime; }
+echo "== frac benchmarks, $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc 2>/dev/null || echo '?') cores, load $(load)"
 bash bench/interp.sh "$build/frac"
 for b in "$build"/bench/*; do
     [ -x "$b" ] || continue
-    echo "== $(basename "$b")"
+    echo "== $(basename "$b") (load before: $(load))"
     "$b"
+    echo "   (load after: $(load))"
 done

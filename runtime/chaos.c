@@ -262,6 +262,7 @@ typedef struct job {
     size_t nchunks;
     worker *w;
     size_t nbins; /* bins/voxels/pixels */
+    uint64_t *direct; /* 2-D counts: worker 0 adds its hits here (the histogram) */
     /* 2-D window */
     int hw, hh;
     double lox, hiy, sx, sy;
@@ -319,13 +320,18 @@ INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t 
     }
 }
 
-/* The 2-D loop keeps the orbit in locals and every pointer in a local: the
+/* Both 2-D loops prefetch the hit's bin and add the hit RING points later
+ * (the facts' prefetch ring): with it the counts-only loop runs faster than
+ * a plain loop into a private uint32 array, even with worker 0 adding into
+ * the 8-byte counts of the histogram itself.
+ * The 2-D loop keeps the orbit in locals and every pointer in a local: the
  * build uses -fno-strict-aliasing, so a store into the counts would otherwise
  * force the compiler to reload all of them after every hit. With colour a
  * bin is 4 uint32 (count, r, g, b) in one 16-byte cell — one cache line per
  * hit; after 65536 hits of a bin (at most 65535 per channel each, so no
  * wrap) the cell is flushed into 64-bit side sums. */
-INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, const int colour)
+INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, const int colour,
+                       const int wide)
 {
     const sysdata *d = j->d;
     worker *w = &j->w[wid];
@@ -346,6 +352,7 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const double *const M = d->m, *const mc = d->mc;
     const uint32_t(*const pal)[3] = d->pal;
     uint32_t *const cnt = w->cnt;
+    uint64_t *const cnt64 = j->direct;
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, c = ob.c;
@@ -366,9 +373,23 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         }
         double fx = (x - lox) * sx, fy = (hiy - y) * sy;
         if (colour == CHAOS_COLOUR_NONE) {
+            /* prefetch this hit's bin, count the hit RING points back
+             * (outside: b = nbins, one past the end, not counted) */
+            size_t b = j->nbins;
             if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-                bump(w, cnt, (size_t)(int)fy * hw + (size_t)(int)fx, j->nbins);
+                b = (size_t)(int)fy * hw + (size_t)(int)fx;
                 inside++;
+            }
+            size_t slot = (size_t)(i % RING), old = ring[slot];
+            ring[slot] = b;
+            if (wide) {
+                PREFETCHW(cnt64 + b);
+                if (old != j->nbins)
+                    cnt64[old]++;
+            } else {
+                PREFETCHW(cnt + b);
+                if (old != j->nbins)
+                    bump(w, cnt, old, j->nbins);
             }
             continue;
         }
@@ -385,17 +406,28 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         ring[slot] = b;
         ringc[slot] = pc;
     }
-    if (colour != CHAOS_COLOUR_NONE)
-        for (int q = 0; q < RING; q++)
+    for (int q = 0; q < RING; q++) {
+        if (colour != CHAOS_COLOUR_NONE)
             add_cell(w, cnt, pal, ring[q], ringc[q], j->nbins);
+        else if (ring[q] != j->nbins && wide)
+            cnt64[ring[q]]++;
+        else if (ring[q] != j->nbins)
+            bump(w, cnt, ring[q], j->nbins);
+    }
     w->inside += inside;
     w->plotted += count;
 }
 
+/* Counts only: worker 0 adds straight into the histogram's 64-bit counts
+ * (no private array, no merge pass, no carry); the others count privately. */
 #define HIST_FN(name, kind, colour)                                                              \
     static void name(void *ctx, size_t chunk, int wid)                                           \
     {                                                                                            \
-        hist_chunk((const job *)ctx, chunk, wid, kind, colour);                                  \
+        const job *j = ctx;                                                                      \
+        if (colour == CHAOS_COLOUR_NONE && wid == 0 && j->direct)                                \
+            hist_chunk(j, chunk, wid, kind, colour, 1);                                          \
+        else                                                                                     \
+            hist_chunk(j, chunk, wid, kind, colour, 0);                                          \
     }
 HIST_FN(hist_i0, KIND_IFS, CHAOS_COLOUR_NONE)
 HIST_FN(hist_i1, KIND_IFS, CHAOS_COLOUR_LAST)
@@ -413,7 +445,11 @@ static const par_fn hist_fns[3][3] = {
 /* ---------- 3-D volume ---------- */
 
 
-INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
+/* diag: every map is a scaling per axis plus a translation (M diagonal, as
+ * in seed 001's octant maps), so a step is 3 multiply-adds instead of 9;
+ * the dropped terms are 0·y etc., which change at most the sign of a zero
+ * coordinate, never a count. */
+INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind, const int diag)
 {
     const sysdata *d = j->d;
     worker *w = &j->w[wid];
@@ -427,7 +463,7 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
     const double sx = j->s3[0], sy = j->s3[1], sz = j->s3[2];
     const double fx_n = j->nx, fy_n = j->ny, fz_n = j->nz;
     const size_t nx = (size_t)j->nx, nxy = (size_t)j->nx * (size_t)j->ny;
-    const size_t trash = j->nbins, nbins = j->nbins; /* outside points go to an extra slot */
+    const size_t trash = j->nbins, nbins = j->nbins; /* outside points: an index past the end */
     const uint32_t n = (uint32_t)d->n;
     const uint32_t *const thr = d->thr, *const sel = d->sel;
     const double *const M = d->m;
@@ -441,7 +477,12 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
     uint64_t inside = 0;
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
-        step_map3(M + 12 * (size_t)k, &x, &y, &z);
+        if (diag) {
+            const double *m = M + 12 * (size_t)k;
+            x = m[0] * x + m[3], y = m[5] * y + m[7], z = m[10] * z + m[11];
+        } else {
+            step_map3(M + 12 * (size_t)k, &x, &y, &z);
+        }
         double fx = (x - lx) * sx, fy = (y - ly) * sy, fz = (z - lz) * sz;
         int in = fx >= 0 && fx < fx_n && fy >= 0 && fy < fy_n && fz >= 0 && fz < fz_n;
         size_t b = trash;
@@ -449,22 +490,40 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind)
             b = (size_t)(int)fx + nx * (size_t)(int)fy + nxy * (size_t)(int)fz;
             inside++;
         }
-        /* prefetch this point's voxel, count the one RING points back */
+        /* prefetch this point's voxel, count the one RING points back
+         * (outside points: b = nbins, one past the counts, not counted) */
         PREFETCHW(&cnt[b]);
-        size_t slot = (size_t)(i % RING);
-        bump(w, cnt, ring[slot], nbins);
+        size_t slot = (size_t)(i % RING), old = ring[slot];
+        if (old != trash)
+            bump(w, cnt, old, nbins);
         ring[slot] = b;
     }
     for (int i = 0; i < RING; i++)
-        bump(w, cnt, ring[i], nbins);
+        if (ring[i] != trash)
+            bump(w, cnt, ring[i], nbins);
     w->inside += inside;
     w->plotted += count;
 }
 
-static void vol_i(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_IFS); }
-static void vol_a(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_R1); }
-static void vol_b(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, KIND_R2); }
-static const par_fn vol_fns[3] = {vol_i, vol_a, vol_b};
+#define VOL_FN(name, kind, diag)                                                                 \
+    static void name(void *ctx, size_t chunk, int wid) { vol_chunk((const job *)ctx, chunk, wid, kind, diag); }
+VOL_FN(vol_i, KIND_IFS, 0)
+VOL_FN(vol_a, KIND_R1, 0)
+VOL_FN(vol_b, KIND_R2, 0)
+VOL_FN(vol_id, KIND_IFS, 1)
+VOL_FN(vol_ad, KIND_R1, 1)
+VOL_FN(vol_bd, KIND_R2, 1)
+static const par_fn vol_fns[2][3] = {{vol_i, vol_a, vol_b}, {vol_id, vol_ad, vol_bd}};
+
+static int maps_diagonal(const sysdata *d)
+{
+    for (int k = 0; k < d->n; k++) {
+        const double *m = d->m + 12 * (size_t)k;
+        if (m[1] != 0 || m[2] != 0 || m[4] != 0 || m[6] != 0 || m[8] != 0 || m[9] != 0)
+            return 0;
+    }
+    return 1;
+}
 
 /* ---------- points (point cloud, fit pre-pass, projection) ---------- */
 
@@ -561,6 +620,38 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The k-th smallest of a[0..n-1] (what a[k] is after sorting; a is
+ * reordered), by quickselect with a three-way partition, so runs of equal
+ * values (a stem on one line) cost one pass. Finite values only. */
+static double select_kth(double *a, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n; /* the answer's index lies in [lo, hi) */
+    while (hi - lo > 1) {
+        double x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
+        double piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+        size_t lt = lo, i = lo, gt = hi; /* [lo,lt) < piv, [lt,i) == piv, [gt,hi) > piv */
+        while (i < gt) {
+            double v = a[i];
+            if (v < piv) {
+                a[i++] = a[lt];
+                a[lt++] = v;
+            } else if (v > piv) {
+                a[i] = a[--gt];
+                a[gt] = v;
+            } else {
+                i++;
+            }
+        }
+        if (k < lt)
+            hi = lt;
+        else if (k >= gt)
+            lo = gt;
+        else
+            return piv;
+    }
+    return a[lo];
+}
+
 rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
                   rt_error *e)
 {
@@ -589,10 +680,18 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
     for (int a = 0; a < dim; a++) {
         for (size_t i = 0; i < np; i++)
             ax[i] = j.pos[3 * i + a];
-        qsort(ax, np, sizeof *ax, cmp_double);
         size_t cut = np / 1000; /* 0.1 % each side */
-        lo[a] = ax[cut];
-        hi[a] = ax[np - 1 - cut];
+        int finite = 1;
+        for (size_t i = 0; i < np; i++)
+            finite &= isfinite(ax[i]) != 0;
+        if (finite) { /* the two quantiles without sorting everything */
+            lo[a] = select_kth(ax, np, cut);
+            hi[a] = select_kth(ax, np, np - 1 - cut);
+        } else {
+            qsort(ax, np, sizeof *ax, cmp_double);
+            lo[a] = ax[cut];
+            hi[a] = ax[np - 1 - cut];
+        }
         if (!isfinite(lo[a]) || !isfinite(hi[a]))
             lo[a] = -1, hi[a] = 1;
         ext[a] = hi[a] - lo[a];
@@ -629,6 +728,7 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
 
 /* ---------- public evaluations ---------- */
 
+/* counts: 0 none, 1 every worker, 2 every worker but 0 (it counts into the result) */
 static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int colour, int zbuf,
                              rt_error *e)
 {
@@ -636,7 +736,7 @@ static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int
     int bad = !w;
     for (int i = 0; !bad && i < nw; i++) {
         /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
-        if (counts && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+        if (counts && !(counts == 2 && i == 0) && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
             bad = 1;
         if (zbuf) {
             w[i].zb = rt_malloc(sizeof *w[i].zb * nbins);
@@ -660,7 +760,8 @@ static uint64_t total_count(const worker *w, int nw, size_t b)
 {
     uint64_t t = 0;
     for (int i = 0; i < nw; i++)
-        t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
+        if (w[i].cnt)
+            t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
     return t;
 }
 
@@ -696,7 +797,9 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     j.sx = hs->w / (hs->hi[0] - hs->lo[0]);
     j.sy = hs->h / (hs->hi[1] - hs->lo[1]);
     int nw = par_workers(run, j.nchunks);
-    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    if (o->colour == CHAOS_COLOUR_NONE)
+        j.direct = hs->count;
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, j.direct ? 2 : 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
     if (rc) {
         sys_free(d);
         return rc;
@@ -704,7 +807,8 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     rc = par_for(run, "chaos game", j.nchunks, hist_fns[d->kind][o->colour], &j);
     rc = finish_par(rc, j.w, nw, e);
     if (!rc) {
-        for (size_t b = 0; b < j.nbins; b++) {
+        size_t merge = j.direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
+        for (size_t b = 0; b < merge; b++) {
             if (o->colour == CHAOS_COLOUR_NONE) {
                 hs->count[b] += total_count(j.w, nw, b);
                 continue;
@@ -745,12 +849,17 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
     }
     j.nbins = (size_t)vol->nx * (size_t)vol->ny * (size_t)vol->nz;
     int nw = par_workers(run, j.nchunks);
-    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 1, 0, 0, e);
+    rt_code rc = alloc_workers(&j.w, nw, j.nbins, 2, 0, 0, e);
     if (rc) {
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, vol_fns[d->kind], &j);
+    /* Worker 0 counts in the volume's own memory (uint32 where the floats
+     * will be; converted in place below), so one thread needs nothing but
+     * the volume. */
+    memset(vol->v, 0, j.nbins * sizeof *vol->v);
+    j.w[0].cnt = (uint32_t *)(void *)vol->v;
+    rc = par_for(run, "chaos game", j.nchunks, vol_fns[maps_diagonal(d)][d->kind], &j);
     rc = finish_par(rc, j.w, nw, e);
     if (!rc) {
         uint64_t mx = 0;
@@ -766,9 +875,12 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
         double den = norm == CHAOS_NORM_TOTAL ? (double)plotted : norm == CHAOS_NORM_MAX ? (double)mx : 1;
         if (!(den > 0))
             den = 1;
-        for (size_t b = 0; b < j.nbins; b++)
-            vol->v[b] = (float)((double)total_count(j.w, nw, b) / den);
+        for (size_t b = 0; b < j.nbins; b++) {
+            uint64_t t = total_count(j.w, nw, b); /* read the count before the float replaces it */
+            vol->v[b] = (float)((double)t / den);
+        }
     }
+    j.w[0].cnt = NULL; /* the volume's memory */
     free_workers(j.w, nw);
     sys_free(d);
     return rc;

@@ -23,8 +23,12 @@
  * is flushed into 64-bit side sums every 65536 hits, so no sum can wrap.
  * Every merge is an exact integer sum: the result is byte-identical for any
  * number of threads. Memory: per worker 4 bytes per bin/voxel (16 with
- * colour). The 2-D coloured and 3-D loops prefetch the target cell and add
- * each hit 32 points later (a ring of pending indices).
+ * colour); a 2-D histogram without colour is counted into by worker 0
+ * directly (hs->count), and a 3-D measure in the volume's own memory
+ * (uint32 counts where the floats will be, converted in place), so one
+ * thread needs no private array. All the 2-D and 3-D counting loops prefetch
+ * the target cell and add each hit 32 points later (a ring of pending
+ * indices).
  *
  * Colour (2-D histograms, point clouds, projections):
  *   CHAOS_COLOUR_NONE   counts only.

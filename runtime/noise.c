@@ -3,6 +3,7 @@
 
 #include <math.h>
 
+#include "noise_impl.h"
 #include "rng.h"
 #include "rt.h"
 
@@ -25,12 +26,6 @@ static const uint8_t ref_perm[256] = {
     150, 254, 138, 236, 205, 93,  222, 114, 67,  29,  24,  72,  243, 141, 128, 195, 78,  66,
     215, 61,  156, 180,
 };
-
-/* The reference grad(h, x, y, z) as a table: h = 0..15 selects
- * (±u) + (±v) with u = h<8 ? x : y, v = h<4 ? y : (h==12||h==14) ? x : z. */
-static const double grad_x[16] = {1, -1, 1, -1, 1, -1, 1, -1, 0, 0, 0, 0, 1, 0, -1, 0};
-static const double grad_y[16] = {1, 1, -1, -1, 0, 0, 0, 0, 1, -1, 1, -1, 1, -1, 1, -1};
-static const double grad_z[16] = {0, 0, 0, 0, 1, 1, -1, -1, 1, 1, -1, -1, 0, 1, 0, -1};
 
 void noise_perm_reference(noise_perm *np)
 {
@@ -65,62 +60,29 @@ void noise_perm_init(noise_perm *np, uint64_t seed)
         np->p[i + 256] = np->p[i];
 }
 
-/* floor(v) and its lattice index mod 256, never converting an out-of-range
- * double to int. */
-static inline double lattice(double v, unsigned *ix)
-{
-    if (fabs(v) < 1073741824.0) { /* inline floor: libm's is a call without SSE4.1 */
-        int i = (int)v;
-        i -= v < (double)i;
-        *ix = (unsigned)i & 255u;
-        return (double)i;
-    }
-    double f = floor(v);
-    if (isfinite(f))
-        *ix = (unsigned)(int)fmod(f, 256.0) & 255u;
-    else
-        *ix = 0;
-    return f;
-}
-
-static inline double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
-static inline double lerp(double t, double a, double b) { return a + t * (b - a); }
-
-static inline double grad(unsigned h, double x, double y, double z)
-{
-    h &= 15u;
-    return grad_x[h] * x + grad_y[h] * y + grad_z[h] * z;
-}
-
-/* Perlin 2002, "Improving Noise", the reference noise() with a table grad. */
-static inline double perlin(const uint8_t *p, double x, double y, double z)
-{
-    unsigned X, Y, Z;
-    x -= lattice(x, &X);
-    y -= lattice(y, &Y);
-    z -= lattice(z, &Z);
-    double u = fade(x), v = fade(y), w = fade(z);
-    unsigned A = p[X] + Y, AA = p[A] + Z, AB = p[A + 1] + Z;
-    unsigned B = p[X + 1] + Y, BA = p[B] + Z, BB = p[B + 1] + Z;
-    double x1 = x - 1, y1 = y - 1, z1 = z - 1;
-    return lerp(w,
-                lerp(v, lerp(u, grad(p[AA], x, y, z), grad(p[BA], x1, y, z)),
-                     lerp(u, grad(p[AB], x, y1, z), grad(p[BB], x1, y1, z))),
-                lerp(v, lerp(u, grad(p[AA + 1], x, y, z1), grad(p[BA + 1], x1, y, z1)),
-                     lerp(u, grad(p[AB + 1], x, y1, z1), grad(p[BB + 1], x1, y1, z1))));
-}
-
 double noise_perlin3(const noise_perm *np, double x, double y, double z)
 {
     return perlin(np->p, x, y, z);
 }
 
+/* The level the blocks use: AVX2 where the machine has it; the SSE2 kernel
+ * (4-double vectors split in halves, the hash lane by lane) measured no
+ * faster than the scalar loop, so without AVX2 the scalar loop runs. */
+static int block_level(void)
+{
+    return noise_simd_best() == NOISE_LEVEL_AVX2 ? NOISE_LEVEL_AVX2 : NOISE_LEVEL_SCALAR;
+}
+
+void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
+                            const double *y, const double *z, double *out)
+{
+    noise_kernel(level, np->p, n, x, y, z, 1, 1, NOISE_SET, out);
+}
+
 void noise_perlin3_block(const noise_perm *np, size_t n, const double *x, const double *y,
                          const double *z, double *out)
 {
-    const uint8_t *p = np->p;
-    for (size_t i = 0; i < n; i++)
-        out[i] = perlin(p, x[i], y[i], z[i]);
+    noise_perlin3_block_at(block_level(), np, n, x, y, z, out);
 }
 
 double noise_fbm3(const noise_perm *np, int octaves, double lacunarity, double gain, double x,
@@ -135,19 +97,24 @@ double noise_fbm3(const noise_perm *np, int octaves, double lacunarity, double g
     return sum;
 }
 
-void noise_fbm3_block(const noise_perm *np, int octaves, double lacunarity, double gain, size_t n,
-                      const double *x, const double *y, const double *z, double *out)
+void noise_fbm3_block_at(int level, const noise_perm *np, int octaves, double lacunarity,
+                         double gain, size_t n, const double *x, const double *y, const double *z,
+                         double *out)
 {
-    const uint8_t *p = np->p;
     for (size_t i = 0; i < n; i++)
         out[i] = 0;
     double s = 1, a = 1;
     for (int o = 0; o < octaves; o++) {
-        for (size_t i = 0; i < n; i++)
-            out[i] += a * perlin(p, x[i] * s, y[i] * s, z[i] * s);
+        noise_kernel(level, np->p, n, x, y, z, s, a, NOISE_ADD, out);
         s *= lacunarity;
         a *= gain;
     }
+}
+
+void noise_fbm3_block(const noise_perm *np, int octaves, double lacunarity, double gain, size_t n,
+                      const double *x, const double *y, const double *z, double *out)
+{
+    noise_fbm3_block_at(block_level(), np, octaves, lacunarity, gain, n, x, y, z, out);
 }
 
 double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, double z)
@@ -161,19 +128,23 @@ double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, 
     return sum;
 }
 
-void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
-                             const double *y, const double *z, double *out)
+void noise_turbulence3_block_at(int level, const noise_perm *np, int octaves, size_t n,
+                                const double *x, const double *y, const double *z, double *out)
 {
-    const uint8_t *p = np->p;
     for (size_t i = 0; i < n; i++)
         out[i] = 0;
     double s = 1, a = 1;
     for (int o = 0; o < octaves; o++) {
-        for (size_t i = 0; i < n; i++)
-            out[i] += a * fabs(perlin(p, x[i] * s, y[i] * s, z[i] * s));
+        noise_kernel(level, np->p, n, x, y, z, s, a, NOISE_ADD_ABS, out);
         s *= 2;
         a *= 0.5;
     }
+}
+
+void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
+                             const double *y, const double *z, double *out)
+{
+    noise_turbulence3_block_at(block_level(), np, octaves, n, x, y, z, out);
 }
 
 /* ---- The 2002 reference, transcribed literally (baseline and cross-check). */

@@ -45,6 +45,16 @@
  * arrays (any n, including n > RT_BLOCK) and give exactly the scalar
  * function's values. All functions are pure and reentrant; a noise_perm is
  * read-only after init and can be shared between threads.
+ *
+ * SIMD (noise_simd.c). Four points at a time with GCC vector extensions,
+ * on two levels: SSE2 (the x86-64 baseline) and AVX2 (with gathers for the
+ * permutation lookups), found at run time (noise_simd_best: the highest
+ * level __builtin_cpu_supports allows). Every level gives bit for bit the
+ * scalar values (same operations in the same order, no FMA), so a result
+ * never depends on the machine. The blocks use AVX2 where present and the
+ * scalar loop otherwise (the SSE2 kernel measured no faster than it; see
+ * bench/noise_bench.c). The *_block_at variants take the level
+ * (NOISE_LEVEL_SCALAR runs the scalar loop), for tests and benchmarks.
  */
 #ifndef NOISE_H
 #define NOISE_H
@@ -71,6 +81,16 @@ void noise_fbm3_block(const noise_perm *np, int octaves, double lacunarity, doub
 double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, double z);
 void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
                              const double *y, const double *z, double *out);
+
+enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2 };
+int noise_simd_best(void);
+void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
+                            const double *y, const double *z, double *out);
+void noise_fbm3_block_at(int level, const noise_perm *np, int octaves, double lacunarity,
+                         double gain, size_t n, const double *x, const double *y, const double *z,
+                         double *out);
+void noise_turbulence3_block_at(int level, const noise_perm *np, int octaves, size_t n,
+                                const double *x, const double *y, const double *z, double *out);
 
 /* Perlin's 2002 reference implementation transcribed literally (branchy
  * grad(), his permutation table, (int)floor). Defined only for

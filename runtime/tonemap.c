@@ -1,10 +1,43 @@
 /* tonemap.c — histogram to image (log density as in flam3's renderer; the
  * formulas are in tonemap.h). */
 #include "tonemap.h"
-#include "rt_alloc.h"
 
 #include <math.h>
-#include <stdlib.h>
+
+/* The count of image pixel (x, y): the sum of its k×k bins. */
+static uint64_t pixel_count(const hist2 *hs, int k, int x, int y)
+{
+    if (k == 1)
+        return hs->count[(size_t)y * hs->w + (size_t)x];
+    uint64_t c = 0;
+    for (int dy = 0; dy < k; dy++)
+        for (int dx = 0; dx < k; dx++)
+            c += hs->count[(size_t)(y * k + dy) * hs->w + (size_t)(x * k + dx)];
+    return c;
+}
+
+/* The colour sums of pixel (x, y), added bin by bin in row order. */
+static void pixel_csum(const hist2 *hs, int k, int x, int y, double s[3])
+{
+    s[0] = s[1] = s[2] = 0;
+    for (int dy = 0; dy < k; dy++)
+        for (int dx = 0; dx < k; dx++) {
+            size_t b = (size_t)(y * k + dy) * hs->w + (size_t)(x * k + dx);
+            for (int ch = 0; ch < 3; ch++)
+                s[ch] += hs->csum[3 * b + ch];
+        }
+}
+
+/* The density value v of a pixel with count c > 0 (tonemap.h). */
+static double density(tonemap_curve curve, uint64_t c, uint64_t mx, double lmx, double gamma,
+                      double bright)
+{
+    double v = curve == TONEMAP_LOG ? log1p((double)c) / lmx : (double)c / (double)mx;
+    if (gamma != 1)
+        v = pow(v, 1 / gamma);
+    v *= bright;
+    return v > 1 ? 1 : v;
+}
 
 rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_error *e)
 {
@@ -19,63 +52,48 @@ rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_erro
     if (!(bright > 0))
         return rt_fail(e, RT_EINVAL, "brightness is %g (expected > 0)", bright);
     int k = hs->w / im->w;
-    size_t np = (size_t)im->w * (size_t)im->h;
-    uint64_t *cnt = rt_malloc(sizeof *cnt * np);
-    double *cs = hs->csum ? rt_malloc(sizeof *cs * 3 * np) : NULL;
-    if (!cnt || (hs->csum && !cs)) {
-        rt_free(cnt);
-        rt_free(cs);
-        return rt_fail(e, RT_ENOMEM, "out of memory for tone mapping");
-    }
+    /* No copy of the histogram: pass 1 finds M, pass 2 sums each pixel's
+     * k×k bins again (integer sums, and the colour sums in the same order,
+     * so the result is the same as summing once into a buffer). */
     uint64_t mx = 0;
     for (int y = 0; y < im->h; y++)
         for (int x = 0; x < im->w; x++) {
-            size_t p = (size_t)y * im->w + x;
-            uint64_t c = 0;
-            double s[3] = {0, 0, 0};
-            for (int dy = 0; dy < k; dy++)
-                for (int dx = 0; dx < k; dx++) {
-                    size_t b = (size_t)(y * k + dy) * hs->w + (size_t)(x * k + dx);
-                    c += hs->count[b];
-                    if (cs)
-                        for (int ch = 0; ch < 3; ch++)
-                            s[ch] += hs->csum[3 * b + ch];
-                }
-            cnt[p] = c;
-            if (cs)
-                for (int ch = 0; ch < 3; ch++)
-                    cs[3 * p + ch] = s[ch];
+            uint64_t c = pixel_count(hs, k, x, y);
             if (c > mx)
                 mx = c;
         }
     ramp grey = ramp_grey();
     const ramp *rp = o->ramp ? o->ramp : &grey;
     double lmx = log1p((double)mx);
-    for (size_t p = 0; p < np; p++) {
-        float *px = im->px + 4 * p;
-        uint64_t c = cnt[p];
-        if (c == 0 || mx == 0) {
-            for (int ch = 0; ch < 4; ch++)
-                px[ch] = o->bg[ch];
-            continue;
-        }
-        double v = o->curve == TONEMAP_LOG ? log1p((double)c) / lmx : (double)c / (double)mx;
-        if (gamma != 1)
-            v = pow(v, 1 / gamma);
-        v *= bright;
-        if (v > 1)
-            v = 1;
-        if (o->colour == TONEMAP_RAMP) {
-            ramp_eval(rp, v, px);
-        } else {
-            for (int ch = 0; ch < 3; ch++) {
-                double mean = cs ? cs[3 * p + ch] / (double)c : 1.0;
-                px[ch] = (float)(o->bg[ch] + (mean - o->bg[ch]) * v);
+    /* v depends on the count only: small counts (most pixels) read it from
+     * a table filled with the same expression. */
+    enum { NV = 4096 };
+    double vt[NV];
+    size_t nv = mx < NV ? (size_t)mx + 1 : NV;
+    for (size_t c = 1; c < nv; c++)
+        vt[c] = density(o->curve, c, mx, lmx, gamma, bright);
+    for (int y = 0; y < im->h; y++)
+        for (int x = 0; x < im->w; x++) {
+            float *px = image_at(im, x, y);
+            uint64_t c = pixel_count(hs, k, x, y);
+            if (c == 0 || mx == 0) {
+                for (int ch = 0; ch < 4; ch++)
+                    px[ch] = o->bg[ch];
+                continue;
             }
-            px[3] = (float)(o->bg[3] + (1 - o->bg[3]) * v);
+            double v = c < nv ? vt[c] : density(o->curve, c, mx, lmx, gamma, bright);
+            if (o->colour == TONEMAP_RAMP) {
+                ramp_eval(rp, v, px);
+            } else {
+                double cs[3] = {1, 1, 1};
+                if (hs->csum)
+                    pixel_csum(hs, k, x, y, cs);
+                for (int ch = 0; ch < 3; ch++) {
+                    double mean = hs->csum ? cs[ch] / (double)c : 1.0;
+                    px[ch] = (float)(o->bg[ch] + (mean - o->bg[ch]) * v);
+                }
+                px[3] = (float)(o->bg[3] + (1 - o->bg[3]) * v);
+            }
         }
-    }
-    rt_free(cnt);
-    rt_free(cs);
     return RT_OK;
 }

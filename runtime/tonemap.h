@@ -38,7 +38,9 @@ typedef struct tonemap_opts {
     const ramp *ramp;   /* TONEMAP_RAMP; NULL = grey */
 } tonemap_opts;
 
-/* Map hs into im (already initialised to the output size, overwritten). */
+/* Map hs into im (already initialised to the output size, overwritten).
+ * Reads hs in place (two passes: the maximum, then the pixels); allocates
+ * nothing. */
 rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_error *e);
 
 #endif

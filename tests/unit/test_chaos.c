@@ -8,6 +8,7 @@
 
 #include "chaos.h"
 #include "check.h"
+#include "rng.h"
 #include "tonemap.h"
 
 /* Number of occupied boxes of side `side` bins (boxes tile from the top-left;
@@ -455,6 +456,20 @@ static void test_tonemap(void)
           "size message: %s", e.msg);
     image_free(&im);
     hist2_free(&hs);
+    /* counts on both sides of the 4096-entry table of v, k = 1 */
+    CHECK(hist2_init(&hs, 4, 1, lo, hi, 0, &e) == RT_OK, "hist");
+    hs.count[0] = 4095, hs.count[1] = 4096, hs.count[2] = 70000, hs.count[3] = 3;
+    CHECK(image_init(&im, 4, 1, &e) == RT_OK, "image");
+    tonemap_opts g = {0};
+    g.curve = TONEMAP_LOG;
+    g.gamma = 2.2;
+    CHECK(tonemap_apply(&hs, &g, &im, &e) == RT_OK, "log gamma");
+    for (int i = 0; i < 4; i++) {
+        double v = pow(log(1.0 + (double)hs.count[i]) / log(70001.0), 1 / 2.2);
+        CHECK_NEAR(im.px[4 * i], v, 1e-6, "log density, gamma 2.2");
+    }
+    image_free(&im);
+    hist2_free(&hs);
 }
 
 
@@ -543,6 +558,167 @@ static void test_3d_nondiagonal(void)
     ifs_free(&f);
 }
 
+/* chaos_hist2 ADDS to the histogram's counts (counts only: worker 0 counts
+ * straight into them, the others merge into them), for 1 and 2 threads. */
+static void test_hist_adds(void)
+{
+    rt_error e;
+    ifs f;
+    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
+                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
+                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
+    double p[4] = {0.01, 0.85, 0.07, 0.07};
+    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.points = 200000;
+    o.seed = 5;
+    o.chunk = 1 << 14;
+    double lo[2] = {-2.5, -0.2}, hi[2] = {2.9, 10.2};
+    hist2 a, b;
+    CHECK(hist2_init(&a, 48, 40, lo, hi, 0, &e) == RT_OK, "hist");
+    rt_run r1 = {1, NULL, 0};
+    CHECK(chaos_hist2(&s, &o, &a, NULL, &r1, &e) == RT_OK, "chaos");
+    uint64_t sum = 0;
+    for (size_t i = 0; i < 48 * 40; i++)
+        sum += a.count[i];
+    CHECK(sum > 190000 && sum <= 200000, "hits in the window: %llu", (unsigned long long)sum);
+    for (int t = 1; t <= 2; t++) {
+        rt_run run = {t, NULL, 0};
+        CHECK(hist2_init(&b, 48, 40, lo, hi, 0, &e) == RT_OK, "hist");
+        for (size_t i = 0; i < 48 * 40; i++)
+            b.count[i] = 7 + ((uint64_t)1 << 40); /* above 32 bits: no narrowing either */
+        CHECK(chaos_hist2(&s, &o, &b, NULL, &run, &e) == RT_OK, "chaos");
+        int bad = 0;
+        for (size_t i = 0; i < 48 * 40; i++)
+            bad += b.count[i] != a.count[i] + 7 + ((uint64_t)1 << 40);
+        CHECK(bad == 0, "%d bins not added to with %d thread(s)", bad, t);
+        hist2_free(&b);
+    }
+    hist2_free(&a);
+    ifs_free(&f);
+}
+
+static int cmp_float(const void *x, const void *y)
+{
+    float a = *(const float *)x, b = *(const float *)y;
+    return (a > b) - (a < b);
+}
+
+/* chaos_fit against its definition (chaos.h), recomputed here from the same
+ * pre-pass points (chaos_points with the pre-pass seed and one chunk of
+ * CHAOS_FIT_POINTS) by sorting: 0.1 % quantiles, 5 % margins, then the
+ * aspect. The fern's stem puts ~1 % of the points on x = 0 exactly: ties. */
+static void test_fit_quantiles(void)
+{
+    rt_error e;
+    ifs f;
+    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
+                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
+                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
+    double p[4] = {0.01, 0.85, 0.07, 0.07};
+    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.seed = 31;
+    double lo[2], hi[2];
+    CHECK(chaos_fit(&s, &o, 300, 200, lo, hi, &e) == RT_OK, "fit");
+    chaos_opts po = o;
+    po.points = CHAOS_FIT_POINTS;
+    po.chunk = CHAOS_FIT_POINTS;
+    po.seed = rng_hash3(o.seed, 1ull << 63, 0, 0);
+    mesh m;
+    mesh_init(&m, 0, 0);
+    CHECK(chaos_points(&s, &po, &m, NULL, &e) == RT_OK, "points");
+    size_t np = CHAOS_FIT_POINTS, cut = np / 1000;
+    float *ax = malloc(np * sizeof *ax);
+    double wlo[2], whi[2];
+    long zeros = 0;
+    for (int a = 0; a < 2; a++) {
+        for (size_t i = 0; i < np; i++) {
+            ax[i] = m.pos[3 * i + a];
+            zeros += a == 0 && ax[i] == 0;
+        }
+        qsort(ax, np, sizeof *ax, cmp_float);
+        double c = 0.5 * ((double)ax[cut] + ax[np - 1 - cut]), x = ((double)ax[np - 1 - cut] - ax[cut]) * 1.1;
+        wlo[a] = c - 0.5 * x, whi[a] = c + 0.5 * x;
+    }
+    CHECK(zeros > 300, "stem points on x = 0: %ld", zeros);
+    double ex = whi[0] - wlo[0], ey = whi[1] - wlo[1], want = 1.5;
+    CHECK(ex / ey < want, "the fern is taller than 3:2");
+    double c = 0.5 * (wlo[0] + whi[0]);
+    wlo[0] = c - 0.5 * ey * want, whi[0] = c + 0.5 * ey * want;
+    for (int a = 0; a < 2; a++)
+        CHECK(lo[a] == wlo[a] && hi[a] == whi[a], "axis %d: [%.17g, %.17g], by sorting [%.17g, %.17g]",
+              a, lo[a], hi[a], wlo[a], whi[a]);
+    free(ax);
+    mesh_free(&m);
+    ifs_free(&f);
+}
+
+/* The stage chain holds no copies (the allocation hook sees every block):
+ * counts without colour on one thread go straight into the histogram and a
+ * 3-D measure into the volume's own memory; tone mapping allocates nothing.
+ * With two threads one private array (the second worker's) is the largest
+ * block. */
+static void test_no_copies(void)
+{
+    rt_error e;
+    rifs r;
+    affine m[8];
+    octant_maps(m);
+    CHECK(rifs_build(&r, m, 8, 1, T1, RIFS_NORMALISE, &e) == RT_OK, "build: %s", e.msg);
+    chaos_sys s3 = {NULL, &r};
+    chaos_opts o = {0};
+    o.points = 1 << 18;
+    o.chunk = 1 << 14;
+    o.seed = 3;
+    double lo[3] = {0, 0, 0}, hi[3] = {256, 256, 256}; /* the maps' attractor */
+    volume vol;
+    CHECK(volume_init(&vol, 64, 64, 64, lo, hi, &e) == RT_OK, "volume");
+    size_t voxels = 64 * 64 * 64;
+    rt_run r1 = {1, NULL, 0}, r2 = {2, NULL, 0};
+    check_limits(-1, -1, -1);
+    CHECK(chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r1, &e) == RT_OK, "volume 1");
+    CHECK(check_hs.peak < voxels, "1 thread: a block of %zu bytes beside the %zu voxels", check_hs.peak, voxels);
+    float *one = malloc(voxels * sizeof *one);
+    memcpy(one, vol.v, voxels * sizeof *one);
+    check_hs.peak = 0;
+    CHECK(chaos_volume(&s3, &o, CHAOS_NORM_TOTAL, &vol, NULL, &r2, &e) == RT_OK, "volume 2");
+    CHECK(check_hs.peak >= 4 * voxels && check_hs.peak < 4 * voxels + 64, "2 threads: largest block %zu", check_hs.peak);
+    CHECK(memcmp(one, vol.v, voxels * sizeof *one) == 0, "volume differs with 2 threads");
+    double sum = 0;
+    for (size_t i = 0; i < voxels; i++)
+        sum += vol.v[i];
+    CHECK_NEAR(sum, 1.0, 1e-5, "total measure");
+    check_limits_off();
+    free(one);
+    volume_free(&vol);
+    rifs_free(&r);
+
+    ifs f;
+    affine tri[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                     affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5)};
+    CHECK(ifs_build(&f, tri, 3, NULL, 0, &e) == RT_OK, "triangle");
+    chaos_sys s2 = {&f, NULL};
+    hist2 hs;
+    double lo2[2] = {0, 0}, hi2[2] = {1, 1};
+    CHECK(hist2_init(&hs, 256, 256, lo2, hi2, 0, &e) == RT_OK, "hist");
+    image im;
+    CHECK(image_init(&im, 128, 128, &e) == RT_OK, "image");
+    check_limits(-1, -1, -1);
+    CHECK(chaos_hist2(&s2, &o, &hs, NULL, &r1, &e) == RT_OK, "hist 1");
+    CHECK(check_hs.peak < 256 * 256, "1 thread: a block of %zu bytes beside the histogram", check_hs.peak);
+    check_hs.peak = 0;
+    tonemap_opts t = {0};
+    CHECK(tonemap_apply(&hs, &t, &im, &e) == RT_OK, "tonemap");
+    CHECK(check_hs.peak == 0, "tone mapping allocated %zu bytes", check_hs.peak);
+    check_limits_off();
+    image_free(&im);
+    hist2_free(&hs);
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -552,5 +728,8 @@ int main(void)
     test_threads();
     test_3d_nondiagonal();
     test_tonemap();
+    test_hist_adds();
+    test_fit_quantiles();
+    test_no_copies();
     return check_done("test_chaos");
 }

@@ -189,11 +189,77 @@ static void test_blocks(void)
     CHECK(o1[2] == noise_perlin3(&np, px[202], py[202], pz[202]), "short block");
 }
 
+/* Every SIMD level this machine runs (noise_simd_best and below) against the
+ * scalar functions, bit for bit: coherent and scattered points, negative
+ * ones, lattice points and half-integers, values near ±2^30 (the fast
+ * lattice path's bound), huge, infinite and NaN coordinates mixed into the
+ * same groups of four, block lengths that leave a tail of 1..3. */
+static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static void test_simd_levels(void)
+{
+    enum { N = 20003 };
+    static double x[N], y[N], z[N], out[N];
+    rng r;
+    rng_init(&r, 77, 1);
+    for (size_t i = 0; i < N; i++) {
+        double u = rng_uniform(&r), v = rng_uniform(&r), w = rng_uniform(&r);
+        switch (i % 8) {
+        case 0: x[i] = u * 10, y[i] = v * 10, z[i] = w * 10; break;           /* coherent-ish */
+        case 1: x[i] = (u - .5) * 1e6, y[i] = (v - .5) * 1e6, z[i] = w * -3e5; break; /* scattered */
+        case 2: x[i] = floor(u * 40) - 20, y[i] = floor(v * 40) * 0.5, z[i] = -0.0; break; /* lattice */
+        case 3: x[i] = 1073741824.0 * (u < .5 ? 1 : -1) - (v - .5) * 4, y[i] = w, z[i] = u; break; /* ±2^30 */
+        case 4: x[i] = u * 1e300, y[i] = v, z[i] = w; break;
+        case 5: x[i] = u < .3 ? INFINITY : u < .6 ? -INFINITY : NAN, y[i] = v, z[i] = w; break;
+        default: x[i] = (u - .5) * 300, y[i] = (v - .5) * 300, z[i] = (w - .5) * 300; break;
+        }
+    }
+    noise_perm np;
+    noise_perm_init(&np, 12345);
+    int best = noise_simd_best();
+    CHECK(best >= NOISE_LEVEL_SSE2, "an x86-64 machine has at least SSE2 (level %d)", best);
+    for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
+        size_t lens[4] = {N, N - 1, N - 2, 5};
+        for (int li = 0; li < 4; li++) {
+            size_t n = lens[li];
+            long bad = 0;
+            noise_perlin3_block_at(level, &np, n, x, y, z, out);
+            for (size_t i = 0; i < n; i++)
+                bad += !same_bits(out[i], noise_perlin3(&np, x[i], y[i], z[i]));
+            CHECK(bad == 0, "level %d, n %zu: %ld perlin values differ from the scalar ones", level, n, bad);
+            bad = 0;
+            noise_fbm3_block_at(level, &np, 6, 2.0, 0.5, n, x, y, z, out);
+            for (size_t i = 0; i < n; i++)
+                bad += !same_bits(out[i], noise_fbm3(&np, 6, 2.0, 0.5, x[i], y[i], z[i]));
+            CHECK(bad == 0, "level %d, n %zu: %ld fBm values differ", level, n, bad);
+            bad = 0;
+            noise_fbm3_block_at(level, &np, 3, 1.9, 0.6, n, x, y, z, out);
+            for (size_t i = 0; i < n; i++)
+                bad += !same_bits(out[i], noise_fbm3(&np, 3, 1.9, 0.6, x[i], y[i], z[i]));
+            CHECK(bad == 0, "level %d, n %zu: %ld fBm (1.9, 0.6) values differ", level, n, bad);
+            bad = 0;
+            noise_turbulence3_block_at(level, &np, 5, n, x, y, z, out);
+            for (size_t i = 0; i < n; i++)
+                bad += !same_bits(out[i], noise_turbulence3(&np, 5, x[i], y[i], z[i]));
+            CHECK(bad == 0, "level %d, n %zu: %ld turbulence values differ", level, n, bad);
+        }
+    }
+    /* the reference value through the blocks (noise.h) */
+    noise_perm_reference(&np);
+    double rx[5] = {3.14, 3.14, 3.14, 3.14, 3.14}, ry[5] = {42, 42, 42, 42, 42}, rz[5] = {7, 7, 7, 7, 7};
+    for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
+        noise_perlin3_block_at(level, &np, 5, rx, ry, rz, out);
+        CHECK(out[0] == 0.13691995878400012 && out[4] == 0.13691995878400012, "level %d: n(3.14, 42, 7) = %.17g",
+              level, out[0]);
+    }
+}
+
 int main(void)
 {
     test_reference();
     test_properties();
     test_octaves();
     test_blocks();
+    test_simd_levels();
     return check_done("test_noise");
 }
