@@ -138,6 +138,8 @@ typedef struct interp {
     int quiet;
     int progress;
     const char *out_dir; /* NULL: current directory */
+    long frame;          /* the frame being rendered (--frames), for the recipe */
+    int frames_given;    /* 1 if a frame was given (otherwise frame is 0 and unused) */
     int is_repl;
     FILE *out;           /* where print() writes (stdout) */
 
