@@ -26,6 +26,7 @@
 #include "par.h"
 #include "parser.h"
 #include "recipe.h"
+#include "report.h"
 #include "repl.h"
 #include "session.h"
 #include "sha256.h"
@@ -72,6 +73,9 @@ static const char usage_text[] =
     "  --threads N           worker threads, 1 to 256 (default: all cores)\n"
     "  -q, --quiet           no progress bars or `wrote FILE` lines\n"
     "  --params              with check: list the script's params and defaults\n"
+    "  --stats               at the end of a run, print one line on stderr: the wall\n"
+    "                        time and each engine's work and rate (on a terminal\n"
+    "                        it is printed without --stats, unless --quiet)\n"
     "  --no-recipe           leave the script text out of the recipe that every\n"
     "                        output carries (its hash, params and seed stay)\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
@@ -172,6 +176,7 @@ typedef struct opts {
     const char *expr;
     int list_params;
     int no_recipe;      /* --no-recipe */
+    int stats;          /* --stats */
     int seed_given;     /* --seed (rerun takes the recipe's) */
     int nargs;
     const char **args;  /* the script's arguments (pointers into argv) */
@@ -222,7 +227,7 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
 
         if (!strcmp(name, "--help") || !strcmp(name, "-h") || !strcmp(name, "--version") ||
             !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params") ||
-            !strcmp(name, "--no-recipe")) {
+            !strcmp(name, "--no-recipe") || !strcmp(name, "--stats")) {
             if (inline_val)
                 return usage_error("%s takes no value (got '%s')", name, a);
             if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
@@ -233,6 +238,10 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                 return EX_OK;
             } else if (!strcmp(name, "--params")) {
                 o->list_params = 1;
+            } else if (!strcmp(name, "--stats")) {
+                if (o->stats)
+                    return usage_error("%s is given twice", name);
+                o->stats = 1;
             } else if (!strcmp(name, "--no-recipe")) {
                 if (o->no_recipe)
                     return usage_error("%s is given twice", name);
@@ -316,6 +325,11 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
     if ((info || rerun) && (o->nov || o->seed_given))
         return usage_error("%s takes the params and the seed from the file's recipe (%s given)", o->mode,
                            o->nov ? "-D" : "--seed");
+    if (o->stats && strcmp(o->mode, "run") != 0 && !rerun)
+        return usage_error("--stats goes with running a script (frac SCRIPT or frac rerun FILE), not %s",
+                           strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
+    if (o->no_recipe && strcmp(o->mode, "check") == 0)
+        return usage_error("%s", "--no-recipe is for runs that write files; check writes none");
     if (info && (I->out_dir || o->no_recipe))
         return usage_error("info only reads the file (%s does not go with it)", I->out_dir ? "-o" : "--no-recipe");
     if (o->list_params && strcmp(o->mode, "check") != 0)
@@ -801,12 +815,16 @@ static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t
     recipe_store st;
     if (!check && install_recipe(I, o, o->script, (const char *)text, len, &st))
         return session_report(I);
+    double t0 = report_clock();
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
         rc = session_report(I);
     } else {
         rc = EX_OK;
         if (check && o->list_params)
             print_params(I);
+        /* the render report: asked for, or on a terminal when an engine ran */
+        if (!check && (o->stats || (!I->quiet && I->nwork && isatty(2))))
+            report_print(I, report_clock() - t0, stderr);
     }
     if (!check)
         recipe_uninstall(&st);
