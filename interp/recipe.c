@@ -79,10 +79,14 @@ void recipe_text(const recipe *r, bytebuf *out, size_t *header_len, char *onelin
             bytebuf_byte(&l, ' ');
             put_escaped(&l, r->params[i]);
         }
-        size_t k = l.failed ? 0 : l.len < n - 1 ? l.len : n - 1;
-        if (k)
-            memcpy(oneline, l.data, k);
-        oneline[k] = 0;
+        if (l.failed) { /* out of memory: the version at least */
+            snprintf(oneline, n, "frac %s", r->version);
+        } else {
+            size_t k = l.len < n - 1 ? l.len : n - 1;
+            if (k)
+                memcpy(oneline, l.data, k);
+            oneline[k] = 0;
+        }
         bytebuf_free(&l);
     }
 }
