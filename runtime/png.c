@@ -120,7 +120,7 @@ static void filter_row(int ft, const unsigned char *cur, const unsigned char *pr
  * (§11.3.4.5: keyword, NUL, compression flag 1, method 0, empty language
  * tag and translated keyword, each ended by NUL, then the zlib stream of
  * the UTF-8 text). */
-static rt_code put_recipe(bytebuf *out, rt_error *e)
+rt_code png_put_recipe(bytebuf *out, rt_error *e)
 {
     const prov *p = prov_get();
     if (!p)
@@ -222,7 +222,7 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
     ihdr[10] = ihdr[11] = ihdr[12] = 0; /* deflate, adaptive filtering, no interlace */
     bytebuf_append(out, png_sig, 8);
     put_chunk(out, "IHDR", ihdr, 13);
-    c = put_recipe(out, e);
+    c = png_put_recipe(out, e);
     if (c) {
         bytebuf_free(&z);
         return c;

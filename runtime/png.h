@@ -72,6 +72,11 @@ rt_code png_read_info(const unsigned char *data, size_t n, png_info *info, rt_er
 rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *info, rt_error *e);
 rt_code png_load(const char *path, image *im, png_info *info, rt_error *e);
 
+/* Append the provenance chunks (tEXt Software, iTXt frac:recipe; see
+ * provenance.h) when a recipe is set, nothing otherwise. png_encode_samples
+ * puts them right after IHDR; other PNG writers (APNG) should do the same. */
+rt_code png_put_recipe(bytebuf *out, rt_error *e);
+
 /* The first tEXt, zTXt or iTXt chunk whose keyword is `keyword`: its text
  * (inflated when compressed, at most max_len bytes) is appended to out and
  * *found set to 1; *found = 0 when there is none. Every chunk's CRC up to
