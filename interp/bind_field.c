@@ -22,6 +22,7 @@
 #include "lang_objects.h"
 #include "lexer.h"
 #include "raymarch.h"
+#include "report.h"
 
 typedef struct field_val {
     field *f;
@@ -577,7 +578,10 @@ static int b_sample(interp *I, value *a, int n, value *out)
     }
     rt_run run = lang_run(I);
     rt_error e;
+    double t0 = report_clock();
     rt_code c = field_sample_volume(field_prog_fn, prog, vol, &run, &e);
+    if (!c)
+        report_work(I, "sample", "voxels", (double)g[0] * g[1] * g[2], t0);
     lang_field_fn_done(tmp, own);
     if (c) {
         val_unref(I, res);
@@ -615,6 +619,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c;
+    double t0 = report_clock();
     volume *vol = lang_as_volume(a[0]);
     if (vol) {
         c = iso_from_volume(vol, &o, &run, m, &e);
@@ -645,6 +650,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         mem_free(I, m);
         return lang_rt_error(I, c, &e, "isosurface");
     }
+    report_work(I, "isosurface", "triangles", (double)m->nt, t0);
     return lang_mesh_value(I, m, out);
 }
 
@@ -696,6 +702,7 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     rt_code c;
     rt_error e;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     volume *vol = lang_as_volume(a[0]);
     if (vol) {
         c = rm_render(rm_volume_field, vol, &cam, &o, &run, im, &e);
@@ -718,6 +725,7 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
         val_unref(I, res);
         return lang_rt_error(I, c, &e, "raymarch");
     }
+    report_work(I, "raymarch", "rays", (double)im->w * im->h, t0);
     *out = res;
     return 0;
 }

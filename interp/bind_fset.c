@@ -22,6 +22,7 @@
 #include "lang_objects.h"
 #include "lexer.h"
 #include "tonemap.h"
+#include "report.h"
 
 /* ---- function sets ---------------------------------------------------------------------- */
 
@@ -636,7 +637,10 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     image *im = NULL;
     c = hist2_init(&hs, w, h, lo, hi, 0, &e);
     if (!c) {
+        double t0 = report_clock();
         c = fset_chaos(&f->fs, &o, &co, &hs, &run, &e);
+        if (!c)
+            report_work(I, "chaos game", "points", (double)co.points, t0);
         if (!c && !lang_image_new(I, w, h, &im))
             c = tonemap_apply(&hs, &t, im, &e);
         hist2_free(&hs);

@@ -25,6 +25,7 @@
 #include "lang_objects.h"
 #include "lexer.h"
 #include "tonemap.h"
+#include "report.h"
 
 /* ---- maps --------------------------------------------------------------------------- */
 
@@ -638,7 +639,10 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     }
     rt_run run = lang_run(I);
     chaos_stats st;
+    double t0 = report_clock();
     c = chaos_hist2(&s, &o, &hs, &st, &run, &e);
+    if (!c)
+        report_work(I, "chaos game", "points", (double)o.points, t0);
     image *im = NULL;
     if (!c && !lang_image_new(I, w, h, &im))
         c = tonemap_apply(&hs, &t, im, &e);
@@ -702,7 +706,10 @@ static int b_measure(interp *I, value *a, int n, value *out)
         value res;
         if (lang_volume_value(I, vol, &res))
             return -1;
+        double t0 = report_clock();
         c = chaos_volume(&s, &o, nm, vol, &st, &run, &e);
+        if (!c)
+            report_work(I, "chaos game", "points", (double)o.points, t0);
         if (c) {
             val_unref(I, res);
             return lang_rt_error(I, c, &e, "measure");
@@ -722,7 +729,10 @@ static int b_measure(interp *I, value *a, int n, value *out)
     }
     c = hist2_init(&hs, w, h, lo, hi, 0, &e);
     if (!c) {
+        double t0 = report_clock();
         c = chaos_hist2(&s, &o, &hs, &st, &run, &e);
+        if (!c)
+            report_work(I, "chaos game", "points", (double)o.points, t0);
         if (!c)
             c = chaos_measure2(&hs, nm, st.plotted, im, &e);
         hist2_free(&hs);
@@ -751,7 +761,10 @@ static int b_points(interp *I, value *a, int n, value *out)
     mesh_init(m, 0, o.colour != CHAOS_COLOUR_NONE);
     rt_run run = lang_run(I);
     rt_error e;
+    double t0 = report_clock();
     rt_code c = chaos_points(&s, &o, m, &run, &e);
+    if (!c)
+        report_work(I, "chaos game", "points", (double)o.points, t0);
     if (c) {
         mesh_free(m);
         mem_free(I, m);
@@ -796,7 +809,10 @@ static int b_view(interp *I, value *a, int n, value *out)
     }
     rt_run run = lang_run(I);
     chaos_stats st;
+    double t0 = report_clock();
     c = chaos_project(&s, &o, &cam, im, &st, &run, &e);
+    if (!c)
+        report_work(I, "chaos game", "points", (double)o.points, t0);
     return lang_image_finish(I, im, c, &e, "view", out);
 }
 

@@ -11,6 +11,7 @@
 #include "lang_wrinkly.h"
 #include "raster.h"
 #include "wrinkly.h"
+#include "report.h"
 
 /* ---- rasterising ------------------------------------------------------------------- */
 
@@ -159,7 +160,10 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
         goto done;
     rt_run run = lang_run(I);
     rt_error e;
+    double t0 = report_clock();
     rt_code c = raster_render(single, &cam, &ro, &run, im, &e);
+    if (!c)
+        report_work(I, "rasterize", "pixels", (double)w * h, t0);
     if (c) {
         lang_rt_error(I, c, &e, W);
         goto done;

@@ -20,6 +20,7 @@
 #include "mpd.h"
 #include "solid.h"
 #include "texobj.h"
+#include "report.h"
 
 #define AUTO_BUDGET ((size_t)64 << 20) /* automatic strategy: largest array it builds */
 
@@ -544,7 +545,10 @@ static int b_textured(interp *I, value *a, int n, value *out)
     }
     texobj_source src = {.field = field_prog_fn, .field_ctx = prog, .ramp = &r};
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     rt_code rc = texobj_render(&s, &cam, &src, &o, &run, im, NULL, &e);
+    if (!rc)
+        report_work(I, "textured", "pixels", (double)im->w * im->h, t0);
     lang_field_fn_done(tmp, own);
     if (rc) {
         val_unref(I, res);

@@ -25,8 +25,11 @@
 #include "fileio.h"
 #include "par.h"
 #include "parser.h"
+#include "recipe.h"
+#include "report.h"
 #include "repl.h"
 #include "session.h"
+#include "sha256.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
 
@@ -35,6 +38,9 @@ static const char usage_text[] =
     "                                          run a script; files it names are written\n"
     "       frac check [--params] [OPTIONS] SCRIPT.frac\n"
     "                                          parse and check without running anything\n"
+    "       frac info FILE                     print the recipe of a file frac wrote\n"
+    "       frac rerun FILE [-o DIR]           render it again from its recipe (same\n"
+    "                                          script, params, seed and frame)\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac --version | --help\n"
@@ -67,6 +73,11 @@ static const char usage_text[] =
     "  --threads N           worker threads, 1 to 256 (default: all cores)\n"
     "  -q, --quiet           no progress bars or `wrote FILE` lines\n"
     "  --params              with check: list the script's params and defaults\n"
+    "  --stats               at the end of a run, print one line on stderr: the wall\n"
+    "                        time and each engine's work and rate (on a terminal\n"
+    "                        it is printed without --stats, unless --quiet)\n"
+    "  --no-recipe           leave the script text out of the recipe that every\n"
+    "                        output carries (its hash, params and seed stay)\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -164,6 +175,9 @@ typedef struct opts {
     const char *script;
     const char *expr;
     int list_params;
+    int no_recipe;      /* --no-recipe */
+    int stats;          /* --stats */
+    int seed_given;     /* --seed (rerun takes the recipe's) */
     int nargs;
     const char **args;  /* the script's arguments (pointers into argv) */
     param_override *ov; /* -D as typed: name is "NAME=VALUE", text the VALUE */
@@ -172,7 +186,8 @@ typedef struct opts {
 
 static int is_command(const char *w)
 {
-    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0;
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 ||
+           strcmp(w, "info") == 0 || strcmp(w, "rerun") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -211,7 +226,8 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             f++;
 
         if (!strcmp(name, "--help") || !strcmp(name, "-h") || !strcmp(name, "--version") ||
-            !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params")) {
+            !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params") ||
+            !strcmp(name, "--no-recipe") || !strcmp(name, "--stats")) {
             if (inline_val)
                 return usage_error("%s takes no value (got '%s')", name, a);
             if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
@@ -222,6 +238,14 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                 return EX_OK;
             } else if (!strcmp(name, "--params")) {
                 o->list_params = 1;
+            } else if (!strcmp(name, "--stats")) {
+                if (o->stats)
+                    return usage_error("%s is given twice", name);
+                o->stats = 1;
+            } else if (!strcmp(name, "--no-recipe")) {
+                if (o->no_recipe)
+                    return usage_error("%s is given twice", name);
+                o->no_recipe = 1;
             } else {
                 I->quiet = 1;
                 I->progress = 0;
@@ -268,6 +292,7 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                     return usage_error("%s takes %s, got '%s'", name, what, val);
                 set_numflag(I, f, d);
                 seen[f] = 1;
+                o->seed_given |= f == F_SEED;
             }
             continue;
         }
@@ -292,6 +317,21 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                            o->script, o->script);
     if ((strcmp(o->mode, "run") == 0 || strcmp(o->mode, "check") == 0) && !o->script)
         return usage_error("%s needs a script file (or - for standard input)", o->mode);
+    int info = strcmp(o->mode, "info") == 0, rerun = strcmp(o->mode, "rerun") == 0;
+    if ((info || rerun) && !o->script)
+        return usage_error("%s needs a file that frac wrote (frac %s FILE)", o->mode, o->mode);
+    if ((info || rerun) && o->nargs)
+        return usage_error("%s takes one file (got '%s' too)", o->mode, o->args[0]);
+    if ((info || rerun) && (o->nov || o->seed_given))
+        return usage_error("%s takes the params and the seed from the file's recipe (%s given)", o->mode,
+                           o->nov ? "-D" : "--seed");
+    if (o->stats && strcmp(o->mode, "run") != 0 && !rerun)
+        return usage_error("--stats goes with running a script (frac SCRIPT or frac rerun FILE), not %s",
+                           strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
+    if (o->no_recipe && strcmp(o->mode, "check") == 0)
+        return usage_error("%s", "--no-recipe is for runs that write files; check writes none");
+    if (info && (I->out_dir || o->no_recipe))
+        return usage_error("info only reads the file (%s does not go with it)", I->out_dir ? "-o" : "--no-recipe");
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -493,6 +533,201 @@ static int finish_output(int rc)
     return rc;
 }
 
+/* ---- recipes: what every output carries, frac info, frac rerun ------------------------- */
+
+/* The recipe of this run (recipe.h), handed to the writers. text NULL: no
+ * script (the REPL). */
+static int install_recipe(interp *I, const opts *o, const char *path, const char *text, size_t len,
+                          recipe_store *st)
+{
+    recipe r;
+    memset(&r, 0, sizeof r);
+    r.version = (char *)FRAC_VERSION;
+    r.script_path = (char *)path;
+    if (text)
+        sha256_hex(text, len, r.sha256);
+    r.seed = I->seed;
+    r.frame_given = I->frames_given;
+    r.frame = I->frame;
+    char **params = mem_alloc(I, (size_t)(o->nov ? o->nov : 1) * sizeof *params);
+    if (!params)
+        return -1;
+    for (int k = 0; k < o->nov; k++)
+        params[k] = (char *)o->ov[k].name; /* "NAME=VALUE" as typed */
+    r.nparams = o->nov;
+    r.params = params;
+    r.nargs = o->nargs;
+    r.args = (char **)o->args;
+    r.has_script = text && !o->no_recipe;
+    r.script = (char *)text;
+    r.script_len = len;
+    int rc = recipe_install(&r, st);
+    mem_free(I, params);
+    if (rc)
+        mem_engine_error(I, "recipe", "out of memory building the recipe");
+    return rc;
+}
+
+/* Read FILE's recipe into *r. Returns 0, or the exit code (the message printed). */
+static int read_recipe(const char *path, recipe *r, char *oneline, size_t on)
+{
+    unsigned char *d;
+    size_t n;
+    rt_error e;
+    rt_code c = fileio_read_all(path, (size_t)1 << 31, &d, &n, &e);
+    if (c) {
+        fprintf(stderr, "frac: error: %s\n", e.msg);
+        return c == RT_ENOMEM ? EX_SOFTWARE : EX_IO;
+    }
+    char *text, err[256];
+    size_t len;
+    int found = recipe_find(d, n, &text, &len, oneline, on, err, sizeof err);
+    rt_free(d);
+    if (found < 0) {
+        fprintf(stderr, "frac: error: '%s': %s\n", path, err);
+        return EX_SCRIPT;
+    }
+    if (found > 0) {
+        if (!oneline[0])
+            fprintf(stderr, "frac: error: '%s' carries no frac recipe (frac writes one into the PNG, PPM/PGM, "
+                            "NRRD, VTK, PLY, OBJ, STL, SVG and flame files it saves)\n", path);
+        return oneline[0] ? -1 : EX_SCRIPT;
+    }
+    int bad = recipe_parse(text, len, r, err, sizeof err);
+    rt_free(text);
+    if (bad) {
+        fprintf(stderr, "frac: error: '%s': %s\n", path, err);
+        return EX_SCRIPT;
+    }
+    if (r->script) {
+        char hex[65];
+        sha256_hex(r->script, r->script_len, hex);
+        if (strcmp(hex, r->sha256) != 0) {
+            fprintf(stderr, "frac: error: '%s': the recipe's script text does not match its script-sha256 "
+                            "(the file is damaged)\n", path);
+            recipe_free(r);
+            return EX_SCRIPT;
+        }
+    }
+    return 0;
+}
+
+static int info_main(const char *path)
+{
+    recipe r;
+    char oneline[256];
+    int rc = read_recipe(path, &r, oneline, sizeof oneline);
+    if (rc == -1) { /* VTK, STL: the one-line form only */
+        printf("%s\n(a one-line recipe: this format has no room for more)\n", oneline);
+        return EX_OK;
+    }
+    if (rc)
+        return rc;
+    bytebuf b;
+    bytebuf_init(&b);
+    recipe_text(&r, &b, NULL, NULL, 0);
+    if (!b.failed)
+        fwrite(b.data, 1, b.len, stdout);
+    if (!r.script && r.has_script)
+        printf("(the script text is not in this file: only PNG files carry it)\n");
+    if (r.script && r.script_len && r.script[r.script_len - 1] != '\n')
+        putchar('\n');
+    bytebuf_free(&b);
+    recipe_free(&r);
+    return EX_OK;
+}
+
+/* Print how to run the recipe's script by hand (when the file lacks its text). */
+static void print_run_line(const recipe *r)
+{
+    fprintf(stderr, "  run the script itself: frac %s --seed %llu", r->script_path, (unsigned long long)r->seed);
+    for (int k = 0; k < r->nparams; k++)
+        fprintf(stderr, " -D '%s'", r->params[k]);
+    if (r->nargs)
+        fprintf(stderr, " --");
+    for (int k = 0; k < r->nargs; k++)
+        fprintf(stderr, " '%s'", r->args[k]);
+    fprintf(stderr, "\n");
+}
+
+/* frac rerun FILE: the recipe's script, params, args, seed and frame become
+ * this run's (o and I), *text its script. Returns 0 or the exit code. */
+static int rerun_prepare(interp *I, opts *o, recipe *r, char **text, size_t *len)
+{
+    char oneline[256];
+    const char *file = o->script;
+    int rc = read_recipe(file, r, oneline, sizeof oneline);
+    if (rc == -1) {
+        fprintf(stderr, "frac: error: '%s' carries only a one-line recipe (%s), not the script: "
+                        "it cannot be rerun\n", file, oneline);
+        return EX_SCRIPT;
+    }
+    if (rc)
+        return rc;
+    if (!r->script) {
+        fprintf(stderr, "frac: error: '%s' cannot be rerun: %s\n", file,
+                r->has_script ? "the file carries the recipe's header only, not the script text (only PNG files "
+                                "carry it)"
+                              : "its recipe was written with --no-recipe (or from the REPL) and has no script text");
+        if (r->script_path[0] != '<') /* not <repl> */
+            print_run_line(r);
+        return EX_SCRIPT;
+    }
+    if (strcmp(r->version, FRAC_VERSION) != 0)
+        fprintf(stderr, "frac: warning: '%s' was made by frac %s, this is frac %s: the files may differ\n", file,
+                r->version, FRAC_VERSION);
+    if (r->nparams > 0) {
+        param_override *ov = mem_calloc(I, (size_t)r->nparams, sizeof *ov);
+        if (!ov)
+            return session_report(I);
+        mem_free(I, o->ov);
+        o->ov = ov;
+    }
+    for (int k = 0; k < r->nparams; k++) {
+        o->ov[k].name = r->params[k];
+        o->ov[k].text = strchr(r->params[k], '=') + 1;
+    }
+    o->nov = r->nparams;
+    if (r->nargs > 0) {
+        const char **args = mem_calloc(I, (size_t)r->nargs, sizeof *args);
+        if (!args)
+            return session_report(I);
+        mem_free(I, o->args);
+        o->args = args;
+    }
+    for (int k = 0; k < r->nargs; k++)
+        o->args[k] = r->args[k];
+    o->nargs = r->nargs;
+    I->seed = r->seed;
+    I->frame = r->frame;
+    I->frames_given = r->frame_given;
+    o->script = r->script_path;
+    *text = r->script;
+    *len = r->script_len;
+    return 0;
+}
+
+static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t len);
+
+/* -D NAME=VALUE (o->ov) as the interpreter's param overrides. */
+static int set_overrides(interp *I, const opts *o)
+{
+    mem_free(I, I->overrides);
+    I->noverrides = o->nov;
+    I->overrides = mem_alloc(I, (size_t)(o->nov ? o->nov : 1) * sizeof *I->overrides);
+    if (!I->overrides)
+        return -1;
+    for (int k = 0; k < o->nov; k++) {
+        const char *eq = strchr(o->ov[k].name, '=');
+        I->overrides[k].name = interp_intern(I, o->ov[k].name, (size_t)(eq - o->ov[k].name));
+        I->overrides[k].text = o->ov[k].text;
+        I->overrides[k].used = 0;
+        if (!I->overrides[k].name)
+            return -1;
+    }
+    return 0;
+}
+
 static int run_frac(interp *I, opts *o)
 {
     int rc;
@@ -500,18 +735,8 @@ static int run_frac(interp *I, opts *o)
         rc = session_report(I);
         return rc ? rc : EX_SOFTWARE;
     }
-    I->noverrides = o->nov;
-    I->overrides = mem_alloc(I, (size_t)(o->nov ? o->nov : 1) * sizeof *I->overrides);
-    if (!I->overrides)
+    if (set_overrides(I, o))
         return session_report(I);
-    for (int k = 0; k < o->nov; k++) {
-        const char *eq = strchr(o->ov[k].name, '=');
-        I->overrides[k].name = interp_intern(I, o->ov[k].name, (size_t)(eq - o->ov[k].name));
-        I->overrides[k].text = o->ov[k].text;
-        I->overrides[k].used = 0;
-        if (!I->overrides[k].name)
-            return session_report(I);
-    }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_sigint;
@@ -521,16 +746,26 @@ static int run_frac(interp *I, opts *o)
     I->interrupt = &interrupted;
 
     int check = strcmp(o->mode, "check") == 0;
+    if (strcmp(o->mode, "info") == 0)
+        return info_main(o->script);
     if (strcmp(o->mode, "repl") == 0) {
         if (I->out_dir && (rc = make_out_dir(I->out_dir)))
             return rc;
-        return repl_main(I, &interrupted);
+        recipe_store st;
+        if (install_recipe(I, o, "<repl>", NULL, 0, &st))
+            return session_report(I);
+        rc = repl_main(I, &interrupted);
+        recipe_uninstall(&st);
+        return rc;
     }
     if (strcmp(o->mode, "eval") == 0) {
         if (I->out_dir && (rc = make_out_dir(I->out_dir)))
             return rc;
         value v = val_nil();
         rc = EX_OK;
+        recipe_store st;
+        if (install_recipe(I, o, "<-e>", o->expr, strlen(o->expr), &st))
+            return session_report(I);
         if (session_run(I, "<-e>", o->expr, strlen(o->expr), 0, &v)) {
             rc = session_report(I);
         } else {
@@ -547,30 +782,61 @@ static int run_frac(interp *I, opts *o)
             bytebuf_free(&b);
         }
         val_unref(I, v);
+        recipe_uninstall(&st);
         return rc;
     }
     unsigned char *text;
     size_t len;
-    rc = read_script(I, o->script, &text, &len);
-    if (rc)
+    recipe rr;
+    int rerun = strcmp(o->mode, "rerun") == 0;
+    memset(&rr, 0, sizeof rr);
+    if (rerun) {
+        char *t = NULL;
+        if ((rc = rerun_prepare(I, o, &rr, &t, &len))) {
+            recipe_free(&rr);
+            return rc;
+        }
+        rr.script = NULL; /* the text is ours now (freed below) */
+        text = (unsigned char *)t;
+        if (set_overrides(I, o)) {
+            rt_free(text);
+            recipe_free(&rr);
+            return session_report(I);
+        }
+    } else if ((rc = read_script(I, o->script, &text, &len))) {
         return rc;
+    }
+    rc = run_script(I, o, check, text, len);
+    rt_free(text);
+    recipe_free(&rr);
+    return rc;
+}
+
+/* Run (or check) the script text: the common tail of run, check and rerun. */
+static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t len)
+{
+    int rc;
     const char *name = strcmp(o->script, "-") == 0 ? "<stdin>" : o->script;
-    if (set_script_args(I, o) || (o->nov && check_overrides(I, name, (const char *)text, len))) {
-        rt_free(text);
+    if (set_script_args(I, o) || (o->nov && check_overrides(I, name, (const char *)text, len)))
         return session_report(I);
-    }
-    if (!check && I->out_dir && (rc = make_out_dir(I->out_dir))) {
-        rt_free(text);
+    if (!check && I->out_dir && (rc = make_out_dir(I->out_dir)))
         return rc;
-    }
+    recipe_store st;
+    if (!check && install_recipe(I, o, o->script, (const char *)text, len, &st))
+        return session_report(I);
+    double t0 = report_clock();
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
         rc = session_report(I);
     } else {
         rc = EX_OK;
         if (check && o->list_params)
             print_params(I);
+        /* the render report: asked for, or on a terminal when an engine ran */
+        if (!check && (o->stats || (!I->quiet && I->nwork && isatty(2))))
+            report_print(I, report_clock() - t0, stderr);
     }
-    rt_free(text);
+    if (!check)
+        recipe_uninstall(&st);
     return rc;
 }
 

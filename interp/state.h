@@ -138,6 +138,12 @@ typedef struct interp {
     int quiet;
     int progress;
     const char *out_dir; /* NULL: current directory */
+    long frame;          /* the frame being rendered (--frames), for the recipe */
+    int frames_given;    /* 1 if a frame was given (otherwise frame is 0 and unused) */
+    /* work the engines did, for the render report (report.h) */
+#define WORK_MAX 12
+    struct { const char *engine, *unit; double amount, seconds; } work[WORK_MAX];
+    int nwork;
     int is_repl;
     FILE *out;           /* where print() writes (stdout) */
 

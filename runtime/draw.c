@@ -2,6 +2,7 @@
  * and byte-stable SVG (seed 003 Fig. 1, 3: drawing K_n). */
 #include "draw.h"
 #include "rt_alloc.h"
+#include "provenance.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -253,7 +254,9 @@ rt_code draw_svg_fill(bytebuf *b, const draw_view *v, const detiter_shape *s, co
         return rt_fail(e, RT_EINVAL, "SVG precision %d (expected 0 to 9)", precision);
     int d = s->dim;
     bytebuf_printf(b,
-                   "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                   "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    prov_put_xml_comment(b);
+    bytebuf_printf(b,
                    "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
                    "viewBox=\"0 0 %d %d\">\n",
                    v->w, v->h, v->w, v->h);

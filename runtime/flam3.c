@@ -1,5 +1,6 @@
 /* flam3.c — flame XML export (conventions in flam3.h). */
 #include "flam3.h"
+#include "provenance.h"
 
 #include <stdlib.h>
 
@@ -53,6 +54,7 @@ rt_code flam3_write(const chaos_sys *s, const flam3_opts *o, bytebuf *out, rt_er
     /* scale: pixels per unit, fitting the window's width (the height follows
      * from the aspect of size) */
     double scale = o->width / (o->hi[0] - o->lo[0]);
+    prov_put_xml_comment(out);
     bytebuf_printf(out, "<flame name=\"");
     put_escaped(out, o->name ? o->name : "frac");
     bytebuf_printf(out,

@@ -1,6 +1,7 @@
 /* mesh_io.c — PLY, OBJ and binary STL writers and readers (see mesh_io.h). */
 #include "mesh_io.h"
 #include "rt_alloc.h"
+#include "provenance.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +24,7 @@ rt_code mio_ply_to_mem(const mesh *m, int ascii, bytebuf *out, rt_error *e)
     if (m->failed)
         return rt_fail(e, RT_ENOMEM, "mesh is incomplete (an allocation failed)");
     bytebuf_printf(out, "ply\nformat %s 1.0\ncomment frac mesh\n", ascii ? "ascii" : "binary_little_endian");
+    prov_put_lines(out, "comment ");
     bytebuf_printf(out, "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n", m->nv);
     if (m->nrm)
         bytebuf_printf(out, "property float nx\nproperty float ny\nproperty float nz\n");
@@ -70,6 +72,7 @@ rt_code mio_obj_to_mem(const mesh *m, bytebuf *out, rt_error *e)
     if (m->failed)
         return rt_fail(e, RT_ENOMEM, "mesh is incomplete (an allocation failed)");
     bytebuf_printf(out, "# frac mesh\n");
+    prov_put_lines(out, "# ");
     for (size_t i = 0; i < m->nv && !out->failed; i++) {
         const float *p = m->pos + 3 * i;
         bytebuf_printf(out, "v %.9g %.9g %.9g", p[0], p[1], p[2]);
@@ -97,6 +100,12 @@ rt_code mio_stl_to_mem(const mesh *m, bytebuf *out, rt_error *e)
     if (m->nt > UINT32_MAX)
         return rt_fail(e, RT_EINVAL, "mesh has %zu triangles, more than STL can hold", m->nt);
     unsigned char hdr[80] = "frac mesh";
+    const prov *pv = prov_get(); /* the one-line recipe, cut to the 80 bytes there are */
+    if (pv && pv->oneline) {
+        size_t l = strlen(pv->oneline);
+        memset(hdr, ' ', sizeof hdr);
+        memcpy(hdr, pv->oneline, l < sizeof hdr ? l : sizeof hdr);
+    }
     bytebuf_append(out, hdr, 80);
     bytebuf_u32le(out, (uint32_t)m->nt);
     for (size_t t = 0; t < m->nt && !out->failed; t++) {

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "deflate.h"
+#include "provenance.h"
 
 #define PNG_MAX_DIM 0x7FFFFFFFu /* §11.2.2: width and height fit in 31 bits */
 #define PNG_MAX_FILE ((size_t)1 << 31)
@@ -114,6 +115,43 @@ static void filter_row(int ft, const unsigned char *cur, const unsigned char *pr
     }
 }
 
+/* The provenance chunks (provenance.h), between IHDR and IDAT: tEXt
+ * Software (§11.3.4.2's keyword) and a compressed iTXt `frac:recipe`
+ * (§11.3.4.5: keyword, NUL, compression flag 1, method 0, empty language
+ * tag and translated keyword, each ended by NUL, then the zlib stream of
+ * the UTF-8 text). */
+rt_code png_put_recipe(bytebuf *out, rt_error *e)
+{
+    const prov *p = prov_get();
+    if (!p)
+        return RT_OK;
+    if (p->software) {
+        bytebuf t;
+        bytebuf_init(&t);
+        bytebuf_append(&t, "Software", 9);
+        bytebuf_append(&t, p->software, strlen(p->software));
+        if (t.failed) {
+            bytebuf_free(&t);
+            return rt_fail(e, RT_ENOMEM, "out of memory writing the PNG recipe");
+        }
+        put_chunk(out, "tEXt", t.data, t.len);
+        bytebuf_free(&t);
+    }
+    if (p->recipe) {
+        bytebuf t;
+        bytebuf_init(&t);
+        bytebuf_append(&t, "frac:recipe\0\1\0\0\0", 16); /* 11 + 5 bytes */
+        rt_code c = deflate_zlib((const unsigned char *)p->recipe, p->recipe_len, 9, &t, e);
+        if (!c && t.failed)
+            c = rt_fail(e, RT_ENOMEM, "out of memory writing the PNG recipe");
+        if (!c)
+            put_chunk(out, "iTXt", t.data, t.len);
+        bytebuf_free(&t);
+        return c;
+    }
+    return RT_OK;
+}
+
 static rt_code check_enc_args(int w, int h, int channels, int bits, rt_error *e)
 {
     if (w < 1 || h < 1)
@@ -184,6 +222,11 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
     ihdr[10] = ihdr[11] = ihdr[12] = 0; /* deflate, adaptive filtering, no interlace */
     bytebuf_append(out, png_sig, 8);
     put_chunk(out, "IHDR", ihdr, 13);
+    c = png_put_recipe(out, e);
+    if (c) {
+        bytebuf_free(&z);
+        return c;
+    }
     const size_t piece = (size_t)1 << 20;
     for (size_t off = 0; off < z.len; off += piece)
         put_chunk(out, "IDAT", z.data + off, z.len - off < piece ? z.len - off : piece);
@@ -286,6 +329,60 @@ static rt_code read_chunk(const unsigned char *d, size_t n, size_t pos, uint32_t
         return rt_fail(e, RT_EFORMAT, "CRC mismatch in PNG chunk '%s' (stored %08x, computed %08x)",
                        type, (unsigned)stored, (unsigned)crc);
     *len = l;
+    return RT_OK;
+}
+
+rt_code png_text(const unsigned char *data, size_t n, const char *keyword, size_t max_len,
+                 bytebuf *out, int *found, rt_error *e)
+{
+    *found = 0;
+    rt_code c = check_sig(data, n, e);
+    if (c)
+        return c;
+    size_t klen = strlen(keyword);
+    for (size_t pos = 8; pos < n;) {
+        uint32_t len;
+        char type[5];
+        if ((c = read_chunk(data, n, pos, &len, type, e)))
+            return c;
+        const unsigned char *p = data + pos + 8;
+        pos += (size_t)len + 12;
+        if (!strcmp(type, "IEND"))
+            break;
+        int is_t = !strcmp(type, "tEXt"), is_z = !strcmp(type, "zTXt"), is_i = !strcmp(type, "iTXt");
+        if (!(is_t || is_z || is_i) || len < klen + 1 || memcmp(p, keyword, klen) || p[klen])
+            continue;
+        const unsigned char *q = p + klen + 1, *end = p + len;
+        int compressed = is_z;
+        if (is_z) {
+            if (q >= end || *q != 0)
+                return rt_fail(e, RT_EFORMAT, "PNG zTXt '%s': unknown compression method", keyword);
+            q++;
+        } else if (is_i) {
+            if (end - q < 2 || q[0] > 1 || q[1] != 0)
+                return rt_fail(e, RT_EFORMAT, "PNG iTXt '%s': bad compression flag or method", keyword);
+            compressed = q[0];
+            q += 2;
+            for (int k = 0; k < 2; k++) { /* language tag, translated keyword */
+                const unsigned char *z = memchr(q, 0, (size_t)(end - q));
+                if (!z)
+                    return rt_fail(e, RT_EFORMAT, "PNG iTXt '%s' is truncated", keyword);
+                q = z + 1;
+            }
+        }
+        if (compressed) {
+            if ((c = inflate_zlib(q, (size_t)(end - q), max_len, out, e)))
+                return c;
+        } else {
+            if ((size_t)(end - q) > max_len)
+                return rt_fail(e, RT_ELIMIT, "PNG text '%s' is longer than %zu bytes", keyword, max_len);
+            bytebuf_append(out, q, (size_t)(end - q));
+        }
+        if (out->failed)
+            return rt_fail(e, RT_ENOMEM, "out of memory reading PNG text '%s'", keyword);
+        *found = 1;
+        return RT_OK;
+    }
     return RT_OK;
 }
 

@@ -3,8 +3,9 @@
  *
  * Encoding. png_encode converts a float RGBA image to 8- or 16-bit samples
  * with round(clamp(v, 0, 1) * maxval) and writes a PNG with only IHDR, IDAT
- * and IEND (no time, text or gamma chunks), so identical pixels always give
- * identical bytes. channels selects the colour type:
+ * and IEND (no time or gamma chunks), so identical pixels always give
+ * identical bytes; when a recipe is set (provenance.h) a tEXt Software and
+ * an iTXt frac:recipe chunk follow IHDR. channels selects the colour type:
  *   1  grey        (colour type 0)  grey = Rec. 709 luminance of R, G, B
  *   2  grey+alpha  (colour type 4)
  *   3  RGB         (colour type 2)  alpha is dropped (not composited)
@@ -70,6 +71,18 @@ rt_code png_save(const image *im, const char *path, int bits, int channels, rt_e
 rt_code png_read_info(const unsigned char *data, size_t n, png_info *info, rt_error *e);
 rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *info, rt_error *e);
 rt_code png_load(const char *path, image *im, png_info *info, rt_error *e);
+
+/* Append the provenance chunks (tEXt Software, iTXt frac:recipe; see
+ * provenance.h) when a recipe is set, nothing otherwise. png_encode_samples
+ * puts them right after IHDR; other PNG writers (APNG) should do the same. */
+rt_code png_put_recipe(bytebuf *out, rt_error *e);
+
+/* The first tEXt, zTXt or iTXt chunk whose keyword is `keyword`: its text
+ * (inflated when compressed, at most max_len bytes) is appended to out and
+ * *found set to 1; *found = 0 when there is none. Every chunk's CRC up to
+ * it is checked. Used by `frac info` for the recipe (provenance.h). */
+rt_code png_text(const unsigned char *data, size_t n, const char *keyword, size_t max_len,
+                 bytebuf *out, int *found, rt_error *e);
 
 /* round(clamp(v, 0, 1) * maxval); NaN gives 0. */
 unsigned png_sample(float v, unsigned maxval);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "png.h"
+#include "provenance.h"
 
 typedef struct hdr {
     const unsigned char *d;
@@ -95,7 +96,9 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
         return rt_fail(e, RT_EINVAL, "PGM/PPM channels %d is invalid (expected 1 or 3)",
                        channels);
     unsigned maxval = bits == 16 ? 65535 : 255;
-    bytebuf_printf(out, "P%c\n%d %d\n%u\n", channels == 1 ? '5' : '6', im->w, im->h, maxval);
+    bytebuf_printf(out, "P%c\n", channels == 1 ? '5' : '6');
+    prov_put_lines(out, "# "); /* the recipe, as header comments */
+    bytebuf_printf(out, "%d %d\n%u\n", im->w, im->h, maxval);
     size_t rb = (size_t)im->w * (size_t)channels * (size_t)(bits / 8);
     unsigned char *row = rt_malloc(rb ? rb : 1);
     if (!row)

@@ -22,8 +22,11 @@ static void draw(progress *p)
     for (int i = 0; i < WIDTH; i++)
         bar[i] = i < fill ? '#' : '.';
     bar[WIDTH] = 0;
-    fprintf(stderr, "\r%s [%s] %3d%% %.1fs", p->label ? p->label : "", bar, (int)(f * 100.0),
-            now_seconds() - p->start);
+    double t = now_seconds() - p->start;
+    fprintf(stderr, "\r%s [%s] %3d%% %.1fs", p->label ? p->label : "", bar, (int)(f * 100.0), t);
+    /* the rest at the rate so far (chunks are equal work in most engines) */
+    if (f > 0 && f < 1)
+        fprintf(stderr, " ETA %.1fs\033[K", t * (1 - f) / f);
     fflush(stderr);
 }
 

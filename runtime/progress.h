@@ -1,7 +1,9 @@
 /* progress.h — a progress bar on stderr, drawn only when stderr is a terminal.
  *
  * Thread-safe: progress_step may be called from any worker. The bar redraws
- * at most ~20 times a second and is erased by progress_end.
+ * at most ~20 times a second and is erased by progress_end. It shows the
+ * label, the bar, the percentage, the time so far and, once some chunks are
+ * done, an ETA: the time so far × (remaining / done).
  */
 #ifndef PROGRESS_H
 #define PROGRESS_H

@@ -6,6 +6,7 @@
  */
 #include "volume_io.h"
 #include "rt_alloc.h"
+#include "provenance.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -86,6 +87,7 @@ rt_code vio_nrrd_to_mem(const volume *v, int type, const char *data_file, bytebu
     }
     bytebuf_printf(out, "NRRD0004\n");
     bytebuf_printf(out, "# frac volume: samples at cell centres, x fastest\n");
+    prov_put_lines(out, "# ");
     bytebuf_printf(out, "type: %s\n", tname[type]);
     bytebuf_printf(out, "dimension: 3\n");
     bytebuf_printf(out, "space: 3D-right-handed\n");
@@ -163,7 +165,9 @@ rt_code vio_vtk_to_mem(const volume *v, bytebuf *out, rt_error *e)
     }
     size_t n = (size_t)v->nx * (size_t)v->ny * (size_t)v->nz;
     bytebuf_printf(out, "# vtk DataFile Version 3.0\n");
-    bytebuf_printf(out, "frac volume\n");
+    /* the title line (at most 256 bytes): the one-line recipe when there is one */
+    const prov *pv = prov_get();
+    bytebuf_printf(out, "%.255s\n", pv && pv->oneline ? pv->oneline : "frac volume");
     bytebuf_printf(out, "BINARY\n");
     bytebuf_printf(out, "DATASET STRUCTURED_POINTS\n");
     bytebuf_printf(out, "DIMENSIONS %d %d %d\n", v->nx, v->ny, v->nz);

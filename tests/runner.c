@@ -901,8 +901,8 @@ static void run_repl_dir(const char *frac, const char *dir)
 }
 
 /* ---- interactive sessions on a pseudo-terminal ---------------------------------------
- * tests/pty/NAME.pty are ptyrun scripts played against `frac repl` on a
- * pty, in name order, with HOME pointing at one fresh folder (so history
+ * tests/pty/NAME.pty are ptyrun scripts played against `frac repl` (or,
+ * when the first line is "# args: A B", against `frac A B`) on a pty, in name order, with HOME pointing at one fresh folder (so history
  * carries from one script to the next). ptyrun must exit 0 and report
  * exit=0 and termios=same (raw mode restored). */
 static void run_pty_dir(const char *frac, const char *ptyrun)
@@ -919,15 +919,23 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
         char path[4096];
         snprintf(path, sizeof path, "tests/pty/%s", names[i]);
         if (matches_filter(path)) {
-            char *argv[] = {(char *)ptyrun, "--check-termios", "--timeout", "20", path, "--",
-                            (char *)frac, "repl", NULL};
+            char *argv[16] = {(char *)ptyrun, "--check-termios", "--timeout", "20", path, "--",
+                              (char *)frac, "repl", NULL};
+            /* a first line "# args: A B" runs `frac A B` instead of `frac repl` */
+            char *text = read_file(path, NULL);
+            if (text && strncmp(text, "# args: ", 8) == 0) {
+                char *nl = strchr(text, '\n');
+                if (nl)
+                    *nl = 0;
+                argv[7 + split_args(text + 8, argv + 7, 8)] = NULL;
+            }
             buf out = {0}, err = {0}, why = {0};
             int rc = run(argv, NULL, &out, &err, 120);
             int ok = rc == 0 && strstr(out.d, "exit=0") && strstr(out.d, "termios=same");
             if (!ok)
                 buf_fmt(&why, "  ptyrun exit %d\n  stdout: %s\n  stderr: %.3000s", rc, out.d, err.d);
             result(path, ok, &why);
-            free(out.d); free(err.d); free(why.d);
+            free(out.d); free(err.d); free(why.d); free(text);
         }
         free(names[i]);
     }
