@@ -303,11 +303,59 @@ static int b_load(interp *I, value *a, int n, value *out)
     return lang_image_value(I, im, out);
 }
 
+/* `%f` in an output path becomes the frame number (--frames; 0 outside it),
+ * zero-padded to I->frame_width digits (cfdg's convention; a negative frame
+ * keeps its '-' before the padded digits: -03); `%%` is one '%'. Any other
+ * '%' is an error, and so is a path without %f when several frames would
+ * each overwrite it. */
+static int expand_frame(interp *I, const char *p, size_t n, char *buf, size_t size, size_t *outn)
+{
+    size_t k = 0;
+    int has_f = 0;
+    for (size_t i = 0; i < n; i++) {
+        char piece[32];
+        size_t pl = 1;
+        piece[0] = p[i];
+        if (p[i] == '%') {
+            char c = i + 1 < n ? p[i + 1] : 0;
+            if (c == 'f') {
+                long f = I->frame;
+                int w = I->frame_width > 0 ? I->frame_width : 1;
+                pl = (size_t)snprintf(piece, sizeof piece, "%s%0*lu", f < 0 ? "-" : "", w,
+                                      f < 0 ? 0ul - (unsigned long)f : (unsigned long)f);
+                has_f = 1;
+            } else if (c != '%') {
+                return err_at(I, NULL, ERR_VALUE,
+                              "save: '%%%.*s' in the output path '%.*s' is neither %%f (the frame number) nor "
+                              "%%%% (a percent sign)",
+                              c ? 1 : 0, &p[i + 1], (int)n, p);
+            }
+            i++;
+        }
+        if (k + pl >= size)
+            return err_at(I, NULL, ERR_IO, "save: path too long: '%.40s…'", p);
+        memcpy(buf + k, piece, pl);
+        k += pl;
+    }
+    if (I->frame_count >= 2 && !has_f)
+        return err_at(I, NULL, ERR_VALUE, "save: output path '%.*s' has no %%f, every frame would overwrite it",
+                      (int)n, p);
+    buf[k] = 0;
+    *outn = k;
+    return 0;
+}
+
 int lang_output_path(interp *I, value path, char *buf, size_t size)
 {
     if (AS_STR(path)->len == 0)
         return err_at(I, NULL, ERR_VALUE, "save: the file name is empty");
-    return lang_join_path(I, NULL, I->out_dir, AS_STR(path)->s, AS_STR(path)->len, buf, size, "save");
+    if (!memchr(AS_STR(path)->s, '%', AS_STR(path)->len) && I->frame_count < 2)
+        return lang_join_path(I, NULL, I->out_dir, AS_STR(path)->s, AS_STR(path)->len, buf, size, "save");
+    char name[4096];
+    size_t n = 0;
+    if (expand_frame(I, AS_STR(path)->s, AS_STR(path)->len, name, sizeof name, &n))
+        return -1;
+    return lang_join_path(I, NULL, I->out_dir, name, n, buf, size, "save");
 }
 
 static int b_save(interp *I, value *a, int n, value *out)

@@ -67,6 +67,11 @@ static const char usage_text[] =
     "  --threads N           worker threads, 1 to 256 (default: all cores)\n"
     "  -q, --quiet           no progress bars or `wrote FILE` lines\n"
     "  --params              with check: list the script's params and defaults\n"
+    "  --frames A..B[:STEP]  run the script once per frame A, A+STEP, … ≤ B, each\n"
+    "                        in a fresh interpreter; the names `frame` (the number)\n"
+    "                        and `clock` (0 at A, 1 at B) are 0 without it; `%f` in\n"
+    "                        an output path is the frame number, zero-padded to the\n"
+    "                        width of B; `%%` is a %. See docs/animation.md\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -168,7 +173,65 @@ typedef struct opts {
     const char **args;  /* the script's arguments (pointers into argv) */
     param_override *ov; /* -D as typed: name is "NAME=VALUE", text the VALUE */
     int nov;
+    const char *frames;           /* --frames A..B[:STEP] as typed; NULL: one plain run */
+    long fa, fb, fstep;           /* its numbers */
+    const unsigned char *text;    /* the script, read once for all frames (NULL: read it) */
+    size_t len;
 } opts;
+
+/* One number of --frames, the n characters at s: an optional '-' and
+ * decimal digits, at most FRAME_MAX in size. */
+#define FRAME_MAX 999999999L
+#define FRAME_COUNT_MAX 100000L
+static int frame_number(const char *spec, const char *s, size_t n, long *out)
+{
+    size_t i = n && *s == '-';
+    long v = 0;
+    int ok = i < n;
+    for (; ok && i < n; i++) {
+        ok = s[i] >= '0' && s[i] <= '9' && (v = v * 10 + (s[i] - '0')) <= FRAME_MAX;
+    }
+    if (!ok) {
+        usage_error("--frames %s: '%.*s' is not a whole number from -%ld to %ld", spec, (int)n, s, FRAME_MAX,
+                    FRAME_MAX);
+        return -1;
+    }
+    *out = *s == '-' ? -v : v;
+    return 0;
+}
+
+/* --frames A..B[:STEP]: whole numbers, A <= B, STEP >= 1, at most
+ * FRAME_COUNT_MAX frames. Prints the usage error and returns -1 if not. */
+static int parse_frames(opts *o)
+{
+    const char *s = o->frames, *dots = strstr(s, ".."), *colon = dots ? strchr(dots + 2, ':') : NULL;
+    long a, b, step = 1;
+    if (!dots) {
+        usage_error("--frames takes A..B or A..B:STEP (e.g. 0..47 or 0..94:2), got '%s'", s);
+        return -1;
+    }
+    const char *bend = colon ? colon : dots + 2 + strlen(dots + 2);
+    if (frame_number(s, s, (size_t)(dots - s), &a) || frame_number(s, dots + 2, (size_t)(bend - dots - 2), &b) ||
+        (colon && frame_number(s, colon + 1, strlen(colon + 1), &step)))
+        return -1;
+    if (b < a) {
+        usage_error("--frames %s: the last frame %ld comes before the first %ld", s, b, a);
+        return -1;
+    }
+    if (step < 1) {
+        usage_error("--frames %s: the step must be at least 1, got %ld", s, step);
+        return -1;
+    }
+    long count = (b - a) / step + 1;
+    if (count > FRAME_COUNT_MAX) {
+        usage_error("--frames %s: %ld frames, more than the limit of %ld", s, count, FRAME_COUNT_MAX);
+        return -1;
+    }
+    o->fa = a;
+    o->fb = b;
+    o->fstep = step;
+    return 0;
+}
 
 static int is_command(const char *w)
 {
@@ -247,6 +310,18 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             continue;
         }
         int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
+        if (!strcmp(name, "--frames")) {
+            if (!val)
+                return usage_error("--frames needs a value: A..B or A..B:STEP (e.g. 0..47)");
+            if (!inline_val)
+                i++;
+            if (o->frames)
+                return usage_error("--frames is given twice");
+            o->frames = val;
+            if (parse_frames(o))
+                return EX_USAGE;
+            continue;
+        }
         if (is_e || is_o || f < NNUM) {
             const char *what = is_e ? "an expression" : is_o ? "a folder" : numflags[f].range;
             if (!val)
@@ -292,6 +367,9 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                            o->script, o->script);
     if ((strcmp(o->mode, "run") == 0 || strcmp(o->mode, "check") == 0) && !o->script)
         return usage_error("%s needs a script file (or - for standard input)", o->mode);
+    if (o->frames && strcmp(o->mode, "run") != 0)
+        return usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
+                           strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -542,16 +620,21 @@ static int run_frac(interp *I, opts *o)
     }
     unsigned char *text;
     size_t len;
-    rc = read_script(o->script, &text, &len);
-    if (rc)
+    if (o->text) { /* --frames: read once, freed by run_frames */
+        text = (unsigned char *)o->text;
+        len = o->len;
+    } else if ((rc = read_script(o->script, &text, &len))) {
         return rc;
+    }
     const char *name = strcmp(o->script, "-") == 0 ? "<stdin>" : o->script;
     if (set_script_args(I, o) || (o->nov && check_overrides(I, name, (const char *)text, len))) {
-        rt_free(text);
+        if (!o->text)
+            rt_free(text);
         return session_report(I);
     }
     if (!check && I->out_dir && (rc = make_out_dir(I->out_dir))) {
-        rt_free(text);
+        if (!o->text)
+            rt_free(text);
         return rc;
     }
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
@@ -561,6 +644,59 @@ static int run_frac(interp *I, opts *o)
         if (check && o->list_params)
             print_params(I);
     }
+    if (!o->text)
+        rt_free(text);
+    return rc;
+}
+
+/* --frames A..B:STEP: the script once per frame, each in a fresh interpreter
+ * set up like a plain run (the same -D, --seed, -o, limits), so frame N is
+ * byte for byte what `--frames N..N` gives for a script that reads `frame`
+ * (`clock` is 0 for a single frame). Stops at the first frame that fails. */
+static int run_frames(interp *T, opts *o)
+{
+    unsigned char *text;
+    size_t len;
+    int rc = read_script(o->script, &text, &len);
+    if (rc)
+        return rc;
+    o->text = text;
+    o->len = len;
+    long count = (o->fb - o->fa) / o->fstep + 1, big = labs(o->fa) > labs(o->fb) ? labs(o->fa) : labs(o->fb);
+    int width = 1;
+    for (; big >= 10; big /= 10)
+        width++;
+    int tty = !T->quiet && isatty(2);
+    rc = EX_OK;
+    for (long k = 0; k < count && rc == EX_OK; k++) {
+        long f = o->fa + k * o->fstep;
+        if (interrupted) {
+            rc = 130;
+            break;
+        }
+        if (tty)
+            fprintf(stderr, "frame %ld (%ld of %ld)\n", f, k + 1, count);
+        interp st, *I = &st;
+        interp_init(I); /* installs I's allocation hook */
+        I->lim = T->lim;
+        I->seed = T->seed;
+        I->threads = T->threads;
+        I->quiet = T->quiet;
+        I->progress = T->progress;
+        I->out_dir = T->out_dir;
+        I->fail_alloc_at = T->fail_alloc_at;
+        I->frame = f;
+        I->frames_given = 1;
+        I->clock = o->fb > o->fa ? (double)(f - o->fa) / (double)(o->fb - o->fa) : 0.0;
+        I->frame_width = width;
+        I->frame_count = count;
+        rc = run_frac(I, o);
+        interp_free(I);
+        rt_alloc_set_hook(&T->hook); /* T's blocks (the script, the options) are counted by T */
+        if (rc != EX_OK && count > 1)
+            fprintf(stderr, "frac: stopped at frame %ld (%ld of %ld frames done)\n", f, k, count);
+    }
+    o->text = NULL;
     rt_free(text);
     return rc;
 }
@@ -578,7 +714,7 @@ static int frac_main(int argc, char **argv)
     if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
-            rc = run_frac(I, &o);
+            rc = o.frames ? run_frames(I, &o) : run_frac(I, &o);
     }
     mem_free(I, o.args);
     mem_free(I, o.ov);

@@ -17,6 +17,12 @@ int session_setup(interp *I)
     I->globals = root; /* builtins register into the root */
     if (builtin_core_init(I) || builtin_image_init(I) || bind_all_init(I))
         return -1;
+    /* `frame` and `clock` (--frames; 0 outside it): read-only, like the
+     * builtins they sit beside (resolve.c refuses assignments to them) */
+    const char *fr = interp_intern(I, "frame", 5), *ck = interp_intern(I, "clock", 5);
+    if (!fr || !ck || val_env_define(I, root, fr, val_num((double)I->frame)) ||
+        val_env_define(I, root, ck, val_num(I->clock)))
+        return -1;
     I->globals = val_env_new(I, root);
     val_heap_unref(I, &root->h); /* the global scope holds it now */
     return I->globals ? 0 : -1;

@@ -140,6 +140,13 @@ typedef struct interp {
     const char *out_dir; /* NULL: current directory */
     int is_repl;
     FILE *out;           /* where print() writes (stdout) */
+    /* frames (frac run --frames A..B[:STEP]): the names `frame` and `clock`,
+     * and what `%f` in an output path becomes; all 0 outside --frames */
+    long frame;          /* this frame's number */
+    int frames_given;    /* 1 when --frames was given */
+    double clock;        /* 0 at A, 1 at B (0 for A..A) */
+    int frame_width;     /* digits of %f: those of the largest |A|, |B| */
+    long frame_count;    /* frames in the range (>= 2: every path needs %f) */
 
     /* builtin registry */
     const builtin **builtins;

@@ -996,19 +996,22 @@ static void run_fail_alloc(const char *frac, const char *script)
 }
 
 /* ---- checks with outside tools --------------------------------------------------------
+ * tests/tools/NAME.py scripts, run as `/usr/bin/python3 tests/tools/NAME.py FRAC`.
  * tests/tools/vdb_check.py opens frac's .vdb files with the OpenVDB library
  * (Debian python3-openvdb, for /usr/bin/python3). Its exit 77 (the module or
  * python missing) prints its "skipped: …" line and counts neither way. */
-static void run_vdb_check(const char *frac)
+static void run_py_check(const char *frac, const char *name)
 {
-    const char *label = "tools/vdb_check.py";
+    char label[256], script[300];
+    snprintf(label, sizeof label, "tools/%s", name);
+    snprintf(script, sizeof script, "tests/tools/%s", name);
     if (!matches_filter(label))
         return;
     if (access("/usr/bin/python3", X_OK) != 0) {
         printf("%s skipped: /usr/bin/python3 not installed\n", label);
         return;
     }
-    char *argv[] = {"/usr/bin/python3", "tests/tools/vdb_check.py", (char *)frac, NULL};
+    char *argv[] = {"/usr/bin/python3", script, (char *)frac, NULL};
     buf out = {0}, err = {0}, why = {0};
     int rc = run(argv, NULL, &out, &err, 120);
     if (rc == 77) {
@@ -1354,7 +1357,8 @@ int main(int argc, char **argv)
         if (realpath(ptyrun, ptyabs))
             run_pty_dir(fracabs, ptyabs);
     }
-    run_vdb_check(fracabs);
+    run_py_check(fracabs, "vdb_check.py");
+    run_py_check(fracabs, "frames_check.py"); /* --frames from outside: frame identity, tty progress */
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
