@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "apng.h"
 #include "builtin.h"
 #include "eval.h"
 #include "fileio.h"
@@ -358,10 +359,69 @@ int lang_output_path(interp *I, value path, char *buf, size_t size)
     return lang_join_path(I, NULL, I->out_dir, name, n, buf, size, "save");
 }
 
+/* save(list_of_images, "x.png", {delay: MS, loop: N}): an animated PNG
+ * (runtime/apng.h), the images its frames in order. */
+static int save_animation(interp *I, value list, const char *path, value opts)
+{
+    if (contract_check_opts(I, opts,
+                            "rec{delay: int[0,65535], loop: int[0,2147483647], bits: int{8,16}, channels: int[1,4]}",
+                            "save"))
+        return -1;
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    if (strcmp(ext, "png") != 0)
+        return err_arg(I, 1, ERR_VALUE, "save: a list of images is saved as an animated PNG (.png), not as .%s",
+                       ext[0] ? ext : "(no extension)");
+    const vlist *l = AS_LIST(list);
+    if (l->n == 0)
+        return err_arg(I, 0, ERR_VALUE, "save: the list of frames is empty (an animated PNG needs at least one)");
+    for (size_t i = 0; i < l->n; i++) {
+        const image *im = lang_as_image(l->items[i]), *first = lang_as_image(l->items[0]);
+        if (!im)
+            return err_item(I, list, i, ERR_TYPE, "save: frame %zu is %s, not an image", i + 1,
+                            val_type_name(l->items[i]));
+        if (im->w != first->w || im->h != first->h)
+            return err_item(I, list, i, ERR_VALUE, "save: frame %zu is %d×%d, frame 1 is %d×%d: all frames must have "
+                            "the same size", i + 1, im->w, im->h, first->w, first->h);
+    }
+    if (l->n > 1000000)
+        return err_arg(I, 0, ERR_LIMIT, "save: %zu frames, more than an animated PNG of frac holds (1000000)", l->n);
+    apng_opts ao = {APNG_DEFAULT_DELAY_MS, 0};
+    int bits = 8, channels = 4;
+    double x;
+    if (lang_opt_num(I, opts, "delay", &x) == 1)
+        ao.delay_ms = (int)x;
+    if (lang_opt_num(I, opts, "loop", &x) == 1)
+        ao.loop = (long)x;
+    if (lang_opt_num(I, opts, "bits", &x) == 1)
+        bits = (int)x;
+    if (lang_opt_num(I, opts, "channels", &x) == 1)
+        channels = (int)x;
+    const image **ims = mem_calloc(I, l->n, sizeof *ims);
+    if (!ims)
+        return -1;
+    for (size_t i = 0; i < l->n; i++)
+        ims[i] = lang_as_image(l->items[i]);
+    rt_error e;
+    rt_code c = apng_save(ims, (int)l->n, bits, channels, &ao, path, &e);
+    mem_free(I, ims);
+    return c ? lang_rt_error(I, c, &e, "save") : 0;
+}
+
 static int b_save(interp *I, value *a, int n, value *out)
 {
     (void)n;
     value v = a[0];
+    if (v.k == V_LIST) {
+        char path[4096];
+        if (lang_output_path(I, a[1], path, sizeof path) || save_animation(I, v, path, a[2]))
+            return -1;
+        if (!I->quiet && !I->is_repl)
+            fprintf(stderr, "wrote %s (%zu frames)\n", path, AS_LIST(v)->n);
+        *out = a[0];
+        val_ref(*out);
+        return 0;
+    }
     if (v.k != V_OBJ || !AS_OBJ(v)->cls->save)
         return err_at(I, NULL, ERR_TYPE, "save: cannot save %s (images, volumes, meshes… can be saved)",
                       val_type_name(v));

@@ -22,6 +22,7 @@
 #include "contract.h"
 #include "cstack.h"
 #include "eval.h"
+#include "apng.h"
 #include "fileio.h"
 #include "par.h"
 #include "parser.h"
@@ -36,6 +37,10 @@ static const char usage_text[] =
     "       frac check [--params] [OPTIONS] SCRIPT.frac\n"
     "                                          parse and check without running anything\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
+    "       frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...\n"
+    "                                          assemble PNG frames (same size and format) into\n"
+    "                                          an animated PNG: MS per frame (default 40),\n"
+    "                                          N plays (default 0: forever)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac --version | --help\n"
     "\n"
@@ -177,6 +182,7 @@ typedef struct opts {
     long fa, fb, fstep;           /* its numbers */
     const unsigned char *text;    /* the script, read once for all frames (NULL: read it) */
     size_t len;
+    const char *delay, *loop;     /* frac apng --delay MS --loop N, as typed */
 } opts;
 
 /* One number of --frames, the n characters at s: an optional '-' and
@@ -235,7 +241,7 @@ static int parse_frames(opts *o)
 
 static int is_command(const char *w)
 {
-    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0;
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 || strcmp(w, "apng") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -310,6 +316,18 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             continue;
         }
         int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
+        if (!strcmp(name, "--delay") || !strcmp(name, "--loop")) {
+            const char **slot = !strcmp(name, "--delay") ? &o->delay : &o->loop;
+            if (!val)
+                return usage_error("%s needs a value: %s", name,
+                                   slot == &o->delay ? "milliseconds per frame" : "a number of plays (0: forever)");
+            if (!inline_val)
+                i++;
+            if (*slot)
+                return usage_error("%s is given twice", name);
+            *slot = val;
+            continue;
+        }
         if (!strcmp(name, "--frames")) {
             if (!val)
                 return usage_error("--frames needs a value: A..B or A..B:STEP (e.g. 0..47)");
@@ -367,6 +385,16 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                            o->script, o->script);
     if ((strcmp(o->mode, "run") == 0 || strcmp(o->mode, "check") == 0) && !o->script)
         return usage_error("%s needs a script file (or - for standard input)", o->mode);
+    if (strcmp(o->mode, "apng") == 0) {
+        if (!o->script)
+            return usage_error("%s", "apng needs frames: frac apng -o OUT.png FRAME.png...");
+        if (!I->out_dir)
+            return usage_error("%s", "apng needs -o OUT.png, the file to write");
+        if (o->nov || o->frames || o->list_params)
+            return usage_error("%s does not go with `frac apng`", o->nov ? "-D" : o->frames ? "--frames" : "--params");
+    } else if (o->delay || o->loop) {
+        return usage_error("%s goes with `frac apng`", o->delay ? "--delay" : "--loop");
+    }
     if (o->frames && strcmp(o->mode, "run") != 0)
         return usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
                            strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
@@ -649,6 +677,59 @@ static int run_frac(interp *I, opts *o)
     return rc;
 }
 
+/* frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...: the frames'
+ * image data copied into one animated PNG (runtime/apng.h); every frame is
+ * checked before anything is written. */
+static int run_apng(interp *I, opts *o)
+{
+    apng_opts ao = {APNG_DEFAULT_DELAY_MS, 0};
+    double d;
+    if (o->delay && parse_whole(o->delay, 0, APNG_MAX_DELAY_MS, &d))
+        return usage_error("--delay takes a whole number of milliseconds from 0 to %d, got '%s'", APNG_MAX_DELAY_MS,
+                           o->delay);
+    if (o->delay)
+        ao.delay_ms = (int)d;
+    if (o->loop && parse_whole(o->loop, 0, APNG_MAX_LOOP, &d))
+        return usage_error("--loop takes a whole number of plays from 0 (forever) to %d, got '%s'", APNG_MAX_LOOP,
+                           o->loop);
+    if (o->loop)
+        ao.loop = (long)d;
+    int n = 1 + o->nargs;
+    const char **names = mem_calloc(I, (size_t)n, sizeof *names);
+    unsigned char **data = mem_calloc(I, (size_t)n, sizeof *data);
+    size_t *lens = mem_calloc(I, (size_t)n, sizeof *lens);
+    int rc = names && data && lens ? EX_OK : session_report(I);
+    rt_error e;
+    for (int i = 0; i < n && rc == EX_OK; i++) {
+        names[i] = i ? o->args[i - 1] : o->script;
+        rt_code c = fileio_read_all(names[i], (size_t)1 << 30, &data[i], &lens[i], &e);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : EX_IO;
+        }
+    }
+    if (rc == EX_OK) {
+        bytebuf b;
+        bytebuf_init(&b);
+        rt_code c = apng_assemble((const unsigned char *const *)data, lens, n, names, &ao, &b, &e);
+        if (!c)
+            c = fileio_write_atomic(I->out_dir, b.data, b.len, &e);
+        bytebuf_free(&b);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : c == RT_EIO ? EX_IO : EX_SCRIPT;
+        } else if (!I->quiet) {
+            fprintf(stderr, "wrote %s (%d frames)\n", I->out_dir, n);
+        }
+    }
+    for (int i = 0; data && i < n; i++)
+        rt_free(data[i]);
+    mem_free(I, names);
+    mem_free(I, data);
+    mem_free(I, lens);
+    return rc;
+}
+
 /* --frames A..B:STEP: the script once per frame, each in a fresh interpreter
  * set up like a plain run (the same -D, --seed, -o, limits), so frame N is
  * byte for byte what `--frames N..N` gives for a script that reads `frame`
@@ -714,7 +795,7 @@ static int frac_main(int argc, char **argv)
     if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
-            rc = o.frames ? run_frames(I, &o) : run_frac(I, &o);
+            rc = o.frames ? run_frames(I, &o) : strcmp(o.mode, "apng") == 0 ? run_apng(I, &o) : run_frac(I, &o);
     }
     mem_free(I, o.args);
     mem_free(I, o.ov);
