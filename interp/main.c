@@ -28,6 +28,7 @@
 #include "parser.h"
 #include "repl.h"
 #include "session.h"
+#include "watch.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
 
@@ -37,6 +38,11 @@ static const char usage_text[] =
     "       frac check [--params] [OPTIONS] SCRIPT.frac\n"
     "                                          parse and check without running anything\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
+    "       frac watch [--show] [OPTIONS] SCRIPT.frac\n"
+    "                                          run the script, then again whenever it or a file\n"
+    "                                          it imports or loads changes (a render in progress\n"
+    "                                          is cancelled); --show previews the first image it\n"
+    "                                          saved; Ctrl-C ends it (exit 0)\n"
     "       frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...\n"
     "                                          assemble PNG frames (same size and format) into\n"
     "                                          an animated PNG: MS per frame (default 40),\n"
@@ -183,6 +189,8 @@ typedef struct opts {
     const unsigned char *text;    /* the script, read once for all frames (NULL: read it) */
     size_t len;
     const char *delay, *loop;     /* frac apng --delay MS --loop N, as typed */
+    int show;                     /* frac watch --show */
+    volatile sig_atomic_t *cancel; /* watch: the render's interrupt flag (NULL: the SIGINT flag) */
 } opts;
 
 /* One number of --frames, the n characters at s: an optional '-' and
@@ -241,7 +249,8 @@ static int parse_frames(opts *o)
 
 static int is_command(const char *w)
 {
-    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 || strcmp(w, "apng") == 0;
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 || strcmp(w, "apng") == 0 ||
+           strcmp(w, "watch") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -280,7 +289,7 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             f++;
 
         if (!strcmp(name, "--help") || !strcmp(name, "-h") || !strcmp(name, "--version") ||
-            !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params")) {
+            !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params") || !strcmp(name, "--show")) {
             if (inline_val)
                 return usage_error("%s takes no value (got '%s')", name, a);
             if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
@@ -291,6 +300,8 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                 return EX_OK;
             } else if (!strcmp(name, "--params")) {
                 o->list_params = 1;
+            } else if (!strcmp(name, "--show")) {
+                o->show = 1;
             } else {
                 I->quiet = 1;
                 I->progress = 0;
@@ -395,6 +406,10 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
     } else if (o->delay || o->loop) {
         return usage_error("%s goes with `frac apng`", o->delay ? "--delay" : "--loop");
     }
+    if (o->show && strcmp(o->mode, "watch") != 0)
+        return usage_error("%s", "--show goes with `frac watch` (in a script or the REPL, use show(image))");
+    if (strcmp(o->mode, "watch") == 0 && (!o->script || strcmp(o->script, "-") == 0))
+        return usage_error("%s", "watch needs a script file to watch: frac watch SCRIPT.frac [-o DIR] [-D NAME=VALUE]");
     if (o->frames && strcmp(o->mode, "run") != 0)
         return usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
                            strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
@@ -615,7 +630,7 @@ static int run_frac(interp *I, opts *o)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     fileio_install_signal_cleanup();
-    I->interrupt = &interrupted;
+    I->interrupt = o->cancel ? o->cancel : &interrupted;
 
     int check = strcmp(o->mode, "check") == 0;
     if (strcmp(o->mode, "repl") == 0) {
@@ -666,7 +681,9 @@ static int run_frac(interp *I, opts *o)
         return rc;
     }
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
-        rc = session_report(I);
+        /* watch: a render cancelled by a change is not reported */
+        int cancelled = o->cancel && *o->cancel && I->err.kind == ERR_INTERRUPT;
+        rc = cancelled ? 130 : session_report(I);
     } else {
         rc = EX_OK;
         if (check && o->list_params)
@@ -675,6 +692,55 @@ static int run_frac(interp *I, opts *o)
     if (!o->text)
         rt_free(text);
     return rc;
+}
+
+/* A new interpreter set up as T (limits, seed, threads, -o, output flags);
+ * interp_init installs its allocation hook: restore T's after interp_free. */
+static void fresh_interp(interp *I, const interp *T)
+{
+    interp_init(I);
+    I->lim = T->lim;
+    I->seed = T->seed;
+    I->threads = T->threads;
+    I->quiet = T->quiet;
+    I->progress = T->progress;
+    I->out_dir = T->out_dir;
+    I->fail_alloc_at = T->fail_alloc_at;
+}
+
+/* frac watch: each render is a plain run of the script, read again, in a
+ * fresh interpreter whose interrupt flag is the watcher's cancel flag. An
+ * interruption there is a change of a file (or Ctrl-C), not an error. */
+typedef struct watch_ctx {
+    interp *T;
+    opts *o;
+} watch_ctx;
+
+static int watch_render(void *ud, volatile sig_atomic_t *cancel)
+{
+    watch_ctx *c = ud;
+    interp st, *I = &st;
+    fresh_interp(I, c->T);
+    c->o->cancel = cancel;
+    int rc = run_frac(I, c->o);
+    if (rc == 130 && *cancel)
+        rc = 0; /* cancelled: watch_main starts again or stops */
+    interp_free(I);
+    rt_alloc_set_hook(&c->T->hook);
+    return rc;
+}
+
+static int run_watch(interp *T, opts *o)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    fileio_install_signal_cleanup();
+    watch_ctx c = {T, o};
+    int rc = watch_main(T, watch_render, &c, &interrupted, o->show, T->quiet);
+    return rc < 0 ? session_report(T) : rc;
 }
 
 /* frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...: the frames'
@@ -758,14 +824,7 @@ static int run_frames(interp *T, opts *o)
         if (tty)
             fprintf(stderr, "frame %ld (%ld of %ld)\n", f, k + 1, count);
         interp st, *I = &st;
-        interp_init(I); /* installs I's allocation hook */
-        I->lim = T->lim;
-        I->seed = T->seed;
-        I->threads = T->threads;
-        I->quiet = T->quiet;
-        I->progress = T->progress;
-        I->out_dir = T->out_dir;
-        I->fail_alloc_at = T->fail_alloc_at;
+        fresh_interp(I, T);
         I->frame = f;
         I->frames_given = 1;
         I->clock = o->fb > o->fa ? (double)(f - o->fa) / (double)(o->fb - o->fa) : 0.0;
@@ -795,7 +854,10 @@ static int frac_main(int argc, char **argv)
     if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
-            rc = o.frames ? run_frames(I, &o) : strcmp(o.mode, "apng") == 0 ? run_apng(I, &o) : run_frac(I, &o);
+            rc = o.frames                       ? run_frames(I, &o)
+                 : strcmp(o.mode, "apng") == 0  ? run_apng(I, &o)
+                 : strcmp(o.mode, "watch") == 0 ? run_watch(I, &o)
+                                                : run_frac(I, &o);
     }
     mem_free(I, o.args);
     mem_free(I, o.ov);

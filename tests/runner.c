@@ -1360,6 +1360,7 @@ int main(int argc, char **argv)
     run_py_check(fracabs, "vdb_check.py");
     run_py_check(fracabs, "frames_check.py"); /* --frames from outside: frame identity, tty progress */
     run_py_check(fracabs, "apng_check.py");   /* APNG: own decoder, pngcheck, PIL, apngdis */
+    run_py_check(fracabs, "watch_check.py");  /* frac watch in the background: edits, cancel, Ctrl-C */
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
