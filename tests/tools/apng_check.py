@@ -216,6 +216,23 @@ with tempfile.TemporaryDirectory() as tmp:
             check(os.path.exists(p) and Image.open(p).convert("RGBA").tobytes() ==
                   Image.open(pngs[k]).convert("RGBA").tobytes(), "apngdis frame %d" % (k + 1))
 
+    # the example animation: a few frames of examples/anim_morph.frac, assembled
+    morph = os.path.join(tmp, "morph")
+    r = frac("run", "--quiet", "--frames", "0..3", "-D", "points=2e4", "-D", "size=40", "-o", morph,
+             os.path.join(os.getcwd(), "examples", "anim_morph.frac"))
+    check(r.returncode == 0, "anim_morph --frames 0..3: %d %s" % (r.returncode, r.stderr))
+    mpngs = [os.path.join(morph, "morph_%d.png" % k) for k in range(4)]
+    check(r.stdout.count("frame ") == 4 and "frame 3 s = 1 " in r.stdout, "anim_morph prints each frame: %r" % r.stdout)
+    manim = os.path.join(tmp, "morph.png")
+    r = frac("apng", "-q", "-o", manim, "--delay", "60", *mpngs)
+    check(r.returncode == 0 and r.stderr == "", "frac apng of the morph: %d %s" % (r.returncode, r.stderr))
+    w, h, got = apng_frames(manim, 4, 60, 0)
+    for k, p in enumerate(mpngs):
+        check(k < len(got) and got[k] == png_pixels(p)[2], "morph.png frame %d = %s" % (k, p))
+    check(len(set(got)) == 4, "the morph's frames differ")
+    if Image:
+        check(Image.open(manim).n_frames == 4, "PIL: morph.png has 4 frames")
+
     # errors: nothing is written
     small = os.path.join(tmp, "small.png")
     subprocess.run([FRAC, "-q", "-e", 'save(image([3, 2]), "%s")' % small], check=True, capture_output=True)
