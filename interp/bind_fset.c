@@ -518,7 +518,7 @@ static rt_code fset_fit(const fset *fs, const fset_order *o, const fset_chaos_op
 }
 
 /* chaos_fset of a 3-D set: the nearest point per pixel through a camera
- * (default: frame(…) of the game's fitted box) */
+ * (default: framing(…) of the game's fitted box) */
 static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, const fset_chaos_opts *co, value camv,
                            value sizev, value bgv, value *out)
 {
@@ -682,7 +682,7 @@ static const builtin fset_builtins[] = {
     BUILTIN("order", b_order, p_order,
             "Which set each step uses: order([1, 2, 1, 2]) lists set numbers in application order (the first is applied first, to K0); order(\"W2 ∘ W1 ∘ W2 ∘ W1\") is the paper's composition notation (rightmost applied first); repeat: true cycles the sequence; order(probabilities: [p1, …], seed:) picks W_n with probability p_n at every step (seed 003 def. 3.2)."),
     BUILTIN("chaos_fset", b_chaos_fset, p_chaos_fset,
-            "The chaos game of a function set with an order, tone-mapped like chaos(…). mode \"orbit\": one long orbit per chunk; with a sequence or periodic order a point is plotted after each full period (the attractor of the composition); with a random order after every step. mode \"walk\": every point is the end of a fresh walk of depth steps from start (a sample of K_depth). A 3-D set is seen through camera (default: framed as frame(…) does), nearest point per pixel shaded by depth, as view(…)."),
+            "The chaos game of a function set with an order, tone-mapped like chaos(…). mode \"orbit\": one long orbit per chunk; with a sequence or periodic order a point is plotted after each full period (the attractor of the composition); with a random order after every step. mode \"walk\": every point is the end of a fresh walk of depth steps from start (a sample of K_depth). A 3-D set is seen through camera (default: framed as framing(…) does), nearest point per pixel shaded by depth, as view(…)."),
 };
 
 int bind_fset_init(interp *I)

@@ -999,7 +999,7 @@ static const builtin ifs_builtins[] = {
     BUILTIN("measure", b_measure, p_measure,
             "The invariant measure (seed 001 §5): the fraction of chaos-game points per cell, into a volume (3-D systems; the fractal solid noise) or an image (2-D); normalize \"total\" (measures sum to 1), \"max\" (densest cell 1) or \"count\"."),
     BUILTIN("points", b_points, p_points, "Chaos-game points as a point cloud (a mesh without triangles; save as .ply)."),
-    BUILTIN("view", b_view, p_view, "A 3-D IFS or RIFS seen through a camera (default: framing the whole attractor, as frame(…) does for its fitted box): nearest point per pixel, shaded by depth."),
+    BUILTIN("view", b_view, p_view, "A 3-D IFS or RIFS seen through a camera (default: framing the whole attractor, as framing(…) does for its fitted box): nearest point per pixel, shaded by depth."),
     BUILTIN("load_ifs", b_load_ifs, p_load_ifs,
             "The entries of a Fractint .ifs file (2-D and (3D) entries, ; comments) as a record name -> ifs."),
 };

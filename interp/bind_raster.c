@@ -181,23 +181,23 @@ done:
 
 /* ---- the default framing as a camera record ------------------------------------------- */
 
-/* frame(lo, hi, size, azimuth, elevation, fov): the camera every default
+/* framing(lo, hi, size, azimuth, elevation, fov): the camera every default
  * view uses (camera_frame_box), as a record {eye, target, up, fov} */
-static int b_frame(interp *I, value *a, int n, value *out)
+static int b_framing(interp *I, value *a, int n, value *out)
 {
     (void)n;
     double lo[3], hi[3];
     int w, h;
-    if (builtin_get_vec(I, a[0], lo, 3, "frame: lo") || builtin_get_vec(I, a[1], hi, 3, "frame: hi") ||
-        lang_arg_size2(I, a[2], &w, &h, "frame: size"))
+    if (builtin_get_vec(I, a[0], lo, 3, "framing: lo") || builtin_get_vec(I, a[1], hi, 3, "framing: hi") ||
+        lang_arg_size2(I, a[2], &w, &h, "framing: size"))
         return -1;
     for (int d = 0; d < 3; d++)
         if (hi[d] < lo[d])
-            return err_arg(I, 1, ERR_VALUE, "frame: hi must not be below lo, but on axis %c %g < %g", "xyz"[d], hi[d],
+            return err_arg(I, 1, ERR_VALUE, "framing: hi must not be below lo, but on axis %c %g < %g", "xyz"[d], hi[d],
                            lo[d]);
     camera cam;
     if (camera_frame_box(&cam, lo, hi, w, h, a[3].u.n, a[4].u.n, a[5].u.n))
-        return err_arg(I, 4, ERR_VALUE, "frame: elevation %g looks straight along the up axis [0, 1, 0]", a[4].u.n);
+        return err_arg(I, 4, ERR_VALUE, "framing: elevation %g looks straight along the up axis [0, 1, 0]", a[4].u.n);
     value r = val_rec(I);
     if (r.k == V_NIL)
         return -1;
@@ -230,7 +230,7 @@ static const bparam p_raster[] = {{"scene", "mesh|wrinkly_surface|list", NULL},
                                   {"pixel", "num>0", "1"},
                                   {"kmax", TY_LOD_K, "8"}};
 
-static const bparam p_frame[] = {{"lo", "vec3", NULL},
+static const bparam p_framing[] = {{"lo", "vec3", NULL},
                                  {"hi", "vec3", NULL},
                                  {"size", TY_SIZE, "[256, 256]"},
                                  {"azimuth", "num", "30"},
@@ -240,7 +240,7 @@ static const bparam p_frame[] = {{"lo", "vec3", NULL},
 static const builtin raster_builtins[] = {
     BUILTIN("rasterize", b_rasterize, p_raster,
             "Render a mesh, a wrinkly surface or a list of them with a Z-buffer into an image: camera (default: framing the scene), lights, background; surfaces are tessellated for this camera."),
-    BUILTIN("frame", b_frame, p_frame,
+    BUILTIN("framing", b_framing, p_framing,
             "The default camera of view, rasterize and chaos_fset in 3-D for the box [lo, hi] and an image of size: looking at the box's centre from azimuth/elevation (degrees, as orbit) and far enough that the box's bounding sphere plus 5 % fits the field of view. Returns a record {eye, target, up, fov}."),
 };
 

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "apng.h"
 #include "builtin.h"
 #include "eval.h"
 #include "fileio.h"
@@ -303,17 +304,124 @@ static int b_load(interp *I, value *a, int n, value *out)
     return lang_image_value(I, im, out);
 }
 
+/* `%f` in an output path becomes the frame number (--frames; 0 outside it),
+ * zero-padded to I->frame_width digits (cfdg's convention; a negative frame
+ * keeps its '-' before the padded digits: -03); `%%` is one '%'. Any other
+ * '%' is an error, and so is a path without %f when several frames would
+ * each overwrite it. */
+static int expand_frame(interp *I, const char *p, size_t n, char *buf, size_t size, size_t *outn)
+{
+    size_t k = 0;
+    int has_f = 0;
+    for (size_t i = 0; i < n; i++) {
+        char piece[32];
+        size_t pl = 1;
+        piece[0] = p[i];
+        if (p[i] == '%') {
+            char c = i + 1 < n ? p[i + 1] : 0;
+            if (c == 'f') {
+                long f = I->frame;
+                int w = I->frame_width > 0 ? I->frame_width : 1;
+                pl = (size_t)snprintf(piece, sizeof piece, "%s%0*lu", f < 0 ? "-" : "", w,
+                                      f < 0 ? 0ul - (unsigned long)f : (unsigned long)f);
+                has_f = 1;
+            } else if (c != '%') {
+                return err_at(I, NULL, ERR_VALUE,
+                              "save: '%%%.*s' in the output path '%.*s' is neither %%f (the frame number) nor "
+                              "%%%% (a percent sign)",
+                              c ? 1 : 0, &p[i + 1], (int)n, p);
+            }
+            i++;
+        }
+        if (k + pl >= size)
+            return err_at(I, NULL, ERR_IO, "save: path too long: '%.40s…'", p);
+        memcpy(buf + k, piece, pl);
+        k += pl;
+    }
+    if (I->frame_count >= 2 && !has_f)
+        return err_at(I, NULL, ERR_VALUE, "save: output path '%.*s' has no %%f, every frame would overwrite it",
+                      (int)n, p);
+    buf[k] = 0;
+    *outn = k;
+    return 0;
+}
+
 int lang_output_path(interp *I, value path, char *buf, size_t size)
 {
     if (AS_STR(path)->len == 0)
         return err_at(I, NULL, ERR_VALUE, "save: the file name is empty");
-    return lang_join_path(I, NULL, I->out_dir, AS_STR(path)->s, AS_STR(path)->len, buf, size, "save");
+    if (!memchr(AS_STR(path)->s, '%', AS_STR(path)->len) && I->frame_count < 2)
+        return lang_join_path(I, NULL, I->out_dir, AS_STR(path)->s, AS_STR(path)->len, buf, size, "save");
+    char name[4096];
+    size_t n = 0;
+    if (expand_frame(I, AS_STR(path)->s, AS_STR(path)->len, name, sizeof name, &n))
+        return -1;
+    return lang_join_path(I, NULL, I->out_dir, name, n, buf, size, "save");
+}
+
+/* save(list_of_images, "x.png", {delay: MS, loop: N}): an animated PNG
+ * (runtime/apng.h), the images its frames in order. */
+static int save_animation(interp *I, value list, const char *path, value opts)
+{
+    if (contract_check_opts(I, opts,
+                            "rec{delay: int[0,65535], loop: int[0,2147483647], bits: int{8,16}, channels: int[1,4]}",
+                            "save"))
+        return -1;
+    char ext[16];
+    fileio_ext(path, ext, sizeof ext);
+    if (strcmp(ext, "png") != 0)
+        return err_arg(I, 1, ERR_VALUE, "save: a list of images is saved as an animated PNG (.png), not as .%s",
+                       ext[0] ? ext : "(no extension)");
+    const vlist *l = AS_LIST(list);
+    if (l->n == 0)
+        return err_arg(I, 0, ERR_VALUE, "save: the list of frames is empty (an animated PNG needs at least one)");
+    for (size_t i = 0; i < l->n; i++) {
+        const image *im = lang_as_image(l->items[i]), *first = lang_as_image(l->items[0]);
+        if (!im)
+            return err_item(I, list, i, ERR_TYPE, "save: frame %zu is %s, not an image", i + 1,
+                            val_type_name(l->items[i]));
+        if (im->w != first->w || im->h != first->h)
+            return err_item(I, list, i, ERR_VALUE, "save: frame %zu is %d×%d, frame 1 is %d×%d: all frames must have "
+                            "the same size", i + 1, im->w, im->h, first->w, first->h);
+    }
+    if (l->n > 1000000)
+        return err_arg(I, 0, ERR_LIMIT, "save: %zu frames, more than an animated PNG of frac holds (1000000)", l->n);
+    apng_opts ao = {APNG_DEFAULT_DELAY_MS, 0};
+    int bits = 8, channels = 4;
+    double x;
+    if (lang_opt_num(I, opts, "delay", &x) == 1)
+        ao.delay_ms = (int)x;
+    if (lang_opt_num(I, opts, "loop", &x) == 1)
+        ao.loop = (long)x;
+    if (lang_opt_num(I, opts, "bits", &x) == 1)
+        bits = (int)x;
+    if (lang_opt_num(I, opts, "channels", &x) == 1)
+        channels = (int)x;
+    const image **ims = mem_calloc(I, l->n, sizeof *ims);
+    if (!ims)
+        return -1;
+    for (size_t i = 0; i < l->n; i++)
+        ims[i] = lang_as_image(l->items[i]);
+    rt_error e;
+    rt_code c = apng_save(ims, (int)l->n, bits, channels, &ao, path, &e);
+    mem_free(I, ims);
+    return c ? lang_rt_error(I, c, &e, "save") : 0;
 }
 
 static int b_save(interp *I, value *a, int n, value *out)
 {
     (void)n;
     value v = a[0];
+    if (v.k == V_LIST) {
+        char path[4096];
+        if (lang_output_path(I, a[1], path, sizeof path) || save_animation(I, v, path, a[2]))
+            return -1;
+        if (!I->quiet && !I->is_repl)
+            fprintf(stderr, "wrote %s (%zu frames)\n", path, AS_LIST(v)->n);
+        *out = a[0];
+        val_ref(*out);
+        return 0;
+    }
     if (v.k != V_OBJ || !AS_OBJ(v)->cls->save)
         return err_at(I, NULL, ERR_TYPE, "save: cannot save %s (images, volumes, meshes… can be saved)",
                       val_type_name(v));

@@ -22,6 +22,7 @@
 #include "contract.h"
 #include "cstack.h"
 #include "eval.h"
+#include "apng.h"
 #include "fileio.h"
 #include "par.h"
 #include "parser.h"
@@ -30,8 +31,13 @@
 #include "repl.h"
 #include "session.h"
 #include "sha256.h"
+#include "watch.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
+
+/* errno of a write to standard output that failed before finish_output's
+ * flush (which then has nothing left to report) */
+static int stdout_errno;
 
 static const char usage_text[] =
     "usage: frac [run] [OPTIONS] SCRIPT.frac [OPTIONS] [ARGS…] [-- ARGS…]\n"
@@ -42,6 +48,15 @@ static const char usage_text[] =
     "       frac rerun FILE [-o DIR]           render it again from its recipe (same\n"
     "                                          script, params, seed and frame)\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
+    "       frac watch [--show] [OPTIONS] SCRIPT.frac\n"
+    "                                          run the script, then again whenever it or a file\n"
+    "                                          it imports or loads changes (a render in progress\n"
+    "                                          is cancelled); --show previews the first image it\n"
+    "                                          saved; Ctrl-C ends it (exit 0)\n"
+    "       frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...\n"
+    "                                          assemble PNG frames (same size and format) into\n"
+    "                                          an animated PNG: MS per frame (default 40),\n"
+    "                                          N plays (default 0: forever)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac --version | --help\n"
     "\n"
@@ -78,6 +93,11 @@ static const char usage_text[] =
     "                        it is printed without --stats, unless --quiet)\n"
     "  --no-recipe           leave the script text out of the recipe that every\n"
     "                        output carries (its hash, params and seed stay)\n"
+    "  --frames A..B[:STEP]  run the script once per frame A, A+STEP, … ≤ B, each\n"
+    "                        in a fresh interpreter; the names `frame` (the number)\n"
+    "                        and `clock` (0 at A, 1 at B) are 0 without it; `%f` in\n"
+    "                        an output path is the frame number, zero-padded to the\n"
+    "                        width of B; `%%` is a %. See docs/animation.md\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -182,12 +202,73 @@ typedef struct opts {
     const char **args;  /* the script's arguments (pointers into argv) */
     param_override *ov; /* -D as typed: name is "NAME=VALUE", text the VALUE */
     int nov;
+    const char *frames;           /* --frames A..B[:STEP] as typed; NULL: one plain run */
+    long fa, fb, fstep;           /* its numbers */
+    const unsigned char *text;    /* the script, read once for all frames (NULL: read it) */
+    size_t len;
+    const char *delay, *loop;     /* frac apng --delay MS --loop N, as typed */
+    int show;                     /* frac watch --show */
+    volatile sig_atomic_t *cancel; /* watch: the render's interrupt flag (NULL: the SIGINT flag) */
 } opts;
+
+/* One number of --frames, the n characters at s: an optional '-' and
+ * decimal digits, at most FRAME_MAX in size. */
+#define FRAME_MAX 999999999L
+#define FRAME_COUNT_MAX 100000L
+static int frame_number(const char *spec, const char *s, size_t n, long *out)
+{
+    size_t i = n && *s == '-';
+    long v = 0;
+    int ok = i < n;
+    for (; ok && i < n; i++) {
+        ok = s[i] >= '0' && s[i] <= '9' && (v = v * 10 + (s[i] - '0')) <= FRAME_MAX;
+    }
+    if (!ok) {
+        usage_error("--frames %s: '%.*s' is not a whole number from -%ld to %ld", spec, (int)n, s, FRAME_MAX,
+                    FRAME_MAX);
+        return -1;
+    }
+    *out = *s == '-' ? -v : v;
+    return 0;
+}
+
+/* --frames A..B[:STEP]: whole numbers, A <= B, STEP >= 1, at most
+ * FRAME_COUNT_MAX frames. Prints the usage error and returns -1 if not. */
+static int parse_frames(opts *o)
+{
+    const char *s = o->frames, *dots = strstr(s, ".."), *colon = dots ? strchr(dots + 2, ':') : NULL;
+    long a, b, step = 1;
+    if (!dots) {
+        usage_error("--frames takes A..B or A..B:STEP (e.g. 0..47 or 0..94:2), got '%s'", s);
+        return -1;
+    }
+    const char *bend = colon ? colon : dots + 2 + strlen(dots + 2);
+    if (frame_number(s, s, (size_t)(dots - s), &a) || frame_number(s, dots + 2, (size_t)(bend - dots - 2), &b) ||
+        (colon && frame_number(s, colon + 1, strlen(colon + 1), &step)))
+        return -1;
+    if (b < a) {
+        usage_error("--frames %s: the last frame %ld comes before the first %ld", s, b, a);
+        return -1;
+    }
+    if (step < 1) {
+        usage_error("--frames %s: the step must be at least 1, got %ld", s, step);
+        return -1;
+    }
+    long count = (b - a) / step + 1;
+    if (count > FRAME_COUNT_MAX) {
+        usage_error("--frames %s: %ld frames, more than the limit of %ld", s, count, FRAME_COUNT_MAX);
+        return -1;
+    }
+    o->fa = a;
+    o->fb = b;
+    o->fstep = step;
+    return 0;
+}
 
 static int is_command(const char *w)
 {
     return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 ||
-           strcmp(w, "info") == 0 || strcmp(w, "rerun") == 0;
+           strcmp(w, "info") == 0 || strcmp(w, "rerun") == 0 || strcmp(w, "apng") == 0 || strcmp(w, "watch") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -227,11 +308,12 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
 
         if (!strcmp(name, "--help") || !strcmp(name, "-h") || !strcmp(name, "--version") ||
             !strcmp(name, "--quiet") || !strcmp(name, "-q") || !strcmp(name, "--params") ||
-            !strcmp(name, "--no-recipe") || !strcmp(name, "--stats")) {
+            !strcmp(name, "--no-recipe") || !strcmp(name, "--stats") || !strcmp(name, "--show")) {
             if (inline_val)
                 return usage_error("%s takes no value (got '%s')", name, a);
             if (!strcmp(name, "--help") || !strcmp(name, "-h")) {
-                fputs(usage_text, stdout);
+                if (fputs(usage_text, stdout) == EOF) /* longer than stdout's buffer: it fails here */
+                    stdout_errno = errno;
                 return EX_OK;
             } else if (!strcmp(name, "--version")) {
                 printf("frac %s\n", FRAC_VERSION);
@@ -246,6 +328,10 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                 if (o->no_recipe)
                     return usage_error("%s is given twice", name);
                 o->no_recipe = 1;
+            } else if (!strcmp(name, "--show")) {
+                if (o->show)
+                    return usage_error("%s is given twice", name);
+                o->show = 1;
             } else {
                 I->quiet = 1;
                 I->progress = 0;
@@ -271,6 +357,30 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             continue;
         }
         int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
+        if (!strcmp(name, "--delay") || !strcmp(name, "--loop")) {
+            const char **slot = !strcmp(name, "--delay") ? &o->delay : &o->loop;
+            if (!val)
+                return usage_error("%s needs a value: %s", name,
+                                   slot == &o->delay ? "milliseconds per frame" : "a number of plays (0: forever)");
+            if (!inline_val)
+                i++;
+            if (*slot)
+                return usage_error("%s is given twice", name);
+            *slot = val;
+            continue;
+        }
+        if (!strcmp(name, "--frames")) {
+            if (!val)
+                return usage_error("--frames needs a value: A..B or A..B:STEP (e.g. 0..47)");
+            if (!inline_val)
+                i++;
+            if (o->frames)
+                return usage_error("--frames is given twice");
+            o->frames = val;
+            if (parse_frames(o))
+                return EX_USAGE;
+            continue;
+        }
         if (is_e || is_o || f < NNUM) {
             const char *what = is_e ? "an expression" : is_o ? "a folder" : numflags[f].range;
             if (!val)
@@ -332,6 +442,23 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
         return usage_error("%s", "--no-recipe is for runs that write files; check writes none");
     if (info && (I->out_dir || o->no_recipe))
         return usage_error("info only reads the file (%s does not go with it)", I->out_dir ? "-o" : "--no-recipe");
+    if (strcmp(o->mode, "apng") == 0) {
+        if (!o->script)
+            return usage_error("%s", "apng needs frames: frac apng -o OUT.png FRAME.png...");
+        if (!I->out_dir)
+            return usage_error("%s", "apng needs -o OUT.png, the file to write");
+        if (o->nov || o->frames || o->list_params)
+            return usage_error("%s does not go with `frac apng`", o->nov ? "-D" : o->frames ? "--frames" : "--params");
+    } else if (o->delay || o->loop) {
+        return usage_error("%s goes with `frac apng`", o->delay ? "--delay" : "--loop");
+    }
+    if (o->show && strcmp(o->mode, "watch") != 0)
+        return usage_error("%s", "--show goes with `frac watch` (in a script or the REPL, use show(image))");
+    if (strcmp(o->mode, "watch") == 0 && (!o->script || strcmp(o->script, "-") == 0))
+        return usage_error("%s", "watch needs a script file to watch: frac watch SCRIPT.frac [-o DIR] [-D NAME=VALUE]");
+    if (o->frames && strcmp(o->mode, "run") != 0)
+        return usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
+                           strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -521,7 +648,7 @@ static int finish_output(int rc)
 {
     errno = 0;
     int bad = fflush(stdout) != 0;
-    int e = errno;
+    int e = errno ? errno : stdout_errno;
     bad |= ferror(stdout);
     if (bad && rc == EX_OK) {
         fprintf(stderr, "frac: error: cannot write to standard output%s%s\n", e ? ": " : "",
@@ -743,7 +870,7 @@ static int run_frac(interp *I, opts *o)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     fileio_install_signal_cleanup();
-    I->interrupt = &interrupted;
+    I->interrupt = o->cancel ? o->cancel : &interrupted;
 
     int check = strcmp(o->mode, "check") == 0;
     if (strcmp(o->mode, "info") == 0)
@@ -790,7 +917,10 @@ static int run_frac(interp *I, opts *o)
     recipe rr;
     int rerun = strcmp(o->mode, "rerun") == 0;
     memset(&rr, 0, sizeof rr);
-    if (rerun) {
+    if (o->text) { /* --frames: read once, freed by run_frames */
+        text = (unsigned char *)o->text;
+        len = o->len;
+    } else if (rerun) {
         char *t = NULL;
         if ((rc = rerun_prepare(I, o, &rr, &t, &len))) {
             recipe_free(&rr);
@@ -807,12 +937,14 @@ static int run_frac(interp *I, opts *o)
         return rc;
     }
     rc = run_script(I, o, check, text, len);
-    rt_free(text);
+    if (!o->text)
+        rt_free(text);
     recipe_free(&rr);
     return rc;
 }
 
-/* Run (or check) the script text: the common tail of run, check and rerun. */
+/* Run (or check) the script text: the common tail of run, check, rerun,
+ * each frame of --frames and each render of watch. */
 static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t len)
 {
     int rc;
@@ -826,7 +958,9 @@ static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t
         return session_report(I);
     double t0 = report_clock();
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
-        rc = session_report(I);
+        /* watch: a render cancelled by a change is not reported */
+        int cancelled = o->cancel && *o->cancel && I->err.kind == ERR_INTERRUPT;
+        rc = cancelled ? 130 : session_report(I);
     } else {
         rc = EX_OK;
         if (check && o->list_params)
@@ -837,6 +971,153 @@ static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t
     }
     if (!check)
         recipe_uninstall(&st);
+    return rc;
+}
+
+/* A new interpreter set up as T (limits, seed, threads, -o, output flags);
+ * interp_init installs its allocation hook: restore T's after interp_free. */
+static void fresh_interp(interp *I, const interp *T)
+{
+    interp_init(I);
+    I->lim = T->lim;
+    I->seed = T->seed;
+    I->threads = T->threads;
+    I->quiet = T->quiet;
+    I->progress = T->progress;
+    I->out_dir = T->out_dir;
+    I->fail_alloc_at = T->fail_alloc_at;
+}
+
+/* frac watch: each render is a plain run of the script, read again, in a
+ * fresh interpreter whose interrupt flag is the watcher's cancel flag. An
+ * interruption there is a change of a file (or Ctrl-C), not an error. */
+typedef struct watch_ctx {
+    interp *T;
+    opts *o;
+} watch_ctx;
+
+static int watch_render(void *ud, volatile sig_atomic_t *cancel)
+{
+    watch_ctx *c = ud;
+    interp st, *I = &st;
+    fresh_interp(I, c->T);
+    c->o->cancel = cancel;
+    int rc = run_frac(I, c->o);
+    if (rc == 130 && *cancel)
+        rc = 0; /* cancelled: watch_main starts again or stops */
+    interp_free(I);
+    rt_alloc_set_hook(&c->T->hook);
+    return rc;
+}
+
+static int run_watch(interp *T, opts *o)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    fileio_install_signal_cleanup();
+    watch_ctx c = {T, o};
+    int rc = watch_main(T, watch_render, &c, &interrupted, o->show, T->quiet);
+    return rc < 0 ? session_report(T) : rc;
+}
+
+/* frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...: the frames'
+ * image data copied into one animated PNG (runtime/apng.h); every frame is
+ * checked before anything is written. */
+static int run_apng(interp *I, opts *o)
+{
+    apng_opts ao = {APNG_DEFAULT_DELAY_MS, 0};
+    double d;
+    if (o->delay && parse_whole(o->delay, 0, APNG_MAX_DELAY_MS, &d))
+        return usage_error("--delay takes a whole number of milliseconds from 0 to %d, got '%s'", APNG_MAX_DELAY_MS,
+                           o->delay);
+    if (o->delay)
+        ao.delay_ms = (int)d;
+    if (o->loop && parse_whole(o->loop, 0, APNG_MAX_LOOP, &d))
+        return usage_error("--loop takes a whole number of plays from 0 (forever) to %d, got '%s'", APNG_MAX_LOOP,
+                           o->loop);
+    if (o->loop)
+        ao.loop = (long)d;
+    int n = 1 + o->nargs;
+    const char **names = mem_calloc(I, (size_t)n, sizeof *names);
+    unsigned char **data = mem_calloc(I, (size_t)n, sizeof *data);
+    size_t *lens = mem_calloc(I, (size_t)n, sizeof *lens);
+    int rc = names && data && lens ? EX_OK : session_report(I);
+    rt_error e;
+    for (int i = 0; i < n && rc == EX_OK; i++) {
+        names[i] = i ? o->args[i - 1] : o->script;
+        rt_code c = fileio_read_all(names[i], (size_t)1 << 30, &data[i], &lens[i], &e);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : EX_IO;
+        }
+    }
+    if (rc == EX_OK) {
+        bytebuf b;
+        bytebuf_init(&b);
+        rt_code c = apng_assemble((const unsigned char *const *)data, lens, n, names, &ao, &b, &e);
+        if (!c)
+            c = fileio_write_atomic(I->out_dir, b.data, b.len, &e);
+        bytebuf_free(&b);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : c == RT_EIO ? EX_IO : EX_SCRIPT;
+        } else if (!I->quiet) {
+            fprintf(stderr, "wrote %s (%d frames)\n", I->out_dir, n);
+        }
+    }
+    for (int i = 0; data && i < n; i++)
+        rt_free(data[i]);
+    mem_free(I, names);
+    mem_free(I, data);
+    mem_free(I, lens);
+    return rc;
+}
+
+/* --frames A..B:STEP: the script once per frame, each in a fresh interpreter
+ * set up like a plain run (the same -D, --seed, -o, limits), so frame N is
+ * byte for byte what `--frames N..N` gives for a script that reads `frame`
+ * (`clock` is 0 for a single frame). Stops at the first frame that fails. */
+static int run_frames(interp *T, opts *o)
+{
+    unsigned char *text;
+    size_t len;
+    int rc = read_script(T, o->script, &text, &len);
+    if (rc)
+        return rc;
+    o->text = text;
+    o->len = len;
+    long count = (o->fb - o->fa) / o->fstep + 1, big = labs(o->fa) > labs(o->fb) ? labs(o->fa) : labs(o->fb);
+    int width = 1;
+    for (; big >= 10; big /= 10)
+        width++;
+    int tty = !T->quiet && isatty(2);
+    rc = EX_OK;
+    for (long k = 0; k < count && rc == EX_OK; k++) {
+        long f = o->fa + k * o->fstep;
+        if (interrupted) {
+            rc = 130;
+            break;
+        }
+        if (tty)
+            fprintf(stderr, "frame %ld (%ld of %ld)\n", f, k + 1, count);
+        interp st, *I = &st;
+        fresh_interp(I, T);
+        I->frame = f;
+        I->frames_given = 1;
+        I->clock = o->fb > o->fa ? (double)(f - o->fa) / (double)(o->fb - o->fa) : 0.0;
+        I->frame_width = width;
+        I->frame_count = count;
+        rc = run_frac(I, o);
+        interp_free(I);
+        rt_alloc_set_hook(&T->hook); /* T's blocks (the script, the options) are counted by T */
+        if (rc != EX_OK && count > 1)
+            fprintf(stderr, "frac: stopped at frame %ld (%ld of %ld frames done)\n", f, k, count);
+    }
+    o->text = NULL;
+    rt_free(text);
     return rc;
 }
 
@@ -853,7 +1134,10 @@ static int frac_main(int argc, char **argv)
     if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
-            rc = run_frac(I, &o);
+            rc = o.frames                       ? run_frames(I, &o)
+                 : strcmp(o.mode, "apng") == 0  ? run_apng(I, &o)
+                 : strcmp(o.mode, "watch") == 0 ? run_watch(I, &o)
+                                                : run_frac(I, &o);
     }
     mem_free(I, o.args);
     mem_free(I, o.ov);

@@ -228,11 +228,22 @@ static const char help_text[] =
     "  :quit          leave (also Ctrl-D on an empty line)\n"
     "Type any statement or expression; bare expressions print their value.\n"
     "Unfinished input continues on a '..' line; a line starting with elif, else\n"
-    "or |> continues the entry before it (which then runs again, joined).\n";
+    "or |> continues the entry before it (which then runs again, joined).\n"
+    "frame and clock are 0 here; `frac run --frames A..B` sets them (:help frame).\n";
+
+static const char frame_help[] =
+    "frame, clock\n"
+    "  Read-only numbers: with `frac run --frames A..B[:STEP]`, frame is the frame\n"
+    "  number and clock (frame - A) / (B - A), 0 at A and 1 at B; 0 otherwise. In\n"
+    "  output paths %f is the frame number, zero-padded. See docs/animation.md.\n";
 
 static void cmd_help(repl *r, const char *arg)
 {
     interp *I = r->I;
+    if (!strcmp(arg, "frame") || !strcmp(arg, "clock")) {
+        fputs(frame_help, stdout);
+        return;
+    }
     if (*arg) {
         const builtin *b = builtin_find(I, arg);
         if (!b) {

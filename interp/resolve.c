@@ -113,6 +113,22 @@ static int visible(resolver *r, scope *s, const char *name)
     return val_env_lookup(r->globals, name) != NULL;
 }
 
+/* `frame` and `clock` as the builtin scope defines them (not shadowed by a
+ * let, a param or a parameter): assigning to them is an error. */
+static int read_only_frame_name(resolver *r, scope *s, const char *name)
+{
+    if (strcmp(name, "frame") != 0 && strcmp(name, "clock") != 0)
+        return 0;
+    for (; s; s = s->parent)
+        if (scope_has(s, name))
+            return 0;
+    env *root = r->globals;
+    while (root->parent)
+        root = root->parent;
+    value *slot = val_env_lookup(r->globals, name);
+    return slot && slot == val_env_lookup(root, name);
+}
+
 /* Append a name to a growable array (freed on failure). */
 static int push_candidate(interp *I, const char ***c, size_t *n, size_t *cap, const char *name)
 {
@@ -301,6 +317,11 @@ static int resolve_block(resolver *r, scope *s, const node *b)
         case N_ASSIGN:
             if (!visible(r, s, st->str))
                 return err_at(r->I, st, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
+                              st->str, st->str);
+            if (read_only_frame_name(r, s, st->str))
+                return err_at(r->I, st, ERR_NAME,
+                              "cannot assign to '%s': it is read-only (set by --frames; 'let %s = …' defines "
+                              "your own)",
                               st->str, st->str);
             if (resolve_node(r, s, st->kids[0]))
                 return -1;

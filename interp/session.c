@@ -17,6 +17,15 @@ int session_setup(interp *I)
     I->globals = root; /* builtins register into the root */
     if (builtin_core_init(I) || builtin_image_init(I) || bind_all_init(I))
         return -1;
+    /* `frame` and `clock` (--frames; 0 outside it): read-only, like the
+     * builtins they sit beside (resolve.c refuses assignments to them) */
+    const char *fr = interp_intern(I, "frame", 5), *ck = interp_intern(I, "clock", 5);
+    if (fr && ck && (val_env_lookup(root, fr) || val_env_lookup(root, ck)))
+        return err_pos(I, -1, 0, 0, ERR_RUNTIME, "internal: a builtin named '%s' would be hidden by the --frames name",
+                       val_env_lookup(root, fr) ? "frame" : "clock"); /* not silently: rename the builtin */
+    if (!fr || !ck || val_env_define(I, root, fr, val_num((double)I->frame)) ||
+        val_env_define(I, root, ck, val_num(I->clock)))
+        return -1;
     I->globals = val_env_new(I, root);
     val_heap_unref(I, &root->h); /* the global scope holds it now */
     return I->globals ? 0 : -1;

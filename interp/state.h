@@ -138,14 +138,19 @@ typedef struct interp {
     int quiet;
     int progress;
     const char *out_dir; /* NULL: current directory */
-    long frame;          /* the frame being rendered (--frames), for the recipe */
-    int frames_given;    /* 1 if a frame was given (otherwise frame is 0 and unused) */
     /* work the engines did, for the render report (report.h) */
 #define WORK_MAX 12
     struct { const char *engine, *unit; double amount, seconds; } work[WORK_MAX];
     int nwork;
     int is_repl;
     FILE *out;           /* where print() writes (stdout) */
+    /* frames (frac run --frames A..B[:STEP]): the names `frame` and `clock`,
+     * and what `%f` in an output path becomes; all 0 outside --frames */
+    long frame;          /* this frame's number */
+    int frames_given;    /* 1 when --frames was given */
+    double clock;        /* 0 at A, 1 at B (0 for A..A) */
+    int frame_width;     /* digits of %f: those of the largest |A|, |B| */
+    long frame_count;    /* frames in the range (>= 2: every path needs %f) */
 
     /* builtin registry */
     const builtin **builtins;

@@ -218,6 +218,15 @@ static void sync_folder(const char *path)
     }
 }
 
+static _Atomic(fileio_path_hook) path_hook;
+static void *path_hook_ud;
+
+void fileio_set_path_hook(fileio_path_hook fn, void *ud)
+{
+    path_hook_ud = ud;
+    atomic_store(&path_hook, fn);
+}
+
 rt_code fileio_write_atomic(const char *path, const void *data, size_t n, rt_error *e)
 {
     size_t plen = strlen(path);
@@ -282,6 +291,9 @@ rt_code fileio_write_atomic(const char *path, const void *data, size_t n, rt_err
     if (bad)
         return rt_fail(e, RT_EIO, "cannot write '%s': %s", path, strerror(err));
     sync_folder(path);
+    fileio_path_hook hook = atomic_load(&path_hook);
+    if (hook)
+        hook(path_hook_ud, path, 1);
     return RT_OK;
 }
 
@@ -290,6 +302,9 @@ rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data
 {
     *data = NULL;
     *n = 0;
+    fileio_path_hook hook = atomic_load(&path_hook);
+    if (hook)
+        hook(path_hook_ud, path, 0);
     FILE *f = fopen(path, "rb");
     if (!f)
         return rt_fail(e, RT_EIO, "cannot open '%s': %s", path, strerror(errno));

@@ -41,6 +41,13 @@ void fileio_cleanup_temps(void);
 int fileio_install_signal_cleanup(void);
 rt_code fileio_read_all(const char *path, size_t max_bytes, unsigned char **data, size_t *n,
                         rt_error *e);
+/* Watching (frac watch): with a hook set, fn(ud, path, wrote) sees every
+ * path fileio_read_all opens (wrote 0; called before reading, so a file that
+ * is missing is seen too) and every file fileio_write_atomic has written
+ * (wrote 1). One process-wide hook, like the allocation hook (rt_alloc.h),
+ * called on the thread that reads or writes; NULL removes it. */
+typedef void (*fileio_path_hook)(void *ud, const char *path, int wrote);
+void fileio_set_path_hook(fileio_path_hook fn, void *ud);
 
 /* A growable byte buffer for building files in memory. */
 typedef struct bytebuf {

@@ -46,6 +46,11 @@ static void put_chunk(bytebuf *out, const char *type, const unsigned char *data,
     bytebuf_u32be(out, crc);
 }
 
+void png_write_chunk(bytebuf *out, const char *type, const unsigned char *data, size_t len)
+{
+    put_chunk(out, type, data, len);
+}
+
 static int paeth(int a, int b, int c) /* §9.4 */
 {
     int p = a + b - c;

@@ -68,6 +68,10 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
                            int level, bytebuf *out, bytebuf *filtered, rt_error *e);
 rt_code png_save(const image *im, const char *path, int bits, int channels, rt_error *e);
 
+/* One chunk: length, type, data, CRC-32 of type and data (§5.3); for
+ * writers of other chunk sequences on top of this encoder (apng.c). */
+void png_write_chunk(bytebuf *out, const char *type, const unsigned char *data, size_t len);
+
 rt_code png_read_info(const unsigned char *data, size_t n, png_info *info, rt_error *e);
 rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *info, rt_error *e);
 rt_code png_load(const char *path, image *im, png_info *info, rt_error *e);

@@ -1004,21 +1004,23 @@ static void run_fail_alloc(const char *frac, const char *script)
 }
 
 /* ---- checks with outside tools --------------------------------------------------------
+ * tests/tools/NAME.py scripts, run as `/usr/bin/python3 tests/tools/NAME.py FRAC`.
  * tests/tools/vdb_check.py opens frac's .vdb files with the OpenVDB library
  * (Debian python3-openvdb, for /usr/bin/python3); tests/tools/mesh_check.py
  * reads the meshes of 3-D function sets with its own PLY/OBJ/STL readers. An
  * exit 77 (a module or python missing) prints its "skipped: …" line and
  * counts neither way. */
-static void run_tool_check(const char *frac, const char *label)
+static void run_py_check(const char *frac, const char *name)
 {
+    char label[256], script[300];
+    snprintf(label, sizeof label, "tools/%s", name);
+    snprintf(script, sizeof script, "tests/tools/%s", name);
     if (!matches_filter(label))
         return;
     if (access("/usr/bin/python3", X_OK) != 0) {
         printf("%s skipped: /usr/bin/python3 not installed\n", label);
         return;
     }
-    char script[256];
-    snprintf(script, sizeof script, "tests/%s", label);
     char *argv[] = {"/usr/bin/python3", script, (char *)frac, NULL};
     buf out = {0}, err = {0}, why = {0};
     int rc = run(argv, NULL, &out, &err, 120);
@@ -1365,8 +1367,11 @@ int main(int argc, char **argv)
         if (realpath(ptyrun, ptyabs))
             run_pty_dir(fracabs, ptyabs);
     }
-    run_tool_check(fracabs, "tools/vdb_check.py");
-    run_tool_check(fracabs, "tools/mesh_check.py");
+    run_py_check(fracabs, "vdb_check.py");
+    run_py_check(fracabs, "mesh_check.py");   /* 3-D function sets' meshes: own PLY/OBJ/STL readers */
+    run_py_check(fracabs, "frames_check.py"); /* --frames from outside: frame identity, tty progress */
+    run_py_check(fracabs, "apng_check.py");   /* APNG: own decoder, pngcheck, PIL, apngdis */
+    run_py_check(fracabs, "watch_check.py");  /* frac watch in the background: edits, cancel, Ctrl-C */
     run_golden(fracabs, 0);
     run_fail_alloc(fracabs, "examples/tour.frac");
     run_fail_alloc(fracabs, "tests/lang/core/functions.frac");

@@ -368,6 +368,45 @@ static int rm_tree(const char *path)
     return unlink(path);
 }
 
+/* fileio_set_path_hook (frac watch): every read is seen before the file is
+ * opened (a missing one too), every completed write after it; a failed
+ * write is not reported; NULL removes the hook. */
+static char seen[8][512];
+static int seen_wrote[8], nseen;
+static void on_path(void *ud, const char *path, int wrote)
+{
+    CHECK(ud == (void *)seen, "the hook gets its user data");
+    if (nseen < 8) {
+        snprintf(seen[nseen], sizeof seen[nseen], "%s", path);
+        seen_wrote[nseen++] = wrote;
+    }
+}
+
+static void test_path_hook(void)
+{
+    char a[4096], missing[4096], dir[4096];
+    pathf(a, sizeof a, "hooked.txt");
+    pathf(missing, sizeof missing, "no_such_file.txt");
+    pathf(dir, sizeof dir, "hook_dir");
+    mkdir(dir, 0777);
+    rt_error e;
+    unsigned char *d;
+    size_t n;
+    fileio_set_path_hook(on_path, seen);
+    CHECK(fileio_write_atomic(a, "abc", 3, &e) == RT_OK, "write: %s", e.msg);
+    CHECK(fileio_read_all(a, 100, &d, &n, &e) == RT_OK && n == 3, "read back");
+    rt_free(d);
+    CHECK(fileio_read_all(missing, 100, &d, &n, &e) == RT_EIO, "missing file");
+    CHECK(fileio_write_atomic(dir, "x", 1, &e) == RT_EIO, "a folder is refused");
+    fileio_set_path_hook(NULL, NULL);
+    CHECK(fileio_read_all(a, 100, &d, &n, &e) == RT_OK, "read without the hook");
+    rt_free(d);
+    CHECK(nseen == 3, "3 paths seen, got %d", nseen);
+    CHECK(nseen >= 3 && !strcmp(seen[0], a) && seen_wrote[0] == 1, "the write: %s %d", seen[0], seen_wrote[0]);
+    CHECK(nseen >= 3 && !strcmp(seen[1], a) && seen_wrote[1] == 0, "the read: %s %d", seen[1], seen_wrote[1]);
+    CHECK(nseen >= 3 && !strcmp(seen[2], missing) && seen_wrote[2] == 0, "the missing read: %s", seen[2]);
+}
+
 int main(void)
 {
     const char *t = getenv("TMPDIR");
@@ -383,6 +422,7 @@ int main(void)
     test_long();
     test_threads();
     test_signals();
+    test_path_hook();
     rm_tree(root);
     return check_done("test_fileio");
 }
