@@ -27,6 +27,7 @@
 #include "parser.h"
 #include "repl.h"
 #include "session.h"
+#include "shard.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
 
@@ -35,6 +36,12 @@ static const char usage_text[] =
     "                                          run a script; files it names are written\n"
     "       frac check [--params] [OPTIONS] SCRIPT.frac\n"
     "                                          parse and check without running anything\n"
+    "       frac run --shard I/N|auto [OPTIONS] SCRIPT.frac\n"
+    "                                          compute shard I of N of every engine call:\n"
+    "                                          writes SCRIPT.shard-I-of-N.part, no images\n"
+    "       frac merge [OPTIONS] SCRIPT.frac PART...\n"
+    "                                          the files of `frac run SCRIPT.frac` from its\n"
+    "                                          parts, byte for byte (docs/scale.md)\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac --version | --help\n"
@@ -67,6 +74,9 @@ static const char usage_text[] =
     "  --threads N           worker threads, 1 to 256 (default: all cores)\n"
     "  -q, --quiet           no progress bars or `wrote FILE` lines\n"
     "  --params              with check: list the script's params and defaults\n"
+    "  --shard I/N | auto    with run: shard I (0 ≤ I < N) of N; auto takes them from\n"
+    "                        SLURM_ARRAY_TASK_ID/_COUNT/_MIN, SLURM_PROCID/SLURM_NTASKS,\n"
+    "                        OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -168,11 +178,13 @@ typedef struct opts {
     const char **args;  /* the script's arguments (pointers into argv) */
     param_override *ov; /* -D as typed: name is "NAME=VALUE", text the VALUE */
     int nov;
+    const char *shard; /* --shard I/N or auto */
+    shard *sh;         /* --shard or merge: kept across re-runs (shard.h) */
 } opts;
 
 static int is_command(const char *w)
 {
-    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0;
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 || strcmp(w, "merge") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -246,6 +258,16 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             o->nov++;
             continue;
         }
+        if (!strcmp(name, "--shard")) {
+            if (!val || !*val)
+                return usage_error("--shard needs a value: I/N or auto");
+            if (o->shard)
+                return usage_error("--shard is given twice");
+            if (!inline_val)
+                i++;
+            o->shard = val;
+            continue;
+        }
         int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
         if (is_e || is_o || f < NNUM) {
             const char *what = is_e ? "an expression" : is_o ? "a folder" : numflags[f].range;
@@ -292,6 +314,12 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
                            o->script, o->script);
     if ((strcmp(o->mode, "run") == 0 || strcmp(o->mode, "check") == 0) && !o->script)
         return usage_error("%s needs a script file (or - for standard input)", o->mode);
+    if (strcmp(o->mode, "merge") == 0 && (!o->script || !o->nargs))
+        return usage_error("merge needs the script and its part files: frac merge [-o DIR] SCRIPT.frac PART...");
+    if (o->shard && strcmp(o->mode, "run") != 0)
+        return usage_error("--shard goes with `frac run`, not `%s`", strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
+    if (o->shard && !strcmp(o->script, "-"))
+        return usage_error("--shard needs a script file, not standard input");
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -554,6 +582,14 @@ static int run_frac(interp *I, opts *o)
         rt_free(text);
         return rc;
     }
+    if (o->sh) { /* --shard or merge: one attempt (shard.h) */
+        int bad = shard_attempt_begin(o->sh, I, name, text, len) || session_run(I, name, (const char *)text, len, 0, NULL);
+        bad = shard_attempt_end(o->sh, !bad, name) || bad;
+        rt_free(text);
+        if (o->sh->again) /* abandoned by a taint: main runs it again */
+            return EX_OK;
+        return bad ? session_report(I) : EX_OK;
+    }
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
         rc = session_report(I);
     } else {
@@ -567,22 +603,35 @@ static int run_frac(interp *I, opts *o)
 
 static int frac_main(int argc, char **argv)
 {
-    interp st, *I = &st;
-    interp_init(I);
-    I->threads = par_cores();
-    I->progress = 1;
-    opts o = {0};
-    o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
-    o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
-    int rc = EX_SOFTWARE;
-    if (o.args && o.ov) {
-        rc = parse_command_line(I, argc, argv, &o);
-        if (rc < 0)
-            rc = run_frac(I, &o);
-    }
-    mem_free(I, o.args);
-    mem_free(I, o.ov);
-    interp_free(I);
+    shard sh; /* --shard / merge: lives across the re-runs, each in a fresh interpreter */
+    int rc, again = 0;
+    do {
+        interp st, *I = &st;
+        interp_init(I);
+        I->threads = par_cores();
+        I->progress = 1;
+        opts o = {0};
+        o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
+        o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
+        rc = EX_SOFTWARE;
+        if (o.args && o.ov) {
+            rc = parse_command_line(I, argc, argv, &o);
+            if (rc < 0 && !again) {
+                if (o.shard && shard_init_run(&sh, o.shard))
+                    rc = EX_USAGE;
+                else if (!strcmp(o.mode, "merge"))
+                    shard_init_merge(&sh, (char *const *)o.args, o.nargs);
+            }
+            if (rc < 0) {
+                o.sh = o.shard || !strcmp(o.mode, "merge") ? &sh : NULL;
+                rc = run_frac(I, &o);
+                again = o.sh && sh.again;
+            }
+        }
+        mem_free(I, o.args);
+        mem_free(I, o.ov);
+        interp_free(I);
+    } while (again);
     return finish_output(rc);
 }
 

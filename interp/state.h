@@ -140,6 +140,7 @@ typedef struct interp {
     const char *out_dir; /* NULL: current directory */
     int is_repl;
     FILE *out;           /* where print() writes (stdout) */
+    struct shard *shard; /* --shard / merge (shard.h); NULL otherwise */
 
     /* builtin registry */
     const builtin **builtins;

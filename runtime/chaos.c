@@ -675,6 +675,39 @@ static void fill_stats(chaos_stats *st, const worker *w, int nw)
     }
 }
 
+/* A sharded or merging call (par.h): the workers' exact integer sums —
+ * k = 1 (count) or 4 (count, r, g, b) per bin — then plotted and inside, go
+ * through par_part_sum as one section; returns the summed array (n words). */
+static uint64_t *shard_sums(const par_part *pp, const worker *w, int nw, size_t nbins, int colour,
+                            size_t *n, rt_code *rc, rt_error *e)
+{
+    size_t k = colour ? 4 : 1;
+    *n = nbins * k + 2;
+    uint64_t *tot = rt_calloc(*n, sizeof *tot);
+    if (!tot) {
+        *rc = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
+        return NULL;
+    }
+    for (size_t b = 0; b < nbins; b++)
+        for (int i = 0; i < nw; i++) {
+            if (!colour)
+                tot[b] += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
+            else
+                for (size_t q = 0; q < 4; q++)
+                    tot[4 * b + q] += w[i].cnt[4 * b + q] + (w[i].carry ? w[i].carry[4 * b + q] : 0);
+        }
+    for (int i = 0; i < nw; i++) {
+        tot[nbins * k] += w[i].plotted;
+        tot[nbins * k + 1] += w[i].inside;
+    }
+    *rc = par_part_sum(pp, tot, *n, e);
+    if (*rc) {
+        rt_free(tot);
+        return NULL;
+    }
+    return tot;
+}
+
 rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_stats *st,
                     const rt_run *run, rt_error *e)
 {
@@ -701,9 +734,26 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, hist_fns[d->kind][o->colour], &j);
+    par_part pp;
+    rc = par_part_begin(&pp, run, o->colour != CHAOS_COLOUR_NONE ? "chaos colour" : "chaos", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", hist_fns[d->kind][o->colour], &j);
     rc = finish_par(rc, j.w, nw, e);
-    if (!rc) {
+    if (!rc && pp.mode != PAR_FULL) {
+        int colour = o->colour != CHAOS_COLOUR_NONE;
+        size_t n;
+        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, colour, &n, &rc, e);
+        for (size_t b = 0; tot && b < j.nbins; b++) {
+            hs->count[b] += tot[colour ? 4 * b : b];
+            for (int ch = 0; colour && ch < 3; ch++)
+                hs->csum[3 * b + ch] += (float)((double)tot[4 * b + ch + 1] / 65535.0);
+        }
+        if (tot && st) {
+            st->plotted = tot[n - 2];
+            st->inside = tot[n - 1];
+        }
+        rt_free(tot);
+    } else if (!rc) {
         for (size_t b = 0; b < j.nbins; b++) {
             if (o->colour == CHAOS_COLOUR_NONE) {
                 hs->count[b] += total_count(j.w, nw, b);
@@ -750,9 +800,31 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, vol_fns[d->kind], &j);
+    par_part pp;
+    rc = par_part_begin(&pp, run, "chaos volume", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", vol_fns[d->kind], &j);
     rc = finish_par(rc, j.w, nw, e);
-    if (!rc) {
+    if (!rc && pp.mode != PAR_FULL) {
+        size_t n;
+        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, 0, &n, &rc, e);
+        if (tot) {
+            uint64_t mx = 0;
+            for (size_t b = 0; b < j.nbins; b++)
+                if (tot[b] > mx)
+                    mx = tot[b];
+            if (st) {
+                st->plotted = tot[n - 2];
+                st->inside = tot[n - 1];
+            }
+            double den = norm == CHAOS_NORM_TOTAL ? (double)tot[n - 2] : norm == CHAOS_NORM_MAX ? (double)mx : 1;
+            if (!(den > 0))
+                den = 1;
+            for (size_t b = 0; b < j.nbins; b++)
+                vol->v[b] = (float)((double)tot[b] / den);
+        }
+        rt_free(tot);
+    } else if (!rc) {
         uint64_t mx = 0;
         for (size_t b = 0; b < j.nbins; b++) {
             uint64_t t = total_count(j.w, nw, b);
