@@ -318,8 +318,8 @@ static int call_builtin(interp *I, const builtin *b, const value *pos, int npos,
     I->cur = call;
     I->bcall = &bc;
     int rc = b->fn(I, args, b->variadic ? npos : nargs, out);
-    if (rc == 0 && I->shard && shard_after_builtin(I, out))
-        rc = -1; /* a sharded engine call's result becomes a partial value */
+    if (I->shard)
+        rc = shard_after_builtin(I, rc, out); /* a sharded engine call's result becomes a partial value */
     I->cur = save;
     I->bcall = save_call;
     if (rc == 0 && I->err.active)

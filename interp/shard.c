@@ -196,7 +196,7 @@ static void rec_head(bytebuf *b, const shard_rec *r, uint64_t lo, uint64_t hi, u
 
 static void payload_range(const shard_rec *r, size_t lo, size_t hi, uint64_t *from, uint64_t *len)
 {
-    if (r->op == PAR_OP_SUM) {
+    if (r->op != PAR_OP_ROWS) { /* SUM, COMBINE: the whole accumulator */
         *from = 0;
         *len = r->total;
         return;
@@ -284,9 +284,10 @@ static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo
     return PAR_SHARD;
 }
 
-static rt_code merge_section(shard *s, const shard_rec *want, void *buf, rt_error *e);
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e);
 
-static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t total, size_t chunk_bytes, rt_error *e)
+static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t total, size_t chunk_bytes,
+                          par_combine_fn fn, void *ctx, rt_error *e)
 {
     shard *s = (shard *)rs;
     if (s->cur < 0)
@@ -298,7 +299,7 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     r.op = op;
     r.nchunks = s->cur_nchunks;
     r.total = total;
-    r.chunk_bytes = op == PAR_OP_ROWS ? chunk_bytes : 0;
+    r.chunk_bytes = op == PAR_OP_SUM ? 0 : chunk_bytes;
     if (s->merging) {
         if (s->next_rec >= s->nrecs)
             return rt_fail(e, RT_EFORMAT, "merge: the parts have no record for section %u of engine call %u", r.sub, r.seq);
@@ -307,7 +308,7 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
         if (p->seq != r.seq || p->sub != r.sub || p->op != r.op || p->total != r.total || p->chunk_bytes != r.chunk_bytes)
             return rt_fail(e, RT_EFORMAT, "merge: engine call %u section %u: the parts hold %llu bytes (op %u), this run needs %llu (op %u)",
                            r.seq, r.sub, (unsigned long long)p->total, p->op, (unsigned long long)r.total, r.op);
-        rt_code c = merge_section(s, p, buf, e);
+        rt_code c = merge_section(s, p, buf, fn, ctx, e);
         s->next_rec++;
         return c;
     }
@@ -503,8 +504,8 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         chunk_range(h.nchunks, *index, *count, &elo, &ehi);
         uint64_t efrom, elen;
         payload_range(&h, elo, ehi, &efrom, &elen);
-        if (lo != elo || hi != ehi || len != elen || (h.op != PAR_OP_SUM && h.op != PAR_OP_ROWS) ||
-            (h.op == PAR_OP_SUM && h.total % 8)) {
+        if (lo != elo || hi != ehi || len != elen || h.op < PAR_OP_SUM || h.op > PAR_OP_COMBINE ||
+            (h.op == PAR_OP_SUM && h.total % 8) || (h.op == PAR_OP_COMBINE && (!h.chunk_bytes || h.total % h.chunk_bytes))) {
             snprintf(msg, sizeof msg, "it is corrupt (record at byte %ld)", at);
             break;
         }
@@ -599,9 +600,15 @@ static int merge_open(shard *s)
 }
 
 /* Fill buf from every part's record `want` (the next one in each part). */
-static rt_code merge_section(shard *s, const shard_rec *want, void *buf, rt_error *e)
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e)
 {
     unsigned char blk[1 << 14];
+    size_t step = sizeof blk;
+    if (want->op == PAR_OP_COMBINE) {
+        if (!fn || !want->chunk_bytes || want->chunk_bytes > sizeof blk)
+            return rt_fail(e, RT_EINVAL, "internal: a combined section without a combine function");
+        step = sizeof blk / want->chunk_bytes * want->chunk_bytes; /* whole elements */
+    }
     for (int i = 0; i < s->count; i++) {
         const char *path = s->parts[s->order[i]];
         FILE *f = fopen(path, "rb");
@@ -616,6 +623,14 @@ static rt_code merge_section(shard *s, const shard_rec *want, void *buf, rt_erro
             memcmp(&h, want, sizeof h) != 0) {
             c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging (record %u.%u of engine call %u not found at byte %ld)",
                         path, want->sub, want->seq, want->seq, s->off[i]);
+        } else if (want->op == PAR_OP_COMBINE) {
+            for (uint64_t k = 0; k < len && !c; k += step) {
+                size_t n = len - k < step ? (size_t)(len - k) : step;
+                if (rd(&r, blk, n))
+                    c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging", path);
+                else
+                    fn(ctx, (unsigned char *)buf + k, blk, n / want->chunk_bytes);
+            }
         } else if (want->op == PAR_OP_SUM) {
             uint64_t *acc = buf;
             for (uint64_t k = 0; k < len && !c; k += sizeof blk) {
@@ -806,11 +821,19 @@ int shard_scan_args(interp *I, const char *bname, const node *call, const value 
     return rc;
 }
 
-int shard_after_builtin(interp *I, value *out)
+int shard_after_builtin(interp *I, int rc, value *out)
 {
     shard *s = I->shard;
     if (!s || s->pending < 0)
-        return 0;
+        return rc;
+    if (rc != 0) { /* the builtin used its partial result itself (a pre-pass, a check) */
+        if (!s->again && !(I->err.active && I->err.kind == ERR_INTERRUPT)) {
+            err_clear(I);
+            taint(s, (uint32_t)s->pending, s->pending_at, "is used inside its builtin");
+        }
+        s->pending = -1;
+        return -1;
+    }
     partial *p = mem_alloc(I, sizeof *p);
     if (!p)
         return -1;

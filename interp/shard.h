@@ -96,7 +96,9 @@ int shard_attempt_end(shard *s, int ok, const char *script);
 /* The evaluator's hooks (eval.c), cheap when s has no partial values. */
 int shard_scan_args(interp *I, const char *builtin_name, const node *call, const value *pos, int npos,
                     const value *named, int nnamed);
-int shard_after_builtin(interp *I, value *out);
+/* After a builtin returned rc: wraps a pending partial result; a builtin
+ * that failed with a partial result pending is a taint. Returns the new rc. */
+int shard_after_builtin(interp *I, int rc, value *out);
 /* save(v, …) in a shard: writes nothing (1: handled), 0 otherwise. */
 int shard_skip_save(interp *I);
 

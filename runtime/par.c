@@ -94,7 +94,12 @@ rt_code par_for(const rt_run *run, const char *label, size_t nchunks, par_fn fn,
 
 static rt_sharder *the_sharder;
 
-void par_set_sharder(rt_sharder *s) { the_sharder = s; }
+rt_sharder *par_set_sharder(rt_sharder *s)
+{
+    rt_sharder *old = the_sharder;
+    the_sharder = s;
+    return old;
+}
 
 rt_code par_part_begin(par_part *p, const rt_run *run, const char *kind, size_t nchunks, rt_error *e)
 {
@@ -146,12 +151,20 @@ rt_code par_part_sum(const par_part *p, uint64_t *acc, size_t n, rt_error *e)
 {
     if (p->mode == PAR_FULL)
         return RT_OK;
-    return p->sharder->section(p->sharder, PAR_OP_SUM, acc, n * sizeof *acc, 0, e);
+    return p->sharder->section(p->sharder, PAR_OP_SUM, acc, n * sizeof *acc, 0, NULL, NULL, e);
 }
 
 rt_code par_part_rows(const par_part *p, void *buf, size_t total_bytes, size_t chunk_bytes, rt_error *e)
 {
     if (p->mode == PAR_FULL)
         return RT_OK;
-    return p->sharder->section(p->sharder, PAR_OP_ROWS, buf, total_bytes, chunk_bytes, e);
+    return p->sharder->section(p->sharder, PAR_OP_ROWS, buf, total_bytes, chunk_bytes, NULL, NULL, e);
+}
+
+rt_code par_part_combine(const par_part *p, void *buf, size_t n, size_t elem, par_combine_fn fn, void *ctx,
+                         rt_error *e)
+{
+    if (p->mode == PAR_FULL)
+        return RT_OK;
+    return p->sharder->section(p->sharder, PAR_OP_COMBINE, buf, n * elem, elem, fn, ctx, e);
 }

@@ -57,24 +57,29 @@ int par_workers(const rt_run *run, size_t nchunks);
  * others run in full everywhere, before or after it). */
 typedef enum par_part_mode { PAR_FULL = 0, PAR_SHARD, PAR_MERGE } par_part_mode;
 
-typedef enum par_part_op { PAR_OP_SUM = 1, PAR_OP_ROWS = 2 } par_part_op;
+typedef enum par_part_op { PAR_OP_SUM = 1, PAR_OP_ROWS = 2, PAR_OP_COMBINE = 3 } par_part_op;
+
+/* PAR_OP_COMBINE: fold n elements of a part (part) into the accumulator
+ * (acc); must be exact and order-free (a max with a total order, a min). */
+typedef void (*par_combine_fn)(void *ctx, void *acc, const void *part, size_t n);
 
 typedef struct rt_sharder {
     /* A new shardable call of `kind` (a short name) with nchunks chunks:
      * returns its mode, and for PAR_SHARD the chunk range in *lo, *hi; -1
      * stops the engine (RT_ECANCEL): the evaluation is being abandoned. */
     int (*begin)(struct rt_sharder *s, const char *kind, size_t nchunks, size_t *lo, size_t *hi);
-    /* One section: op, the buffer of total bytes (SUM: total/8 uint64),
-     * chunk_bytes for ROWS. Record it (PAR_SHARD) or fill it (PAR_MERGE). */
-    rt_code (*section)(struct rt_sharder *s, par_part_op op, void *buf, size_t total,
-                       size_t chunk_bytes, rt_error *e);
+    /* One section: op, the buffer of total bytes (SUM: total/8 uint64);
+     * unit: chunk_bytes for ROWS, the element size for COMBINE (with fn,
+     * ctx). Record it (PAR_SHARD) or fill it (PAR_MERGE). */
+    rt_code (*section)(struct rt_sharder *s, par_part_op op, void *buf, size_t total, size_t unit,
+                       par_combine_fn fn, void *ctx, rt_error *e);
 } rt_sharder;
 
 /* Install the process's sharder (NULL: none). Process-wide for the reason
  * the allocation hook is (rt_alloc.h): a process runs one interpreter at a
  * time, and rt_run is initialised positionally in many places. Set it only
  * while no engine runs. */
-void par_set_sharder(rt_sharder *s);
+rt_sharder *par_set_sharder(rt_sharder *s); /* returns the previous one */
 
 typedef struct par_part {
     const rt_run *run;
@@ -90,5 +95,8 @@ rt_code par_part_for(const par_part *p, const char *label, par_fn fn, void *ctx)
 rt_code par_part_sum(const par_part *p, uint64_t *acc, size_t n, rt_error *e);
 /* Section of a buffer filled chunk by chunk (the last chunk may be shorter). */
 rt_code par_part_rows(const par_part *p, void *buf, size_t total_bytes, size_t chunk_bytes, rt_error *e);
+/* Section of n elements of elem bytes, merged with fn (order-free). */
+rt_code par_part_combine(const par_part *p, void *buf, size_t n, size_t elem, par_combine_fn fn, void *ctx,
+                         rt_error *e);
 
 #endif
