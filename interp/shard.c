@@ -225,7 +225,7 @@ static void where(interp *I, const node *n, char *buf, size_t size)
     if (n && n->src >= 0 && n->src < I->nsrc)
         snprintf(buf, size, "%s:%d:%d", I->srcs[n->src].name, n->line + I->srcs[n->src].first_line - 1, n->col);
     else
-        snprintf(buf, size, "?");
+        buf[0] = 0;
 }
 
 /* Call `seq` (made at `at`) cannot be sharded: compute it fully from now on. */
@@ -240,8 +240,8 @@ static int taint(shard *s, uint32_t seq, const node *at, const char *why)
         char a[512], b[512];
         where(I, at, a, sizeof a);
         where(I, I->cur, b, sizeof b);
-        fprintf(stderr, "frac: note: engine call %u (at %s) is computed fully in every shard: its result %s at %s\n",
-                seq, a, why, b);
+        fprintf(stderr, "frac: note: engine call %u (at %s) is computed fully in every shard: its result %s%s%s\n",
+                seq, a, why, b[0] ? " at " : "", b);
     }
     return err_at(I, NULL, ERR_RUNTIME, "--shard: abandoned to re-run (call %u is computed fully)", seq);
 }

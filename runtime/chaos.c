@@ -865,14 +865,62 @@ rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_
         sys_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
     }
-    rt_code rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    /* chunk c writes points [c*chunk, (c+1)*chunk): a shard fills its
+     * chunks' points, merge places them (par.h) */
+    par_part pp;
+    rt_code rc = par_part_begin(&pp, run, "chaos points", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", points_chunk, &j);
     rc = finish_par(rc, NULL, 0, e);
+    if (!rc)
+        rc = par_part_rows(&pp, j.pos, sizeof *j.pos * 3 * np, sizeof *j.pos * 3 * (size_t)j.chunk, e);
+    if (!rc && j.col)
+        rc = par_part_rows(&pp, j.col, sizeof *j.col * 4 * np, sizeof *j.col * 4 * (size_t)j.chunk, e);
     for (size_t i = 0; !rc && i < np; i++)
         if (mesh_add_vertex(m, j.pos + 3 * i, NULL, j.col ? j.col + 4 * i : NULL) == UINT32_MAX)
             rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
     rt_free(j.pos);
     rt_free(j.col);
     sys_free(d);
+    return rc;
+}
+
+typedef struct zcell {
+    double z;
+    uint32_t tag, pad;
+} zcell;
+
+static void combine_z(void *ctx, void *acc, const void *part, size_t n)
+{
+    (void)ctx;
+    zcell *a = acc;
+    const zcell *p = part;
+    for (size_t b = 0; b < n; b++)
+        if (p[b].z < a[b].z || (p[b].z == a[b].z && p[b].tag < a[b].tag))
+            a[b] = p[b];
+}
+
+/* Sharded projection: the workers' nearest points, merged with the shards'
+ * (par_part_combine), land in worker 0's arrays; the others are reset. */
+static rt_code shard_zbuf(const par_part *pp, worker *w, int nw, size_t nbins, rt_error *e)
+{
+    zcell *zc = rt_calloc(nbins, sizeof *zc);
+    if (!zc)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the shard's z-buffer");
+    for (size_t b = 0; b < nbins; b++) {
+        zc[b].z = w[0].zb[b];
+        zc[b].tag = w[0].tag[b];
+        for (int i = 1; i < nw; i++)
+            combine_z(NULL, &zc[b], &(zcell){w[i].zb[b], w[i].tag[b], 0}, 1);
+    }
+    rt_code rc = par_part_combine(pp, zc, nbins, sizeof *zc, combine_z, NULL, e);
+    for (size_t b = 0; !rc && b < nbins; b++) {
+        w[0].zb[b] = zc[b].z;
+        w[0].tag[b] = zc[b].tag;
+        for (int i = 1; i < nw; i++)
+            w[i].zb[b] = INFINITY, w[i].tag[b] = 0;
+    }
+    rt_free(zc);
     return rc;
 }
 
@@ -895,8 +943,13 @@ rt_code chaos_project(const chaos_sys *s, const chaos_opts *o, const camera *cam
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    par_part pp;
+    rc = par_part_begin(&pp, run, "chaos view", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", points_chunk, &j);
     rc = finish_par(rc, j.w, nw, e);
+    if (!rc && pp.mode != PAR_FULL) /* the shards' z-buffers merge by the same nearest-point rule */
+        rc = shard_zbuf(&pp, j.w, nw, j.nbins, e);
     if (!rc) {
         /* merge: nearest depth, ties by smaller tag (order-free) */
         double zmin = INFINITY, zmax = -INFINITY;
