@@ -23,6 +23,7 @@
 #include "lang_image.h"
 #include "lang_ifs.h"
 #include "lang_objects.h"
+#include "shard.h"
 #include "lexer.h"
 #include "tonemap.h"
 
@@ -642,6 +643,11 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     rt_run run = lang_run(I);
     chaos_stats st;
     c = chaos_hist2(&s, &o, &hs, &st, &run, &e);
+    if (!c && shard_pending(I)) { /* a shard: the result becomes a partial value (shard.h) */
+        hist2_free(&hs);
+        *out = val_nil();
+        return 0;
+    }
     image *im = NULL;
     if (!c && !lang_image_new(I, w, h, &im))
         c = tonemap_apply(&hs, &t, im, &e);

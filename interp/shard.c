@@ -319,7 +319,8 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     payload_range(&r, lo, hi, &from, &len);
     size_t start = s->part.len;
     rec_head(&s->part, &r, lo, hi, len);
-    if (op == PAR_OP_SUM) {
+    static const uint16_t one = 1;
+    if (op == PAR_OP_SUM && *(const unsigned char *)&one != 1) { /* a big-endian host: word by word */
         const uint64_t *a = buf;
         for (size_t k = 0; k < total / 8; k++)
             put_u64(&s->part, a[k]);
@@ -845,6 +846,11 @@ int shard_after_builtin(interp *I, int rc, value *out)
     s->live++; /* val_obj destroys p on failure */
     *out = val_obj(I, &partial_class, p);
     return out->k == V_NIL ? -1 : 0;
+}
+
+int shard_pending(const interp *I)
+{
+    return I->shard && !I->shard->merging && I->shard->pending >= 0;
 }
 
 int shard_skip_save(interp *I)

@@ -99,6 +99,10 @@ int shard_scan_args(interp *I, const char *builtin_name, const node *call, const
 /* After a builtin returned rc: wraps a pending partial result; a builtin
  * that failed with a partial result pending is a taint. Returns the new rc. */
 int shard_after_builtin(interp *I, int rc, value *out);
+/* In a shard, the engine call just made is split: its result will be
+ * replaced by a partial value, so a binding may skip finishing it (tone
+ * mapping a histogram nobody will see). */
+int shard_pending(const interp *I);
 /* save(v, …) in a shard: writes nothing (1: handled), 0 otherwise. */
 int shard_skip_save(interp *I);
 
