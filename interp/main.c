@@ -320,6 +320,9 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
         return usage_error("--shard goes with `frac run`, not `%s`", strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
     if (o->shard && !strcmp(o->script, "-"))
         return usage_error("--shard needs a script file, not standard input");
+    if (o->shard && o->nargs)
+        return usage_error("--shard runs a script without arguments (got '%s'): merge could not give them to it",
+                           o->args[0]);
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -622,6 +625,8 @@ static int frac_main(int argc, char **argv)
                 else if (!strcmp(o.mode, "merge"))
                     shard_init_merge(&sh, (char *const *)o.args, o.nargs);
             }
+            if (rc < 0 && !strcmp(o.mode, "merge"))
+                o.nargs = 0; /* the words after the script are its parts, not its `args` */
             if (rc < 0) {
                 o.sh = o.shard || !strcmp(o.mode, "merge") ? &sh : NULL;
                 rc = run_frac(I, &o);
