@@ -1,7 +1,7 @@
 #!/bin/sh
-# check.sh SCRIPT [FRAC OPTIONS…] — shard + merge equals the single run.
+# check.sh [-n "N…"] SCRIPT [FRAC OPTIONS…] — shard + merge equals the single run.
 #
-# Runs `frac run SCRIPT` once, then for each N in $SHARD_NS (default 1 2 3 7)
+# Runs `frac run SCRIPT` once, then for each N in -n (or $SHARD_NS; default 1 2 3 7)
 # the N shards `frac run --shard I/N` concurrently as separate processes (one
 # thread each), then `frac merge` (three threads) on their parts, and compares
 # every output file (cmp, byte for byte) and stdout with the single run's.
@@ -9,6 +9,10 @@
 # FRAC (default: frac on PATH) is the binary.
 set -u
 frac=${FRAC:-frac}
+if [ "$1" = "-n" ]; then
+    SHARD_NS=$2
+    shift 2
+fi
 script=$1
 shift
 name=$(basename "$script" .frac)
