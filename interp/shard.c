@@ -490,7 +490,7 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
                 break;
             }
             if (!first && k != s->nrecs) {
-                snprintf(msg, sizeof msg, "it has %u records, shard 0's part has %u", k, s->nrecs);
+                snprintf(msg, sizeof msg, "it has %u records, the first part given has %u", k, s->nrecs);
                 break;
             }
             if (fgetc(r.f) != EOF) {
@@ -537,7 +537,7 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
             s->recs[k] = h;
             s->nrecs = k + 1;
         } else if (k >= s->nrecs || memcmp(&s->recs[k], &h, sizeof h) != 0) {
-            snprintf(msg, sizeof msg, "its record %u (engine call %u) differs from shard 0's", k, h.seq);
+            snprintf(msg, sizeof msg, "its record %u (engine call %u) differs from the first part's", k, h.seq);
             break;
         }
     }
