@@ -17,6 +17,7 @@
 #include "fset.h"
 #include "hist.h"
 #include "lang_fset.h"
+#include "par.h"
 #include "lang_ifs.h"
 #include "lang_image.h"
 #include "lang_objects.h"
@@ -485,7 +486,10 @@ static rt_code fset_fit(const fset *fs, const fset_order *o, const fset_chaos_op
         rt_code c = hist2_init(&hs, G, G, lo, hi, 0, e);
         if (c)
             return c;
-        if ((c = fset_chaos(fs, o, &fo, &hs, run, e))) {
+        rt_sharder *sv = par_set_sharder(NULL); /* a pre-pass: in full in every shard (par.h) */
+        c = fset_chaos(fs, o, &fo, &hs, run, e);
+        par_set_sharder(sv);
+        if (c) {
             hist2_free(&hs);
             return c;
         }

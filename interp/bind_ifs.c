@@ -23,6 +23,7 @@
 #include "lang_image.h"
 #include "lang_ifs.h"
 #include "lang_objects.h"
+#include "shard.h"
 #include "lexer.h"
 #include "tonemap.h"
 #include "report.h"
@@ -643,6 +644,11 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     c = chaos_hist2(&s, &o, &hs, &st, &run, &e);
     if (!c)
         report_work(I, "chaos game", "points", (double)o.points, t0);
+    if (!c && shard_pending(I)) { /* a shard: the result becomes a partial value (shard.h) */
+        hist2_free(&hs);
+        *out = val_nil();
+        return 0;
+    }
     image *im = NULL;
     if (!c && !lang_image_new(I, w, h, &im))
         c = tonemap_apply(&hs, &t, im, &e);

@@ -11,6 +11,7 @@
 #include "lexer.h"
 #include "lang_image.h"
 #include "lang_objects.h"
+#include "shard.h"
 
 static void image_destroy(void *p)
 {
@@ -428,6 +429,11 @@ static int b_save(interp *I, value *a, int n, value *out)
     char path[4096];
     if (lang_output_path(I, a[1], path, sizeof path))
         return -1;
+    if (shard_skip_save(I)) { /* a shard writes only its part file (shard.h) */
+        *out = a[0];
+        val_ref(*out);
+        return 0;
+    }
     if (AS_OBJ(v)->cls->save(I, AS_OBJ(v)->payload, path, a[2]))
         return -1;
     if (!I->quiet && !I->is_repl)

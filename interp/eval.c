@@ -13,6 +13,7 @@
 #include "lang_objects.h"
 #include "lexer.h"
 #include "parser.h"
+#include "shard.h"
 #include "stdlib_embed.h"
 
 static int check_interrupt(interp *I, const node *at)
@@ -263,6 +264,8 @@ static int call_builtin(interp *I, const builtin *b, const value *pos, int npos,
                         const value *named, int nnamed, const node *const *anodes, const node *call,
                         value *out)
 {
+    if (I->shard && shard_scan_args(I, b->name, call, pos, npos, named, nnamed))
+        return -1; /* a partial value passed on: re-run with its call computed fully */
     const bspec *spec = contract_spec(I, b);
     if (!spec)
         return err_at(I, call, ERR_RUNTIME, "internal error: builtin %s is not registered", b->name);
@@ -315,6 +318,8 @@ static int call_builtin(interp *I, const builtin *b, const value *pos, int npos,
     I->cur = call;
     I->bcall = &bc;
     int rc = b->fn(I, args, b->variadic ? npos : nargs, out);
+    if (I->shard)
+        rc = shard_after_builtin(I, rc, out); /* a sharded engine call's result becomes a partial value */
     I->cur = save;
     I->bcall = save_call;
     if (rc == 0 && I->err.active)

@@ -32,6 +32,7 @@
 #include "session.h"
 #include "sha256.h"
 #include "watch.h"
+#include "shard.h"
 
 enum { EX_OK = 0, EX_USAGE = 64, EX_SCRIPT = 65, EX_SOFTWARE = 70, EX_IO = 74 };
 
@@ -47,6 +48,12 @@ static const char usage_text[] =
     "       frac info FILE                     print the recipe of a file frac wrote\n"
     "       frac rerun FILE [-o DIR]           render it again from its recipe (same\n"
     "                                          script, params, seed and frame)\n"
+    "       frac run --shard I/N|auto [OPTIONS] SCRIPT.frac\n"
+    "                                          compute shard I of N of every engine call:\n"
+    "                                          writes SCRIPT.shard-I-of-N.part, no images\n"
+    "       frac merge [OPTIONS] SCRIPT.frac PART...\n"
+    "                                          the files of `frac run SCRIPT.frac` from its\n"
+    "                                          parts, byte for byte (docs/scale.md)\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
     "       frac watch [--show] [OPTIONS] SCRIPT.frac\n"
     "                                          run the script, then again whenever it or a file\n"
@@ -98,6 +105,9 @@ static const char usage_text[] =
     "                        and `clock` (0 at A, 1 at B) are 0 without it; `%f` in\n"
     "                        an output path is the frame number, zero-padded to the\n"
     "                        width of B; `%%` is a %. See docs/animation.md\n"
+    "  --shard I/N | auto    with run: shard I (0 ≤ I < N) of N; auto takes them from\n"
+    "                        SLURM_ARRAY_TASK_ID/_COUNT/_MIN, SLURM_PROCID/SLURM_NTASKS,\n"
+    "                        OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -209,6 +219,8 @@ typedef struct opts {
     const char *delay, *loop;     /* frac apng --delay MS --loop N, as typed */
     int show;                     /* frac watch --show */
     volatile sig_atomic_t *cancel; /* watch: the render's interrupt flag (NULL: the SIGINT flag) */
+    const char *shard; /* --shard I/N or auto */
+    shard *sh;         /* --shard or merge: kept across re-runs (shard.h) */
 } opts;
 
 /* One number of --frames, the n characters at s: an optional '-' and
@@ -267,8 +279,8 @@ static int parse_frames(opts *o)
 
 static int is_command(const char *w)
 {
-    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 ||
-           strcmp(w, "info") == 0 || strcmp(w, "rerun") == 0 || strcmp(w, "apng") == 0 || strcmp(w, "watch") == 0;
+    return strcmp(w, "run") == 0 || strcmp(w, "check") == 0 || strcmp(w, "repl") == 0 || strcmp(w, "info") == 0 ||
+           strcmp(w, "rerun") == 0 || strcmp(w, "apng") == 0 || strcmp(w, "watch") == 0 || strcmp(w, "merge") == 0;
 }
 
 /* Fill *o from argv. Returns -1 to go on, or the exit code to stop with
@@ -354,6 +366,16 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
             o->ov[o->nov].name = def; /* interned once the interpreter is set up */
             o->ov[o->nov].text = deq + 1;
             o->nov++;
+            continue;
+        }
+        if (!strcmp(name, "--shard")) {
+            if (!val || !*val)
+                return usage_error("--shard needs a value: I/N or auto");
+            if (o->shard)
+                return usage_error("--shard is given twice");
+            if (!inline_val)
+                i++;
+            o->shard = val;
             continue;
         }
         int is_e = !strcmp(name, "-e"), is_o = !strcmp(name, "-o") || !strcmp(name, "--out-dir");
@@ -459,6 +481,17 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
     if (o->frames && strcmp(o->mode, "run") != 0)
         return usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
                            strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
+    if (strcmp(o->mode, "merge") == 0 && (!o->script || !o->nargs))
+        return usage_error("merge needs the script and its part files: frac merge [-o DIR] SCRIPT.frac PART...");
+    if (o->shard && strcmp(o->mode, "run") != 0)
+        return usage_error("--shard goes with `frac run`, not `%s`", strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
+    if (o->shard && !strcmp(o->script, "-"))
+        return usage_error("--shard needs a script file, not standard input");
+    if (o->shard && o->nargs)
+        return usage_error("--shard runs a script without arguments (got '%s'): merge could not give them to it",
+                           o->args[0]);
+    if (o->frames && (o->shard || strcmp(o->mode, "merge") == 0))
+        return usage_error("%s", "--frames does not go with --shard or merge yet: shard each frame with --frames N..N");
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))
@@ -956,6 +989,14 @@ static int run_script(interp *I, opts *o, int check, unsigned char *text, size_t
     recipe_store st;
     if (!check && install_recipe(I, o, o->script, (const char *)text, len, &st))
         return session_report(I);
+    if (o->sh) { /* --shard or merge: one attempt (shard.h) */
+        int bad = shard_attempt_begin(o->sh, I, name, text, len) || session_run(I, name, (const char *)text, len, 0, NULL);
+        bad = shard_attempt_end(o->sh, !bad, name) || bad;
+        recipe_uninstall(&st);
+        if (o->sh->again) /* abandoned by a taint: main runs it again */
+            return EX_OK;
+        return bad ? session_report(I) : EX_OK;
+    }
     double t0 = report_clock();
     if (session_run(I, name, (const char *)text, len, check, NULL)) {
         /* watch: a render cancelled by a change is not reported */
@@ -1123,25 +1164,40 @@ static int run_frames(interp *T, opts *o)
 
 static int frac_main(int argc, char **argv)
 {
-    interp st, *I = &st;
-    interp_init(I);
-    I->threads = par_cores();
-    I->progress = 1;
-    opts o = {0};
-    o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
-    o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
-    int rc = EX_SOFTWARE;
-    if (o.args && o.ov) {
-        rc = parse_command_line(I, argc, argv, &o);
-        if (rc < 0)
-            rc = o.frames                       ? run_frames(I, &o)
-                 : strcmp(o.mode, "apng") == 0  ? run_apng(I, &o)
-                 : strcmp(o.mode, "watch") == 0 ? run_watch(I, &o)
-                                                : run_frac(I, &o);
-    }
-    mem_free(I, o.args);
-    mem_free(I, o.ov);
-    interp_free(I);
+    shard sh; /* --shard / merge: lives across the re-runs, each in a fresh interpreter */
+    int rc, again = 0;
+    do {
+        interp st, *I = &st;
+        interp_init(I);
+        I->threads = par_cores();
+        I->progress = 1;
+        opts o = {0};
+        o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
+        o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
+        rc = EX_SOFTWARE;
+        if (o.args && o.ov) {
+            rc = parse_command_line(I, argc, argv, &o);
+            if (rc < 0 && !again) {
+                if (o.shard && shard_init_run(&sh, o.shard))
+                    rc = EX_USAGE;
+                else if (!strcmp(o.mode, "merge"))
+                    shard_init_merge(&sh, (char *const *)o.args, o.nargs);
+            }
+            if (rc < 0 && !strcmp(o.mode, "merge"))
+                o.nargs = 0; /* the words after the script are its parts, not its `args` */
+            if (rc < 0) {
+                o.sh = o.shard || !strcmp(o.mode, "merge") ? &sh : NULL;
+                rc = o.frames                       ? run_frames(I, &o)
+                     : strcmp(o.mode, "apng") == 0  ? run_apng(I, &o)
+                     : strcmp(o.mode, "watch") == 0 ? run_watch(I, &o)
+                                                    : run_frac(I, &o);
+                again = o.sh && sh.again;
+            }
+        }
+        mem_free(I, o.args);
+        mem_free(I, o.ov);
+        interp_free(I);
+    } while (again);
     return finish_output(rc);
 }
 

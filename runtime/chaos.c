@@ -776,6 +776,39 @@ static void fill_stats(chaos_stats *st, const worker *w, int nw)
     }
 }
 
+/* A sharded or merging call (par.h): the workers' exact integer sums —
+ * k = 1 (count) or 4 (count, r, g, b) per bin — then plotted and inside, go
+ * through par_part_sum as one section; returns the summed array (n words). */
+static uint64_t *shard_sums(const par_part *pp, const worker *w, int nw, size_t nbins, int colour,
+                            size_t *n, rt_code *rc, rt_error *e)
+{
+    size_t k = colour ? 4 : 1;
+    *n = nbins * k + 2;
+    uint64_t *tot = rt_calloc(*n, sizeof *tot);
+    if (!tot) {
+        *rc = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
+        return NULL;
+    }
+    for (size_t b = 0; b < nbins; b++)
+        for (int i = 0; i < nw; i++) {
+            if (!colour)
+                tot[b] += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
+            else
+                for (size_t q = 0; q < 4; q++)
+                    tot[4 * b + q] += w[i].cnt[4 * b + q] + (w[i].carry ? w[i].carry[4 * b + q] : 0);
+        }
+    for (int i = 0; i < nw; i++) {
+        tot[nbins * k] += w[i].plotted;
+        tot[nbins * k + 1] += w[i].inside;
+    }
+    *rc = par_part_sum(pp, tot, *n, e);
+    if (*rc) {
+        rt_free(tot);
+        return NULL;
+    }
+    return tot;
+}
+
 rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_stats *st,
                     const rt_run *run, rt_error *e)
 {
@@ -797,16 +830,38 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     j.sx = hs->w / (hs->hi[0] - hs->lo[0]);
     j.sy = hs->h / (hs->hi[1] - hs->lo[1]);
     int nw = par_workers(run, j.nchunks);
-    if (o->colour == CHAOS_COLOUR_NONE)
-        j.direct = hs->count;
-    rt_code rc = alloc_workers(&j.w, nw, j.nbins, j.direct ? 2 : 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    par_part pp;
+    rt_code rc = par_part_begin(&pp, run, o->colour != CHAOS_COLOUR_NONE ? "chaos colour" : "chaos", j.nchunks, e);
     if (rc) {
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, hist_fns[d->kind][o->colour], &j);
+    /* worker 0 counts straight into the histogram, except in a shard or a
+     * merge: there every worker's counts go through shard_sums */
+    if (o->colour == CHAOS_COLOUR_NONE && pp.mode == PAR_FULL)
+        j.direct = hs->count;
+    rc = alloc_workers(&j.w, nw, j.nbins, j.direct ? 2 : 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    if (rc) {
+        sys_free(d);
+        return rc;
+    }
+    rc = par_part_for(&pp, "chaos game", hist_fns[d->kind][o->colour], &j);
     rc = finish_par(rc, j.w, nw, e);
-    if (!rc) {
+    if (!rc && pp.mode != PAR_FULL) {
+        int colour = o->colour != CHAOS_COLOUR_NONE;
+        size_t n;
+        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, colour, &n, &rc, e);
+        for (size_t b = 0; tot && b < j.nbins; b++) {
+            hs->count[b] += tot[colour ? 4 * b : b];
+            for (int ch = 0; colour && ch < 3; ch++)
+                hs->csum[3 * b + ch] += (float)((double)tot[4 * b + ch + 1] / 65535.0);
+        }
+        if (tot && st) {
+            st->plotted = tot[n - 2];
+            st->inside = tot[n - 1];
+        }
+        rt_free(tot);
+    } else if (!rc) {
         size_t merge = j.direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
         for (size_t b = 0; b < merge; b++) {
             if (o->colour == CHAOS_COLOUR_NONE) {
@@ -856,12 +911,34 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
     }
     /* Worker 0 counts in the volume's own memory (uint32 where the floats
      * will be; converted in place below), so one thread needs nothing but
-     * the volume. */
+     * the volume; in a shard shard_sums reads it there like any worker's. */
     memset(vol->v, 0, j.nbins * sizeof *vol->v);
     j.w[0].cnt = (uint32_t *)(void *)vol->v;
-    rc = par_for(run, "chaos game", j.nchunks, vol_fns[maps_diagonal(d)][d->kind], &j);
+    par_part pp;
+    rc = par_part_begin(&pp, run, "chaos volume", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", vol_fns[maps_diagonal(d)][d->kind], &j);
     rc = finish_par(rc, j.w, nw, e);
-    if (!rc) {
+    if (!rc && pp.mode != PAR_FULL) {
+        size_t n;
+        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, 0, &n, &rc, e);
+        if (tot) {
+            uint64_t mx = 0;
+            for (size_t b = 0; b < j.nbins; b++)
+                if (tot[b] > mx)
+                    mx = tot[b];
+            if (st) {
+                st->plotted = tot[n - 2];
+                st->inside = tot[n - 1];
+            }
+            double den = norm == CHAOS_NORM_TOTAL ? (double)tot[n - 2] : norm == CHAOS_NORM_MAX ? (double)mx : 1;
+            if (!(den > 0))
+                den = 1;
+            for (size_t b = 0; b < j.nbins; b++)
+                vol->v[b] = (float)((double)tot[b] / den);
+        }
+        rt_free(tot);
+    } else if (!rc) {
         uint64_t mx = 0;
         for (size_t b = 0; b < j.nbins; b++) {
             uint64_t t = total_count(j.w, nw, b);
@@ -905,14 +982,62 @@ rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_
         sys_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
     }
-    rt_code rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    /* chunk c writes points [c*chunk, (c+1)*chunk): a shard fills its
+     * chunks' points, merge places them (par.h) */
+    par_part pp;
+    rt_code rc = par_part_begin(&pp, run, "chaos points", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", points_chunk, &j);
     rc = finish_par(rc, NULL, 0, e);
+    if (!rc)
+        rc = par_part_rows(&pp, j.pos, sizeof *j.pos * 3 * np, sizeof *j.pos * 3 * (size_t)j.chunk, e);
+    if (!rc && j.col)
+        rc = par_part_rows(&pp, j.col, sizeof *j.col * 4 * np, sizeof *j.col * 4 * (size_t)j.chunk, e);
     for (size_t i = 0; !rc && i < np; i++)
         if (mesh_add_vertex(m, j.pos + 3 * i, NULL, j.col ? j.col + 4 * i : NULL) == UINT32_MAX)
             rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu points", np);
     rt_free(j.pos);
     rt_free(j.col);
     sys_free(d);
+    return rc;
+}
+
+typedef struct zcell {
+    double z;
+    uint32_t tag, pad;
+} zcell;
+
+static void combine_z(void *ctx, void *acc, const void *part, size_t n)
+{
+    (void)ctx;
+    zcell *a = acc;
+    const zcell *p = part;
+    for (size_t b = 0; b < n; b++)
+        if (p[b].z < a[b].z || (p[b].z == a[b].z && p[b].tag < a[b].tag))
+            a[b] = p[b];
+}
+
+/* Sharded projection: the workers' nearest points, merged with the shards'
+ * (par_part_combine), land in worker 0's arrays; the others are reset. */
+static rt_code shard_zbuf(const par_part *pp, worker *w, int nw, size_t nbins, rt_error *e)
+{
+    zcell *zc = rt_calloc(nbins, sizeof *zc);
+    if (!zc)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the shard's z-buffer");
+    for (size_t b = 0; b < nbins; b++) {
+        zc[b].z = w[0].zb[b];
+        zc[b].tag = w[0].tag[b];
+        for (int i = 1; i < nw; i++)
+            combine_z(NULL, &zc[b], &(zcell){w[i].zb[b], w[i].tag[b], 0}, 1);
+    }
+    rt_code rc = par_part_combine(pp, zc, nbins, sizeof *zc, combine_z, NULL, e);
+    for (size_t b = 0; !rc && b < nbins; b++) {
+        w[0].zb[b] = zc[b].z;
+        w[0].tag[b] = zc[b].tag;
+        for (int i = 1; i < nw; i++)
+            w[i].zb[b] = INFINITY, w[i].tag[b] = 0;
+    }
+    rt_free(zc);
     return rc;
 }
 
@@ -935,8 +1060,13 @@ rt_code chaos_project(const chaos_sys *s, const chaos_opts *o, const camera *cam
         sys_free(d);
         return rc;
     }
-    rc = par_for(run, "chaos game", j.nchunks, points_chunk, &j);
+    par_part pp;
+    rc = par_part_begin(&pp, run, "chaos view", j.nchunks, e);
+    if (!rc)
+        rc = par_part_for(&pp, "chaos game", points_chunk, &j);
     rc = finish_par(rc, j.w, nw, e);
+    if (!rc && pp.mode != PAR_FULL) /* the shards' z-buffers merge by the same nearest-point rule */
+        rc = shard_zbuf(&pp, j.w, nw, j.nbins, e);
     if (!rc) {
         /* merge: nearest depth, ties by smaller tag (order-free) */
         double zmin = INFINITY, zmax = -INFINITY;

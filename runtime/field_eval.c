@@ -238,8 +238,14 @@ rt_code field_sample_volume(rt_field_fn fn, const void *ctx, volume *vol, const 
         return rt_fail(e, RT_EINVAL, "volume to fill is empty (%d x %d x %d)", vol->nx, vol->ny,
                        vol->nz);
     vol_job j = {fn, ctx, vol};
-    rt_code c = par_for(run, "field", (size_t)vol->nz, vol_slice, &j);
+    /* one chunk per z slice: a shard fills its slices, merge places them (par.h) */
+    par_part pp;
+    size_t slice = (size_t)vol->nx * (size_t)vol->ny * sizeof *vol->v;
+    rt_code c = par_part_begin(&pp, run, "field volume", (size_t)vol->nz, e);
+    if (c)
+        return c;
+    c = par_part_for(&pp, "field", vol_slice, &j);
     if (c == RT_ECANCEL)
         return rt_fail(e, RT_ECANCEL, "interrupted");
-    return c;
+    return c ? c : par_part_rows(&pp, vol->v, slice * (size_t)vol->nz, slice, e);
 }

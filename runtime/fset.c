@@ -438,7 +438,11 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
             goto done;
         }
     }
-    code = par_for(run, "chaos", nchunks, opts->mode == FSET_WALK ? chaos_walk : chaos_orbit, &c);
+    par_part pp; /* a shard runs its chunks; counts are exact sums (par.h) */
+    code = par_part_begin(&pp, run, "fset chaos", nchunks, e);
+    if (code)
+        goto done;
+    code = par_part_for(&pp, "chaos", opts->mode == FSET_WALK ? chaos_walk : chaos_orbit, &c);
     if (code == RT_ECANCEL) {
         rt_fail(e, code, "interrupted");
         goto done;
@@ -447,7 +451,12 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
         code = rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
         goto done;
     }
-    for (int i = 0; i < nw; i++)
+    for (int i = 1; pp.mode != PAR_FULL && i < nw; i++) /* the shard's sums into worker 0's */
+        for (size_t b = 0; b < nbins; b++)
+            c.count[0][b] += c.count[i][b];
+    if (pp.mode != PAR_FULL && (code = par_part_sum(&pp, c.count[0], nbins, e)))
+        goto done;
+    for (int i = 0; i < (pp.mode != PAR_FULL ? 1 : nw); i++)
         for (size_t b = 0; b < nbins; b++)
             hs->count[b] += c.count[i][b];
 done:

@@ -491,7 +491,13 @@ rt_code rm_render(rt_field_fn f, const void *ctx, const camera *cam, const rm_op
     double l = sqrt(o->light[0] * o->light[0] + o->light[1] * o->light[1] + o->light[2] * o->light[2]);
     for (int a = 0; a < 3; a++)
         j.light[a] = l > 0 ? o->light[a] / l : 0;
-    if (par_for(run, "raymarch", (size_t)im->h, row_fn, &j))
+    /* one chunk per row: a shard fills its rows, merge places them (par.h) */
+    par_part pp;
+    size_t row = (size_t)im->w * 4 * sizeof *im->px;
+    rt_code rc = par_part_begin(&pp, run, "raymarch", (size_t)im->h, e);
+    if (rc)
+        return rc;
+    if (par_part_for(&pp, "raymarch", row_fn, &j))
         return rt_fail(e, RT_ECANCEL, "raymarch interrupted");
-    return RT_OK;
+    return par_part_rows(&pp, im->px, row * (size_t)im->h, row, e);
 }

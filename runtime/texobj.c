@@ -317,13 +317,32 @@ rt_code texobj_render(const texobj_shape *s, const camera *cam, const texobj_sou
         rt_free(j.hits);
         return rt_fail(e, RT_ENOMEM, "out of memory rendering a %d x %d textured object", im->w, im->h);
     }
-    rc = par_for(run, "textured object", nbands, render_band, &j);
-    if (st) {
-        st->rays = st->hits = 0;
-        for (int w = 0; w < nw; w++) {
-            st->rays += j.rays[w];
-            st->hits += j.hits[w];
+    /* a chunk is a band of TEXOBJ_BAND rows: a shard fills its bands and
+     * counts its rays and hits, merge places the bands and adds the counts (par.h) */
+    par_part pp;
+    rc = par_part_begin(&pp, run, "textured object", nbands, e);
+    if (!rc)
+        rc = par_part_for(&pp, "textured object", render_band, &j);
+    uint64_t cnt[2] = {0, 0};
+    for (int w = 0; w < nw; w++) {
+        cnt[0] += j.rays[w];
+        cnt[1] += j.hits[w];
+    }
+    if (!rc && pp.mode != PAR_FULL) {
+        size_t band = (size_t)im->w * TEXOBJ_BAND * 4 * sizeof *im->px;
+        rc = par_part_rows(&pp, im->px, (size_t)im->w * (size_t)im->h * 4 * sizeof *im->px, band, e);
+        if (!rc)
+            rc = par_part_sum(&pp, cnt, 2, e);
+        if (rc) {
+            rt_free(j.acc);
+            rt_free(j.rays);
+            rt_free(j.hits);
+            return rc;
         }
+    }
+    if (st) {
+        st->rays = cnt[0];
+        st->hits = cnt[1];
     }
     rt_free(j.acc);
     rt_free(j.rays);
@@ -369,8 +388,13 @@ rt_code texobj_sample_volume(rt_field_fn f, const void *ctx, volume *vol, const 
     if (!f || !vol->v || vol->nx < 1 || vol->ny < 1 || vol->nz < 1)
         return rt_fail(e, RT_EINVAL, "volume sampling: no field or the volume is not initialised");
     vjob j = {f, ctx, vol};
-    rt_code rc = par_for(run, "sample volume", (size_t)vol->nz, volume_slice, &j);
-    return rc ? rt_fail(e, rc, "interrupted") : RT_OK;
+    par_part pp; /* one chunk per z slice (par.h) */
+    size_t slice = (size_t)vol->nx * (size_t)vol->ny * sizeof *vol->v;
+    rt_code rc = par_part_begin(&pp, run, "sample volume", (size_t)vol->nz, e);
+    if (rc)
+        return rc;
+    rc = par_part_for(&pp, "sample volume", volume_slice, &j);
+    return rc ? rt_fail(e, rc, "interrupted") : par_part_rows(&pp, vol->v, slice * (size_t)vol->nz, slice, e);
 }
 
 typedef struct sjob {
@@ -419,6 +443,11 @@ rt_code texobj_slice(rt_field_fn f, const void *ctx, const ramp *r, const double
         j.v[i] = v[i];
     }
     j.im = im;
-    rt_code rc = par_for(run, "slice", (size_t)im->h, slice_row, &j);
-    return rc ? rt_fail(e, rc, "interrupted") : RT_OK;
+    par_part pp; /* one chunk per row (par.h) */
+    size_t row = (size_t)im->w * 4 * sizeof *im->px;
+    rt_code rc = par_part_begin(&pp, run, "slice", (size_t)im->h, e);
+    if (rc)
+        return rc;
+    rc = par_part_for(&pp, "slice", slice_row, &j);
+    return rc ? rt_fail(e, rc, "interrupted") : par_part_rows(&pp, im->px, row * (size_t)im->h, row, e);
 }

@@ -28,6 +28,17 @@ static int cell_greater(uint64_t key, uint32_t aux, const tops_cell *c)
     return !c->hit || key > c->key || (key == c->key && aux > c->aux);
 }
 
+/* Merging shards' tops: the same order-free max as merging workers. */
+static void combine_cells(void *ctx, void *acc, const void *part, size_t n)
+{
+    (void)ctx;
+    tops_cell *a = acc;
+    const tops_cell *p = part;
+    for (size_t k = 0; k < n; k++)
+        if (p[k].hit && cell_greater(p[k].key, p[k].aux, &a[k]))
+            a[k] = p[k];
+}
+
 static void fixed_point(const affine *m, double out[2])
 {
     double a = m->m[0][0], b = m->m[0][1], c = m->m[1][0], d = m->m[1][1];
@@ -172,7 +183,11 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
             code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread fractal tops", nw);
             goto done;
         }
-    code = par_for(run, g ? "colour stealing" : "fractal top", nchunks, tops_chunk, &c);
+    par_part pp; /* a shard runs its chunks; the cells merge by the same max (par.h) */
+    code = par_part_begin(&pp, run, g ? "colour stealing" : "fractal top", nchunks, e);
+    if (code)
+        goto done;
+    code = par_part_for(&pp, g ? "colour stealing" : "fractal top", tops_chunk, &c);
     if (code) {
         rt_fail(e, code, "interrupted");
         goto done;
@@ -185,6 +200,7 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
             if (s->hit && cell_greater(s->key, s->aux, &out->cell[k]))
                 out->cell[k] = *s;
         }
+    code = par_part_combine(&pp, out->cell, npx, sizeof *out->cell, combine_cells, NULL, e);
 done:
     for (int i = 1; i < nw; i++)
         rt_free(c.cells[i]);

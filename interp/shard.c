@@ -1,0 +1,859 @@
+/* shard.c — part files, partial values, taint and re-run, merge (see shard.h). */
+#include "shard.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "deflate.h"
+#include "builtin.h"
+#include "lang_objects.h"
+#include "session.h"
+
+/* ---- small helpers ------------------------------------------------------------ */
+
+static uint64_t fnv1a64(const unsigned char *p, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a 64-bit offset basis and prime */
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+static void put_u32(bytebuf *b, uint32_t v) { bytebuf_u32le(b, v); }
+static void put_u64(bytebuf *b, uint64_t v)
+{
+    bytebuf_u32le(b, (uint32_t)v);
+    bytebuf_u32le(b, (uint32_t)(v >> 32));
+}
+static void put_str(bytebuf *b, const char *s)
+{
+    put_u32(b, (uint32_t)strlen(s));
+    bytebuf_append(b, s, strlen(s));
+}
+static uint32_t get_u32(const unsigned char *p) { return p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t get_u64(const unsigned char *p) { return get_u32(p) | (uint64_t)get_u32(p + 4) << 32; }
+
+static int parse_count(const char *s, long lo, long *out)
+{
+    if (!s || !*s)
+        return -1;
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || v < lo || v > SHARD_MAX_PARTS)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static void chunk_range(size_t nchunks, int i, int n, size_t *lo, size_t *hi)
+{
+    /* contiguous: shard i of n computes chunks [nchunks*i/n, nchunks*(i+1)/n) */
+    *lo = (size_t)((unsigned __int128)nchunks * (unsigned)i / (unsigned)n);
+    *hi = (size_t)((unsigned __int128)nchunks * (unsigned)(i + 1) / (unsigned)n);
+}
+
+/* ---- the command line ------------------------------------------------------------ */
+
+static const struct {
+    const char *rank, *size, *min;
+} launchers[] = {
+    {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN"},
+    {"SLURM_PROCID", "SLURM_NTASKS", NULL},
+    {"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE", NULL},
+    {"PMI_RANK", "PMI_SIZE", NULL},
+};
+
+static void shard_zero(shard *s)
+{
+    memset(s, 0, sizeof *s);
+    s->pending = -1;
+    s->cur = -1;
+}
+
+int shard_init_run(shard *s, const char *spec)
+{
+    shard_zero(s);
+    long i = -1, n = -1;
+    if (strcmp(spec, "auto") == 0) {
+        size_t k;
+        for (k = 0; k < sizeof launchers / sizeof launchers[0]; k++) {
+            const char *r = getenv(launchers[k].rank), *z = getenv(launchers[k].size);
+            if (!r)
+                continue;
+            long mn = 0;
+            if (parse_count(r, 0, &i) || parse_count(z, 1, &n) ||
+                (launchers[k].min && getenv(launchers[k].min) && parse_count(getenv(launchers[k].min), 0, &mn))) {
+                fprintf(stderr, "frac: --shard auto: %s=%s with %s=%s is not a shard number and count\n"
+                                "(run `frac --help` for usage)\n",
+                        launchers[k].rank, r, launchers[k].size, z ? z : "(unset)");
+                return -1;
+            }
+            i -= mn;
+            if (i < 0 || i >= n) {
+                fprintf(stderr, "frac: --shard auto: %s=%s gives shard %ld, not in 0..%ld\n(run `frac --help` for usage)\n",
+                        launchers[k].rank, r, i, n - 1);
+                return -1;
+            }
+            break;
+        }
+        if (k == sizeof launchers / sizeof launchers[0]) {
+            fprintf(stderr, "frac: --shard auto: no launcher environment found (SLURM_ARRAY_TASK_ID, SLURM_PROCID, "
+                            "OMPI_COMM_WORLD_RANK or PMI_RANK); give --shard I/N\n(run `frac --help` for usage)\n");
+            return -1;
+        }
+    } else {
+        const char *sl = strchr(spec, '/');
+        char ib[32];
+        if (sl && (size_t)(sl - spec) < sizeof ib) {
+            memcpy(ib, spec, (size_t)(sl - spec));
+            ib[sl - spec] = 0;
+        }
+        if (!sl || (size_t)(sl - spec) >= sizeof ib || parse_count(ib, 0, &i) || parse_count(sl + 1, 1, &n) || i >= n) {
+            fprintf(stderr, "frac: --shard takes I/N with 0 <= I < N <= %d, or auto; got '%s'\n"
+                            "(run `frac --help` for usage)\n",
+                    SHARD_MAX_PARTS, spec);
+            return -1;
+        }
+    }
+    s->index = (int)i;
+    s->count = (int)n;
+    return 0;
+}
+
+void shard_init_merge(shard *s, char *const *parts, int nparts)
+{
+    shard_zero(s);
+    s->merging = 1;
+    s->parts = parts;
+    s->nparts = nparts;
+}
+
+/* ---- the header --------------------------------------------------------------- */
+
+/* params as given with -D, sorted by name, one NAME=VALUE per line */
+static void params_text(interp *I, bytebuf *b)
+{
+    int n = I->noverrides, done[256] = {0};
+    for (int k = 0; k < n && k < 256; k++) {
+        int best = -1;
+        for (int j = 0; j < n && j < 256; j++)
+            if (!done[j] && (best < 0 || strcmp(I->overrides[j].name, I->overrides[best].name) < 0))
+                best = j;
+        done[best] = 1;
+        bytebuf_printf(b, "%s=%s\n", I->overrides[best].name, I->overrides[best].text);
+    }
+    bytebuf_byte(b, 0);
+}
+
+static void header(shard *s, bytebuf *b, int index, int count)
+{
+    bytebuf pt;
+    bytebuf_init(&pt);
+    params_text(s->I, &pt);
+    bytebuf_append(b, "FRACPART", 8);
+    put_u32(b, SHARD_FORMAT);
+    put_str(b, FRAC_VERSION);
+    put_str(b, "fnv1a-64");
+    put_u64(b, s->hash);
+    put_u64(b, s->I->seed);
+    put_u32(b, 0); /* frame */
+    put_str(b, pt.data ? (const char *)pt.data : "");
+    put_u32(b, (uint32_t)index);
+    put_u32(b, (uint32_t)count);
+    bytebuf_free(&pt);
+    put_u32(b, deflate_crc32(0, b->data, b->len));
+}
+
+/* ---- records -------------------------------------------------------------------- */
+
+#define REC_HEAD 80 /* "REC " seq sub op kind[16] nchunks lo hi total chunk_bytes payload */
+
+struct shard_rec {
+    uint32_t seq, sub, op;
+    char kind[16];
+    uint64_t nchunks, total, chunk_bytes;
+};
+
+static void rec_head(bytebuf *b, const shard_rec *r, uint64_t lo, uint64_t hi, uint64_t payload)
+{
+    bytebuf_append(b, "REC ", 4);
+    put_u32(b, r->seq);
+    put_u32(b, r->sub);
+    put_u32(b, r->op);
+    bytebuf_append(b, r->kind, 16);
+    put_u64(b, r->nchunks);
+    put_u64(b, lo);
+    put_u64(b, hi);
+    put_u64(b, r->total);
+    put_u64(b, r->chunk_bytes);
+    put_u64(b, payload);
+}
+
+static void payload_range(const shard_rec *r, size_t lo, size_t hi, uint64_t *from, uint64_t *len)
+{
+    if (r->op != PAR_OP_ROWS) { /* SUM, COMBINE: the whole accumulator */
+        *from = 0;
+        *len = r->total;
+        return;
+    }
+    uint64_t a = (uint64_t)lo * r->chunk_bytes, z = (uint64_t)hi * r->chunk_bytes;
+    if (a > r->total)
+        a = r->total;
+    if (z > r->total)
+        z = r->total;
+    *from = a;
+    *len = z - a;
+}
+
+/* ---- the runtime's callbacks ------------------------------------------------------ */
+
+static int is_full(const shard *s, uint32_t seq)
+{
+    for (int k = 0; k < s->nfull; k++)
+        if (s->full[k] == seq)
+            return 1;
+    return 0;
+}
+
+static void where(interp *I, const node *n, char *buf, size_t size)
+{
+    if (n && n->src >= 0 && n->src < I->nsrc)
+        snprintf(buf, size, "%s:%d:%d", I->srcs[n->src].name, n->line + I->srcs[n->src].first_line - 1, n->col);
+    else
+        buf[0] = 0;
+}
+
+/* Call `seq` (made at `at`) cannot be sharded: compute it fully from now on. */
+static int taint(shard *s, uint32_t seq, const node *at, const char *why)
+{
+    interp *I = s->I;
+    if (s->nfull >= SHARD_MAX_FULL)
+        return err_at(I, NULL, ERR_LIMIT, "--shard: more than %d engine calls cannot be sharded", SHARD_MAX_FULL);
+    s->full[s->nfull++] = seq;
+    s->again = 1;
+    if (!I->quiet) {
+        char a[512], b[512];
+        where(I, at, a, sizeof a);
+        where(I, I->cur, b, sizeof b);
+        fprintf(stderr, "frac: note: engine call %u (at %s) is computed fully in every shard: its result %s%s%s\n",
+                seq, a, why, b[0] ? " at " : "", b);
+    }
+    return err_at(I, NULL, ERR_RUNTIME, "--shard: abandoned to re-run (call %u is computed fully)", seq);
+}
+
+static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo, size_t *hi)
+{
+    shard *s = (shard *)rs;
+    interp *I = s->I;
+    if (s->pending >= 0) { /* a second call inside one builtin while the first one is partial */
+        taint(s, (uint32_t)s->pending, s->pending_at, "feeds another engine call inside the same builtin");
+        return -1;
+    }
+    uint32_t seq = s->seq++;
+    s->cur = -1;
+    if (s->merging) {
+        if (s->next_rec < s->nrecs && s->recs[s->next_rec].seq == seq) {
+            const shard_rec *r = &s->recs[s->next_rec];
+            if (strncmp(r->kind, kind, 16) != 0 || r->nchunks != nchunks) {
+                err_at(I, NULL, ERR_VALUE, "merge: engine call %u is %s with %zu chunks here, but %.16s with %llu chunks in the parts",
+                       seq, kind, nchunks, r->kind, (unsigned long long)r->nchunks);
+                return -1;
+            }
+            s->cur = seq;
+            s->sub = 0;
+            s->cur_nchunks = nchunks;
+            return PAR_MERGE;
+        }
+        return PAR_FULL;
+    }
+    if (is_full(s, seq))
+        return PAR_FULL;
+    s->cur = seq;
+    s->sub = 0;
+    s->cur_nchunks = nchunks;
+    memset(s->cur_kind, 0, sizeof s->cur_kind);
+    snprintf(s->cur_kind, sizeof s->cur_kind, "%s", kind);
+    chunk_range(nchunks, s->index, s->count, lo, hi);
+    s->pending = seq;
+    s->pending_at = I->cur;
+    return PAR_SHARD;
+}
+
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e);
+
+static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t total, size_t chunk_bytes,
+                          par_combine_fn fn, void *ctx, rt_error *e)
+{
+    shard *s = (shard *)rs;
+    if (s->cur < 0)
+        return rt_fail(e, RT_EINVAL, "internal: a shard section outside a sharded call");
+    shard_rec r;
+    memset(&r, 0, sizeof r);
+    r.seq = (uint32_t)s->cur;
+    r.sub = s->sub++;
+    r.op = op;
+    r.nchunks = s->cur_nchunks;
+    r.total = total;
+    r.chunk_bytes = op == PAR_OP_SUM ? 0 : chunk_bytes;
+    if (s->merging) {
+        if (s->next_rec >= s->nrecs)
+            return rt_fail(e, RT_EFORMAT, "merge: the parts have no record for section %u of engine call %u", r.sub, r.seq);
+        const shard_rec *p = &s->recs[s->next_rec];
+        memcpy(r.kind, p->kind, 16);
+        if (p->seq != r.seq || p->sub != r.sub || p->op != r.op || p->total != r.total || p->chunk_bytes != r.chunk_bytes)
+            return rt_fail(e, RT_EFORMAT, "merge: engine call %u section %u: the parts hold %llu bytes (op %u), this run needs %llu (op %u)",
+                           r.seq, r.sub, (unsigned long long)p->total, p->op, (unsigned long long)r.total, r.op);
+        rt_code c = merge_section(s, p, buf, fn, ctx, e);
+        s->next_rec++;
+        return c;
+    }
+    memcpy(r.kind, s->cur_kind, 16);
+    size_t lo, hi;
+    chunk_range(r.nchunks, s->index, s->count, &lo, &hi);
+    uint64_t from, len;
+    payload_range(&r, lo, hi, &from, &len);
+    size_t start = s->part.len;
+    rec_head(&s->part, &r, lo, hi, len);
+    static const uint16_t one = 1;
+    if (op == PAR_OP_SUM && *(const unsigned char *)&one != 1) { /* a big-endian host: word by word */
+        const uint64_t *a = buf;
+        for (size_t k = 0; k < total / 8; k++)
+            put_u64(&s->part, a[k]);
+    } else {
+        bytebuf_append(&s->part, (const unsigned char *)buf + from, (size_t)len); /* the host's bytes: little-endian */
+    }
+    if (s->part.failed)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the part file (%llu bytes)", (unsigned long long)len);
+    put_u32(&s->part, deflate_crc32(0, s->part.data + start, s->part.len - start));
+    s->nrec++;
+    return s->part.failed ? rt_fail(e, RT_ENOMEM, "out of memory for the part file") : RT_OK;
+}
+
+/* ---- merge: reading parts ------------------------------------------------------------ */
+
+typedef struct reader {
+    FILE *f;
+    const char *path;
+    uint32_t crc;
+    long pos;
+} reader;
+
+static int rd(reader *r, void *p, size_t n)
+{
+    if (fread(p, 1, n, r->f) != n)
+        return -1;
+    r->crc = deflate_crc32(r->crc, p, n);
+    r->pos += (long)n;
+    return 0;
+}
+
+/* Read one record head at r's position; 1 at the end marker, 0 a record, -1 error (message in msg). */
+static int read_head(reader *r, shard_rec *h, uint64_t *lo, uint64_t *hi, uint64_t *len, char *msg, size_t ms)
+{
+    unsigned char b[REC_HEAD];
+    memset(h, 0, sizeof *h); /* records are compared with memcmp: no stray padding bytes */
+    r->crc = 0;
+    if (rd(r, b, 4)) {
+        snprintf(msg, ms, "it is truncated (no end marker)");
+        return -1;
+    }
+    if (memcmp(b, "END ", 4) == 0)
+        return 1;
+    if (memcmp(b, "REC ", 4) != 0 || rd(r, b + 4, REC_HEAD - 4)) {
+        snprintf(msg, ms, memcmp(b, "REC ", 4) ? "it is corrupt (bad record marker at byte %ld)" : "it is truncated (in a record header)", r->pos - 4);
+        return -1;
+    }
+    h->seq = get_u32(b + 4);
+    h->sub = get_u32(b + 8);
+    h->op = get_u32(b + 12);
+    memcpy(h->kind, b + 16, 16);
+    h->nchunks = get_u64(b + 32);
+    *lo = get_u64(b + 40);
+    *hi = get_u64(b + 48);
+    h->total = get_u64(b + 56);
+    h->chunk_bytes = get_u64(b + 64);
+    *len = get_u64(b + 72);
+    return 0;
+}
+
+
+/* Read a string field of at most max bytes into buf (NUL-terminated). */
+static int rd_str(reader *r, char *buf, size_t max)
+{
+    unsigned char b[4];
+    if (rd(r, b, 4))
+        return -1;
+    uint32_t n = get_u32(b);
+    if (n >= max || rd(r, buf, n))
+        return -1;
+    buf[n] = 0;
+    return 0;
+}
+
+/* The header: each field against this run's. 0, or -1 with the reason in msg. */
+static int read_header(shard *s, reader *r, int *index, int *count, char *msg, size_t ms)
+{
+    unsigned char b[16];
+    char str[4096];
+    bytebuf pt;
+    bytebuf_init(&pt);
+    params_text(s->I, &pt);
+    int rc = -1;
+    if (rd(r, b, 8) || memcmp(b, "FRACPART", 8) != 0)
+        snprintf(msg, ms, "is not a frac part file");
+    else if (rd(r, b, 4))
+        snprintf(msg, ms, "is truncated (in its header)");
+    else if (get_u32(b) != SHARD_FORMAT)
+        snprintf(msg, ms, "has part format %u; this frac reads format %d", get_u32(b), SHARD_FORMAT);
+    else if (rd_str(r, str, sizeof str))
+        snprintf(msg, ms, "is truncated or corrupt (in its header)");
+    else if (strcmp(str, FRAC_VERSION) != 0)
+        snprintf(msg, ms, "was made by frac %.64s; this is frac %s", str, FRAC_VERSION);
+    else if (rd_str(r, str, sizeof str) || strcmp(str, "fnv1a-64") != 0 || rd(r, b, 16))
+        snprintf(msg, ms, "is truncated or corrupt (in its header)");
+    else if (get_u64(b) != s->hash)
+        snprintf(msg, ms, "was made from another script (its hash differs)");
+    else if (get_u64(b + 8) != s->I->seed)
+        snprintf(msg, ms, "was made with --seed %llu, not %llu", (unsigned long long)get_u64(b + 8),
+                 (unsigned long long)s->I->seed);
+    else if (rd(r, b, 4) || rd_str(r, str, sizeof str))
+        snprintf(msg, ms, "is truncated or corrupt (in its header)");
+    else if (get_u32(b) != 0)
+        snprintf(msg, ms, "is of frame %u, not frame 0", get_u32(b));
+    else if (strcmp(str, pt.data ? (const char *)pt.data : "") != 0)
+        snprintf(msg, ms, "was made with other -D params");
+    else if (rd(r, b, 8))
+        snprintf(msg, ms, "is truncated (in its header)");
+    else {
+        *index = (int)get_u32(b);
+        *count = (int)get_u32(b + 4);
+        uint32_t crc = r->crc;
+        if (fread(b + 8, 1, 4, r->f) != 4)
+            snprintf(msg, ms, "is truncated (in its header)");
+        else if (get_u32(b + 8) != crc)
+            snprintf(msg, ms, "is corrupt (header checksum)");
+        else if (*count < 1 || *count > SHARD_MAX_PARTS || *index >= *count)
+            snprintf(msg, ms, "is corrupt (shard %d of %d)", *index, *count);
+        else
+            rc = 0;
+        r->pos += 4;
+    }
+    bytebuf_free(&pt);
+    return rc;
+}
+
+static int bad_part(interp *I, const char *path, const char *fmt, const char *detail)
+{
+    return err_pos(I, -1, 0, 0, ERR_VALUE, fmt, path, detail);
+}
+
+/* Check one part fully; fills its index and count; records compared with (or,
+ * for the first part, stored into) s->recs. */
+static int check_part(shard *s, const char *path, int first, int *index, int *count, long *first_rec)
+{
+    interp *I = s->I;
+    reader r = {fopen(path, "rb"), path, 0, 0};
+    if (!r.f)
+        return err_pos(I, -1, 0, 0, ERR_IO, "merge: cannot open the part '%s': %s", path, strerror(errno));
+    char msg[256] = "";
+    int rc = -1;
+    unsigned char b[64];
+    unsigned char *blk = NULL;
+    if (read_header(s, &r, index, count, msg, sizeof msg)) {
+        bad_part(I, path, "merge: '%s' %s", msg);
+        goto out;
+    }
+    *first_rec = r.pos;
+    uint32_t k = 0;
+    blk = mem_alloc(I, 1 << 16);
+    if (!blk)
+        goto out;
+    for (;; k++) {
+        shard_rec h;
+        uint64_t lo, hi, len;
+        long at = r.pos;
+        int e = read_head(&r, &h, &lo, &hi, &len, msg, sizeof msg);
+        if (e < 0)
+            break;
+        if (e == 1) {
+            if (rd(&r, b, 8)) {
+                snprintf(msg, sizeof msg, "it is truncated (in the end marker)");
+                break;
+            }
+            if (get_u32(b) != k || get_u32(b + 4) != deflate_crc32(0, "END ", 4)) {
+                snprintf(msg, sizeof msg, "it is corrupt (end marker)");
+                break;
+            }
+            if (!first && k != s->nrecs) {
+                snprintf(msg, sizeof msg, "it has %u records, the first part given has %u", k, s->nrecs);
+                break;
+            }
+            if (fgetc(r.f) != EOF) {
+                snprintf(msg, sizeof msg, "it has bytes after its end marker");
+                break;
+            }
+            s->nrecs = k;
+            rc = 0;
+            break;
+        }
+        size_t elo, ehi;
+        chunk_range(h.nchunks, *index, *count, &elo, &ehi);
+        uint64_t efrom, elen;
+        payload_range(&h, elo, ehi, &efrom, &elen);
+        if (lo != elo || hi != ehi || len != elen || h.op < PAR_OP_SUM || h.op > PAR_OP_COMBINE ||
+            (h.op == PAR_OP_SUM && h.total % 8) || (h.op == PAR_OP_COMBINE && (!h.chunk_bytes || h.total % h.chunk_bytes))) {
+            snprintf(msg, sizeof msg, "it is corrupt (record at byte %ld)", at);
+            break;
+        }
+        uint64_t left = len;
+        while (left) {
+            size_t n = left < (1u << 16) ? (size_t)left : 1u << 16;
+            if (rd(&r, blk, n))
+                break;
+            left -= n;
+        }
+        uint32_t crc = r.crc;
+        if (left || fread(b, 1, 4, r.f) != 4) {
+            snprintf(msg, sizeof msg, "it is truncated (in record %u)", k);
+            break;
+        }
+        r.pos += 4;
+        if (get_u32(b) != crc) {
+            snprintf(msg, sizeof msg, "it is corrupt (checksum of record %u, engine call %u)", k, h.seq);
+            break;
+        }
+        if (first) {
+            if (k % 64 == 0) {
+                shard_rec *nr = mem_realloc(I, s->recs, (k + 64) * sizeof *nr);
+                if (!nr)
+                    break;
+                s->recs = nr;
+            }
+            s->recs[k] = h;
+            s->nrecs = k + 1;
+        } else if (k >= s->nrecs || memcmp(&s->recs[k], &h, sizeof h) != 0) {
+            snprintf(msg, sizeof msg, "its record %u (engine call %u) differs from the first part's", k, h.seq);
+            break;
+        }
+    }
+    if (rc && msg[0])
+        bad_part(I, path, "merge: '%s': %s", msg);
+out:
+    mem_free(I, blk);
+    fclose(r.f);
+    return rc;
+}
+
+static int merge_open(shard *s)
+{
+    interp *I = s->I;
+    int n = s->nparts, count = -1;
+    if (n < 1)
+        return err_pos(I, -1, 0, 0, ERR_USAGE, "merge needs the script and its part files");
+    int *idx = mem_alloc(I, (size_t)n * sizeof *idx);
+    long *first = mem_alloc(I, (size_t)n * sizeof *first);
+    if (!idx || !first) {
+        mem_free(I, idx);
+        mem_free(I, first);
+        return -1;
+    }
+    int rc = 0;
+    for (int p = 0; p < n && !rc; p++) {
+        int c;
+        /* the first part read stores the records; the others must match */
+        if (check_part(s, s->parts[p], p == 0, &idx[p], &c, &first[p]))
+            rc = -1;
+        else if (p > 0 && c != count)
+            rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: '%s' is shard %d of %d, but '%s' is of %d", s->parts[p], idx[p], c,
+                         s->parts[0], count);
+        count = c;
+    }
+    if (!rc) {
+        s->count = count;
+        s->order = mem_alloc(I, (size_t)count * sizeof *s->order);
+        s->off = mem_alloc(I, (size_t)count * sizeof *s->off);
+        if (!s->order || !s->off)
+            rc = -1;
+        for (int i = 0; !rc && i < count; i++)
+            s->order[i] = -1;
+        for (int p = 0; !rc && p < n; p++) {
+            if (s->order[idx[p]] >= 0)
+                rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: shard %d of %d is given twice: '%s' and '%s'", idx[p], count,
+                             s->parts[s->order[idx[p]]], s->parts[p]);
+            else {
+                s->order[idx[p]] = p;
+                s->off[idx[p]] = first[p];
+            }
+        }
+        for (int i = 0; !rc && i < count; i++)
+            if (s->order[i] < 0)
+                rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: shard %d of %d is missing (%d part%s given)", i, count, n,
+                             n == 1 ? "" : "s");
+    }
+    mem_free(I, idx);
+    mem_free(I, first);
+    return rc;
+}
+
+/* Fill buf from every part's record `want` (the next one in each part). */
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e)
+{
+    unsigned char blk[1 << 14];
+    size_t step = sizeof blk;
+    if (want->op == PAR_OP_COMBINE) {
+        if (!fn || !want->chunk_bytes || want->chunk_bytes > sizeof blk)
+            return rt_fail(e, RT_EINVAL, "internal: a combined section without a combine function");
+        step = sizeof blk / want->chunk_bytes * want->chunk_bytes; /* whole elements */
+    }
+    for (int i = 0; i < s->count; i++) {
+        const char *path = s->parts[s->order[i]];
+        FILE *f = fopen(path, "rb");
+        if (!f)
+            return rt_fail(e, RT_EIO, "merge: cannot open '%s': %s", path, strerror(errno));
+        reader r = {f, path, 0, s->off[i]};
+        shard_rec h;
+        uint64_t lo, hi, len;
+        char msg[256];
+        rt_code c = RT_OK;
+        if (fseek(f, s->off[i], SEEK_SET) || read_head(&r, &h, &lo, &hi, &len, msg, sizeof msg) ||
+            memcmp(&h, want, sizeof h) != 0) {
+            c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging (record %u.%u of engine call %u not found at byte %ld)",
+                        path, want->sub, want->seq, want->seq, s->off[i]);
+        } else if (want->op == PAR_OP_COMBINE) {
+            for (uint64_t k = 0; k < len && !c; k += step) {
+                size_t n = len - k < step ? (size_t)(len - k) : step;
+                if (rd(&r, blk, n))
+                    c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging", path);
+                else
+                    fn(ctx, (unsigned char *)buf + k, blk, n / want->chunk_bytes);
+            }
+        } else if (want->op == PAR_OP_SUM) {
+            uint64_t *acc = buf;
+            for (uint64_t k = 0; k < len && !c; k += sizeof blk) {
+                size_t n = len - k < sizeof blk ? (size_t)(len - k) : sizeof blk;
+                if (rd(&r, blk, n))
+                    c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging", path);
+                for (size_t q = 0; !c && q < n; q += 8)
+                    acc[(k + q) / 8] += get_u64(blk + q);
+            }
+        } else {
+            uint64_t from, l2;
+            payload_range(want, (size_t)lo, (size_t)hi, &from, &l2);
+            if (rd(&r, (unsigned char *)buf + from, (size_t)len))
+                c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging", path);
+        }
+        uint32_t crc = r.crc;
+        if (!c && (fread(blk, 1, 4, f) != 4 || get_u32(blk) != crc))
+            c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging (checksum)", path);
+        s->off[i] = r.pos + 4;
+        fclose(f);
+        if (c)
+            return c;
+    }
+    return RT_OK;
+}
+
+/* ---- attempts ----------------------------------------------------------------------- */
+
+int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned char *text, size_t len)
+{
+    (void)script;
+    s->I = I;
+    s->again = 0;
+    s->seq = 0;
+    s->pending = -1;
+    s->cur = -1;
+    s->live = 0;
+    s->nrec = 0;
+    s->next_rec = 0;
+    s->hash = fnv1a64(text, len);
+    s->rt.begin = cb_begin;
+    s->rt.section = cb_section;
+    bytebuf_init(&s->part);
+    I->shard = s;
+    par_set_sharder(&s->rt);
+    if (s->merging)
+        return merge_open(s);
+    header(s, &s->part, s->index, s->count);
+    s->devnull = fopen("/dev/null", "w");
+    if (!s->devnull)
+        return err_pos(I, -1, 0, 0, ERR_IO, "--shard: cannot open /dev/null: %s", strerror(errno));
+    I->out = s->devnull; /* a shard prints nothing of the script's: the merge does */
+    return 0;
+}
+
+int shard_attempt_end(shard *s, int ok, const char *script)
+{
+    interp *I = s->I;
+    int rc = 0;
+    if (ok && !s->merging && !s->again) {
+        bytebuf_append(&s->part, "END ", 4);
+        put_u32(&s->part, s->nrec);
+        put_u32(&s->part, deflate_crc32(0, "END ", 4));
+        const char *base = strrchr(script, '/') ? strrchr(script, '/') + 1 : script;
+        size_t bl = strlen(base);
+        if (bl > 5 && strcmp(base + bl - 5, ".frac") == 0)
+            bl -= 5;
+        char name[1024], path[FILEIO_PATH_MAX];
+        snprintf(name, sizeof name, "%.*s.shard-%d-of-%d.part", (int)(bl < 900 ? bl : 900), base, s->index, s->count);
+        if (lang_join_path(I, NULL, I->out_dir, name, strlen(name), path, sizeof path, "--shard"))
+            rc = -1;
+        else if (s->part.failed)
+            rc = mem_engine_error(I, "--shard", "out of memory for the part file");
+        else {
+            rt_error e;
+            rt_code c = fileio_write_atomic(path, s->part.data, s->part.len, &e);
+            if (c)
+                rc = lang_rt_error(I, c, &e, "--shard");
+            else if (!I->quiet)
+                fprintf(stderr, "wrote %s\n", path);
+        }
+    }
+    par_set_sharder(NULL);
+    bytebuf_free(&s->part);
+    mem_free(I, s->recs);
+    mem_free(I, s->order);
+    mem_free(I, s->off);
+    s->recs = NULL;
+    s->order = NULL;
+    s->off = NULL;
+    s->nrecs = 0;
+    if (s->devnull) {
+        I->out = stdout;
+        fclose(s->devnull);
+        s->devnull = NULL;
+    }
+    return rc;
+}
+
+/* ---- partial values -------------------------------------------------------------------- */
+
+typedef struct partial {
+    shard *s;
+    uint32_t seq;
+    const node *at;
+} partial;
+
+static void partial_destroy(void *p)
+{
+    partial *q = p;
+    q->s->live--;
+    rt_free(q);
+}
+
+static void partial_summary(const void *p, bytebuf *out)
+{
+    bytebuf_printf(out, "<partial result of engine call %u>", ((const partial *)p)->seq);
+}
+
+static int partial_arith(interp *I, int op, value a, value b, value *out);
+static int partial_get(interp *I, const void *p, const char *name, value *out);
+static int partial_save(interp *I, const void *p, const char *path, value opts)
+{
+    (void)I, (void)p, (void)path, (void)opts;
+    return 0; /* the record is in the part already */
+}
+
+static const obj_class partial_class = {
+    .name = "partial",
+    .destroy = partial_destroy,
+    .summary = partial_summary,
+    .arith = partial_arith,
+    .get = partial_get,
+    .save = partial_save,
+};
+
+static int partial_arith(interp *I, int op, value a, value b, value *out)
+{
+    (void)I, (void)op, (void)out;
+    const partial *p = a.k == V_OBJ && AS_OBJ(a)->cls == &partial_class ? AS_OBJ(a)->payload : AS_OBJ(b)->payload;
+    return taint(p->s, p->seq, p->at, "is operated on");
+}
+
+static int partial_get(interp *I, const void *pp, const char *name, value *out)
+{
+    (void)I, (void)out;
+    const partial *p = pp;
+    char why[96];
+    snprintf(why, sizeof why, "is inspected (.%s)", name);
+    return taint(p->s, p->seq, p->at, why);
+}
+
+static int scan(shard *s, const char *bname, value v, int depth)
+{
+    if (v.k == V_OBJ && AS_OBJ(v)->cls == &partial_class) {
+        const partial *p = AS_OBJ(v)->payload;
+        char why[96];
+        snprintf(why, sizeof why, "is passed to %s", bname);
+        return taint(s, p->seq, p->at, why);
+    }
+    if (depth > 64)
+        return 0;
+    if (v.k == V_LIST)
+        for (size_t i = 0; i < AS_LIST(v)->n; i++)
+            if (scan(s, bname, AS_LIST(v)->items[i], depth + 1))
+                return -1;
+    if (v.k == V_REC)
+        for (size_t i = 0; i < AS_REC(v)->n; i++)
+            if (scan(s, bname, AS_REC(v)->vals[i], depth + 1))
+                return -1;
+    return 0;
+}
+
+int shard_scan_args(interp *I, const char *bname, const node *call, const value *pos, int npos,
+                    const value *named, int nnamed)
+{
+    shard *s = I->shard;
+    if (!s || s->live <= 0)
+        return 0;
+    const node *saved = I->cur;
+    I->cur = call;
+    int from = strcmp(bname, "save") == 0, rc = 0; /* save(partial, …) is what a shard is for */
+    for (int i = from; i < npos && !rc; i++)
+        rc = scan(s, bname, pos[i], 0);
+    for (int i = 0; i < nnamed && !rc; i++)
+        rc = scan(s, bname, named[i], 0);
+    I->cur = saved;
+    return rc;
+}
+
+int shard_after_builtin(interp *I, int rc, value *out)
+{
+    shard *s = I->shard;
+    if (!s || s->pending < 0)
+        return rc;
+    if (rc != 0) { /* the builtin used its partial result itself (a pre-pass, a check) */
+        if (!s->again && !(I->err.active && I->err.kind == ERR_INTERRUPT)) {
+            err_clear(I);
+            taint(s, (uint32_t)s->pending, s->pending_at, "is used inside its builtin");
+        }
+        s->pending = -1;
+        return -1;
+    }
+    partial *p = mem_alloc(I, sizeof *p);
+    if (!p)
+        return -1;
+    p->s = s;
+    p->seq = (uint32_t)s->pending;
+    p->at = s->pending_at;
+    s->pending = -1;
+    val_unref(I, *out);
+    s->live++; /* val_obj destroys p on failure */
+    *out = val_obj(I, &partial_class, p);
+    return out->k == V_NIL ? -1 : 0;
+}
+
+int shard_pending(const interp *I)
+{
+    return I->shard && !I->shard->merging && I->shard->pending >= 0;
+}
+
+int shard_skip_save(interp *I)
+{
+    return I->shard && !I->shard->merging;
+}
