@@ -211,21 +211,32 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
         return err_at(I, call, ERR_LIMIT, "too many parameters");
     if (npos + nnamed > MAX_ARGS)
         return err_at(I, call, ERR_TYPE, "%s: too many arguments", fname);
-    const char *anames[MAX_ARGS];
-    int required[MAX_ARGS], slot[MAX_ARGS];
-    for (int j = 0; j < l->nparams; j++)
-        required[j] = l->kids[j] == NULL;
-    for (int i = 0; i < npos; i++)
-        anames[i] = NULL;
-    for (int k = 0; k < nnamed; k++)
-        anames[npos + k] = names[k];
-    if (contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, npos + nnamed, call, slot))
-        return -1;
     value bound[MAX_ARGS];
-    int have[MAX_ARGS] = {0};
-    for (int i = 0; i < npos + nnamed; i++) {
-        bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
-        have[slot[i]] = 1;
+    int have[MAX_ARGS];
+    if (nnamed == 0 && npos == l->nparams) {
+        /* every parameter given in order: nothing for contract_match to report */
+        for (int i = 0; i < npos; i++) {
+            bound[i] = pos[i];
+            have[i] = 1;
+        }
+    } else {
+        const char *anames[MAX_ARGS];
+        int required[MAX_ARGS], slot[MAX_ARGS];
+        for (int j = 0; j < l->nparams; j++) {
+            required[j] = l->kids[j] == NULL;
+            have[j] = 0;
+        }
+        for (int i = 0; i < npos; i++)
+            anames[i] = NULL;
+        for (int k = 0; k < nnamed; k++)
+            anames[npos + k] = names[k];
+        if (contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, npos + nnamed, call,
+                           slot))
+            return -1;
+        for (int i = 0; i < npos + nnamed; i++) {
+            bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
+            have[slot[i]] = 1;
+        }
     }
     env *e = val_env_new(I, f->closure);
     if (!e)

@@ -114,6 +114,8 @@ typedef struct interp {
 
     /* scopes and values */
     heap *heap_all;
+    env *env_pool;       /* freed small scopes kept for reuse (value.c) */
+    int env_pool_n;
     env *globals;
     module *mods;
     int nmods, cap_mods;

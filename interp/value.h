@@ -86,6 +86,11 @@ struct env {
     size_t index_cap;
 };
 
+/* Freed scopes with at most ENV_POOL_CAP slots are kept (up to ENV_POOL_MAX)
+ * and reused by val_env_new. */
+#define ENV_POOL_CAP 8
+#define ENV_POOL_MAX 256
+
 /* Hash of an interned name (its address). */
 static inline size_t name_hash(const char *name)
 {
