@@ -235,6 +235,13 @@ static int b_range(interp *I, value *a, int n, value *out)
     if (count > I->lim.max_list)
         return err_at(I, NULL, ERR_LIMIT, "range of %.0f items is longer than the list limit of %.0f (raise it with --max-list)",
                       count, I->lim.max_list);
+    if (I->lazy_range) { /* a `for` walks the items without the list (eval.c) */
+        I->lazy_range->start = start;
+        I->lazy_range->step = step;
+        I->lazy_range->count = (size_t)count;
+        I->lazy_range->used = 1;
+        return 0;
+    }
     value l = val_list(I, (size_t)count);
     if (l.k == V_NIL)
         return -1;
