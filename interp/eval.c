@@ -24,6 +24,7 @@ static inline value *lookup(env *e, const node *n)
         env *t = e;
         for (int h = n->hops; h > 0 && t; h--)
             t = t->parent;
+        /* t is NULL only if the scopes are not the ones resolve.c saw */
         size_t k = (size_t)n->slot - 1;
         if (t && k < t->n && t->names[k] == n->str)
             return &t->vals[k];
@@ -280,8 +281,14 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
             if (eval_expr(I, e, l->kids[j], &v))
                 goto done;
         }
-        if (val_env_define(I, e, l->names[j], v))
+        if ((size_t)j == e->n && e->n < e->cap) {
+            /* parameter j goes to slot j: the parser refuses duplicate names */
+            e->names[j] = l->names[j];
+            e->vals[j] = v;
+            e->n++;
+        } else if (val_env_define(I, e, l->names[j], v)) {
             goto done;
+        }
     }
     if (push_frame(I, fname, call))
         goto done;

@@ -149,17 +149,6 @@ void val_heap_unref(interp *I, heap *h)
     }
 }
 
-void val_ref(value v)
-{
-    if (v.k >= V_STR && v.k != V_BUILTIN)
-        v.u.h->rc++;
-}
-
-void val_unref(interp *I, value v)
-{
-    if (v.k >= V_STR && v.k != V_BUILTIN)
-        val_heap_unref(I, v.u.h);
-}
 
 void val_heap_free_all(interp *I)
 {
