@@ -389,8 +389,12 @@ int eval_call_value(interp *I, value fn, const value *args, int nargs, value *ou
 /* Kept out of eval_expr so its argument arrays do not enlarge every nested
  * evaluation's frame (the C stack is the nesting limit, see cstack.h). */
 /* lazy (may be NULL): if the callee is the builtin range, its items are
- * described there instead of built (`for` and comprehensions). */
-__attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node *n, value *out, range_spec *lazy)
+ * described there instead of built (`for` and comprehensions). assign (may
+ * be NULL): the `x = …` this call is the value of; if the callee is the
+ * builtin concat and its first argument is the list x still holds, concat
+ * may extend that list in place (builtins_core.c checks nothing else holds it). */
+__attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node *n, value *out, range_spec *lazy,
+                                                  const node *assign)
 {
     value fn;
     if (eval_expr(I, e, n->kids[0], &fn))
@@ -424,6 +428,12 @@ __attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node 
         I->lazy_range = lazy;
         rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
         I->lazy_range = NULL;
+    } else if (assign && npos > 0 && pos[0].k == V_LIST && fn.k == V_BUILTIN &&
+               strcmp(fn.u.bi->name, "concat") == 0) {
+        value *x = lookup(e, assign); /* the arguments may have reassigned it */
+        I->append_target = x && x->k == V_LIST && x->u.h == pos[0].u.h ? pos[0].u.h : NULL;
+        rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
+        I->append_target = NULL;
     } else {
         rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
     }
@@ -438,7 +448,7 @@ done:
 
 static int eval_call(interp *I, env *e, const node *n, value *out)
 {
-    return eval_call_in(I, e, n, out, NULL);
+    return eval_call_in(I, e, n, out, NULL, NULL);
 }
 
 /* ---- indexing --------------------------------------------------------------- */
@@ -554,7 +564,7 @@ static int eval_iterable(interp *I, env *e, const node *n, value *it, range_spec
 {
     memset(rs, 0, sizeof *rs);
     if (n->kind == N_CALL) {
-        if (eval_call_in(I, e, n, it, rs))
+        if (eval_call_in(I, e, n, it, rs, NULL))
             return -1;
     } else if (eval_expr(I, e, n, it)) {
         return -1;
@@ -1074,7 +1084,8 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
             return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                           n->str, n->str);
         value v;
-        if (eval_expr(I, e, n->kids[0], &v))
+        const node *rhs = n->kids[0];
+        if (rhs->kind == N_CALL ? eval_call_in(I, e, rhs, &v, NULL, n) : eval_expr(I, e, rhs, &v))
             return -1;
         slot = lookup(e, n); /* the evaluation may have grown the scope */
         val_unref(I, *slot);

@@ -149,6 +149,7 @@ typedef struct interp {
     struct contract_cache *contract; /* compiled declarations (contract.c) */
     const struct bcall *bcall;       /* the builtin call running, for positions */
     struct range_spec *lazy_range;   /* set by `for`: range() describes its items here (eval.c) */
+    const heap *append_target;       /* x = concat(x, …): x's list, which concat may extend (eval.c) */
 } interp;
 
 /* The items start + step * i, i < count, of a range() that a `for` loop or
