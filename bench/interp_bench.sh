@@ -5,12 +5,14 @@
 #   closure    make a closure per iteration and call it                 per iteration
 #   concat     s = concat(s, [i]) (frac) / s[#s+1] = i (Lua)            per item
 #   string     s = s + "x" (frac) / s = s .. "x" (Lua)                  per item
-# (concat and string are quadratic in frac, string in Lua too: their slope is
-# an average cost per item over the sizes run, not a constant.)
+# (string building copies the string each time in both, so its slope is an
+# average cost per item over the sizes run, not a constant; concat extends
+# the list in place since x = concat(x, …) does that.)
 # Each program runs at two sizes; the rate is the slope (CPU seconds, user +
 # system, from /usr/bin/time) between them, so start-up and fixed costs drop
 # out. Prints ns per operation for both, the ratio and the load average.
-# Usage: bash bench/interp_bench.sh [build/frac]     (best of REPS=3 runs)
+# Usage: bash bench/interp_bench.sh [build/frac]     (best of REPS=3 runs;
+#        ONLY=fib runs one program)
 set -eu
 frac=${1:-build/frac}
 reps=${REPS:-3}
@@ -68,9 +70,10 @@ load=$(cut -d' ' -f1-3 /proc/loadavg)
 printf '%-8s %12s %12s %8s   (load average %s)\n' program 'frac ns/op' 'Lua ns/op' ratio "$load"
 # name, two frac sizes, two Lua sizes (Lua needs larger ones to take measurable time)
 for spec in "fib 22 27 27 30" "range 1000000 3000000 3000000 30000000" "closure 300000 1000000 1000000 3000000" \
-    "concat 5000 20000 1000000 5000000" "string 20000 80000 20000 80000"; do
+    "concat 300000 1000000 1000000 5000000" "string 20000 80000 20000 80000"; do
     set -- $spec
     name=$1 n1=$2 n2=$3 m1=$4 m2=$5
+    [ -n "${ONLY:-}" ] && [ "$ONLY" != "$name" ] && continue
     prog "$name"
     f1=$(cpu "$tmp/f1" "$frac" -D N="$n1" "$tmp/$name.frac")
     f2=$(cpu "$tmp/f2" "$frac" -D N="$n2" "$tmp/$name.frac")
