@@ -349,8 +349,13 @@ static int call_builtin(interp *I, const builtin *b, const value *pos, int npos,
         }
         if (args[s].k == V_NIL && cp->def_nil)
             continue;
-        char what[160];
-        snprintf(what, sizeof what, "argument '%s'", cp->name);
+        char what[160]; /* "argument 'NAME'", without snprintf: every call builds it */
+        size_t nl = strlen(cp->name);
+        if (nl > sizeof what - 13)
+            nl = sizeof what - 13;
+        memcpy(what, "argument '", 10);
+        memcpy(what + 10, cp->name, nl);
+        memcpy(what + 10 + nl, "'", 2);
         cpos at = {nodes[s] ? nodes[s] : call, -1, 0, 0};
         if (contract_check_value(I, cp->type, args[s], b->name, what, at))
             return -1;
