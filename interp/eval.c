@@ -392,8 +392,8 @@ int eval_call_value(interp *I, value fn, const value *args, int nargs, value *ou
 }
 
 /* Kept out of eval_expr so its argument arrays do not enlarge every nested
- * evaluation's frame (the C stack is the nesting limit, see cstack.h). */
-/* lazy (may be NULL): if the callee is the builtin range, its items are
+ * evaluation's frame (the C stack is the nesting limit, see cstack.h).
+ * lazy (may be NULL): if the callee is the builtin range, its items are
  * described there instead of built (`for` and comprehensions). assign (may
  * be NULL): the `x = …` this call is the value of; if the callee is the
  * builtin concat and its first argument is the list x still holds, concat
