@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 load() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || uptime; }
 echo "== frac benchmarks, $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc 2>/dev/null || echo '?') cores, load $(load)"
 bash bench/interp.sh "$build/frac"
+bash bench/interp_bench.sh "$build/frac"
 for b in "$build"/bench/*; do
     [ -x "$b" ] || continue
     echo "== $(basename "$b") (load before: $(load))"

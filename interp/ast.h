@@ -53,6 +53,12 @@ typedef struct node {
     int nparams;       /* N_LAMBDA */
     struct node *body; /* N_LAMBDA */
     const char *doc;   /* N_PARAM: trailing comment text (may be NULL) */
+    /* Set by resolve.c (0 = not resolved: look the name up by name). For
+     * N_NAME and N_ASSIGN: the name is slot - 1 of the scope `hops` parents
+     * up from the one the node is evaluated in; for N_LET, N_PARAM and
+     * N_FNDEF: the slot it defines in its own scope. The evaluator checks
+     * the slot still holds that name before using it (see eval.c). */
+    int slot, hops;
 } node;
 
 #endif

@@ -235,6 +235,13 @@ static int b_range(interp *I, value *a, int n, value *out)
     if (count > I->lim.max_list)
         return err_at(I, NULL, ERR_LIMIT, "range of %.0f items is longer than the list limit of %.0f (raise it with --max-list)",
                       count, I->lim.max_list);
+    if (I->lazy_range) { /* a `for` walks the items without the list (eval.c) */
+        I->lazy_range->start = start;
+        I->lazy_range->step = step;
+        I->lazy_range->count = (size_t)count;
+        I->lazy_range->used = 1;
+        return 0;
+    }
     value l = val_list(I, (size_t)count);
     if (l.k == V_NIL)
         return -1;
@@ -330,8 +337,49 @@ static int b_fold(interp *I, value *a, int n, value *out)
     return 0;
 }
 
+/* x = concat(x, …) where the variable x holds the only other reference to
+ * its list (eval.c sets append_target then): the list is extended in place,
+ * amortised O(1) per item, which no one can observe. Anything else (an
+ * argument that is not a list, the list limit) takes the copying path,
+ * which reports it as before. 1 done, 0 not applicable, -1 out of memory. */
+static int concat_in_place(interp *I, value *a, int n, value *out)
+{
+    if (n < 1 || a[0].k != V_LIST || I->append_target != a[0].u.h || a[0].u.h->rc != 2)
+        return 0;
+    vlist *l = AS_LIST(a[0]);
+    size_t total = l->n;
+    for (int k = 1; k < n; k++) {
+        if (a[k].k != V_LIST)
+            return 0;
+        total += AS_LIST(a[k])->n;
+    }
+    if ((double)total > I->lim.max_list)
+        return 0;
+    if (total > l->cap) {
+        size_t cap = l->cap * 2 > total ? l->cap * 2 : total;
+        value *items = mem_realloc(I, l->items, cap * sizeof *items);
+        if (!items)
+            return -1;
+        l->items = items;
+        l->cap = cap;
+    }
+    for (int k = 1; k < n; k++) {
+        const vlist *m = AS_LIST(a[k]);
+        for (size_t i = 0, mn = m->n; i < mn; i++) {
+            val_ref(m->items[i]);
+            l->items[l->n++] = m->items[i];
+        }
+    }
+    val_ref(a[0]);
+    *out = a[0];
+    return 1;
+}
+
 static int b_concat(interp *I, value *a, int n, value *out)
 {
+    int r = concat_in_place(I, a, n, out);
+    if (r)
+        return r < 0 ? -1 : 0;
     value l = val_list(I, 0);
     if (l.k == V_NIL)
         return -1;

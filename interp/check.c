@@ -75,13 +75,46 @@ int check_collect(interp *I, const node *prog, check_names *out)
     for (int i = 0; i < prog->nkids; i++)
         if (collect(I, out, prog->kids[i], 1))
             return -1;
+    /* check_call looks every call's name up here: hashed, not scanned */
+    size_t cap = 16;
+    while (cap < (size_t)out->n * 2 + 2)
+        cap *= 2;
+    out->index = mem_calloc(I, cap, sizeof *out->index);
+    out->count = mem_calloc(I, cap, sizeof *out->count);
+    if (!out->index || !out->count)
+        return -1;
+    out->index_cap = cap;
+    for (int i = 0; i < out->n; i++) {
+        size_t h = name_hash(out->v[i].name) & (cap - 1);
+        while (out->index[h] && out->v[out->index[h] - 1].name != out->v[i].name)
+            h = (h + 1) & (cap - 1);
+        out->index[h] = i + 1;
+        out->count[h]++;
+    }
     return 0;
 }
 
 void check_names_free(interp *I, check_names *b)
 {
     mem_free(I, b->v);
+    mem_free(I, b->index);
+    mem_free(I, b->count);
     memset(b, 0, sizeof *b);
+}
+
+/* How many times the program binds name, and the def of its last binding. */
+static int bound_count(const check_names *b, const char *name, const node **def)
+{
+    *def = NULL;
+    if (!b->index_cap)
+        return 0;
+    size_t h = name_hash(name) & (b->index_cap - 1);
+    while (b->index[h] && b->v[b->index[h] - 1].name != name)
+        h = (h + 1) & (b->index_cap - 1);
+    if (!b->index[h])
+        return 0;
+    *def = b->v[b->index[h] - 1].def;
+    return b->count[h];
 }
 
 /* The arguments of a call as the evaluator passes them: positional ones
@@ -159,13 +192,8 @@ int check_call(interp *I, const check_names *bound, env *const *mods, int nmods,
     if (callee->kind != N_NAME)
         return 0;
     const char *name = callee->str;
-    const node *def = NULL;
-    int nbound = 0;
-    for (int i = 0; i < bound->n; i++)
-        if (bound->v[i].name == name) {
-            nbound++;
-            def = bound->v[i].def;
-        }
+    const node *def;
+    int nbound = bound_count(bound, name, &def);
     if (nbound > 1 || (nbound == 1 && !def))
         return 0; /* a variable, or a name given more than one meaning: checked when it runs */
     if (def)

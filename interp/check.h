@@ -14,6 +14,9 @@
 typedef struct check_names {
     struct { const char *name; const node *def; } *v; /* def: a top-level N_FNDEF, else NULL */
     int n, cap;
+    int *index; /* open addressing over v by name: i + 1 of the name's last entry, 0 empty */
+    int *count; /* per index slot: how many entries have that name */
+    size_t index_cap;
 } check_names;
 
 /* Collect every name the program binds (anywhere). */

@@ -768,16 +768,23 @@ typedef struct cctx {
     const char *who;
 } cctx;
 
+static const char *num_text(double x, char *buf, size_t n)
+{
+    fmt_num(x, buf, n);
+    return buf;
+}
+
 /* A number against an alternative's finiteness, range and choices. */
 static int check_num(cctx *c, const calt *a, double x, const char *what, cpos at)
 {
     char got[40];
-    fmt_num(x, got, sizeof got);
+    /* x is formatted only for a message (num_text): the shortest round-trip
+     * form costs thousands of instructions, and every call passes here */
     if ((isnan(x) && !a->nan) || (isinf(x) && !a->inf))
-        return err_cpos(c->I, at, ERR_VALUE, "%s: %s must be a finite number, got %s", c->who, what, got);
+        return err_cpos(c->I, at, ERR_VALUE, "%s: %s must be a finite number, got %s", c->who, what, num_text(x, got, sizeof got));
     if (a->kind == K_INT && isfinite(x) && fabs(x) > 9007199254740992.0)
         return err_cpos(c->I, at, ERR_VALUE, "%s: %s must be a whole number of at most 2^53, got %s", c->who, what,
-                        got);
+                        num_text(x, got, sizeof got));
     int bad = 0;
     if (a->has_lo && (a->lo_open ? !(x > a->lo) : !(x >= a->lo)) && !isnan(x))
         bad = 1;
@@ -787,7 +794,7 @@ static int check_num(cctx *c, const calt *a, double x, const char *what, cpos at
         sbuf r = {{0}, 0};
         describe_range(a, &r);
         int rc = err_cpos(c->I, at, ERR_VALUE, "%s: %s must be %s, got %s", c->who, what, r.data,
-                          got);
+                          num_text(x, got, sizeof got));
         return rc;
     }
     if (a->nchoice && a->kind != K_STR) {
@@ -797,7 +804,7 @@ static int check_num(cctx *c, const calt *a, double x, const char *what, cpos at
         sbuf d = {{0}, 0};
         describe_alt(a, &d);
         int rc = err_cpos(c->I, at, ERR_VALUE, "%s: %s must be %s, got %s", c->who, what, d.data,
-                          got);
+                          num_text(x, got, sizeof got));
         return rc;
     }
     return 0;

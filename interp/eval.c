@@ -16,6 +16,35 @@
 #include "shard.h"
 #include "stdlib_embed.h"
 
+/* A name by its slot (resolve.c), checked: the slot must hold the name
+ * (it may not be defined yet, or a REPL input may have stopped half-way),
+ * else the search by name decides, as it always did. */
+static inline value *lookup(env *e, const node *n)
+{
+    if (n->slot) {
+        env *t = e;
+        for (int h = n->hops; h > 0 && t; h--)
+            t = t->parent;
+        /* t is NULL only if the scopes are not the ones resolve.c saw */
+        size_t k = (size_t)n->slot - 1;
+        if (t && k < t->n && t->names[k] == n->str)
+            return &t->vals[k];
+    }
+    return val_env_lookup(e, n->str);
+}
+
+/* Define n->str in e (takes v), in place when the slot already holds it. */
+static inline int define(interp *I, env *e, const node *n, value v)
+{
+    size_t k = (size_t)n->slot - 1;
+    if (n->slot && k < e->n && e->names[k] == n->str) {
+        val_unref(I, e->vals[k]);
+        e->vals[k] = v;
+        return 0;
+    }
+    return val_env_define(I, e, n->str, v);
+}
+
 static int check_interrupt(interp *I, const node *at)
 {
     if (I->interrupt && *I->interrupt)
@@ -212,21 +241,32 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
         return err_at(I, call, ERR_LIMIT, "too many parameters");
     if (npos + nnamed > MAX_ARGS)
         return err_at(I, call, ERR_TYPE, "%s: too many arguments", fname);
-    const char *anames[MAX_ARGS];
-    int required[MAX_ARGS], slot[MAX_ARGS];
-    for (int j = 0; j < l->nparams; j++)
-        required[j] = l->kids[j] == NULL;
-    for (int i = 0; i < npos; i++)
-        anames[i] = NULL;
-    for (int k = 0; k < nnamed; k++)
-        anames[npos + k] = names[k];
-    if (contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, npos + nnamed, call, slot))
-        return -1;
     value bound[MAX_ARGS];
-    int have[MAX_ARGS] = {0};
-    for (int i = 0; i < npos + nnamed; i++) {
-        bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
-        have[slot[i]] = 1;
+    int have[MAX_ARGS];
+    if (nnamed == 0 && npos == l->nparams) {
+        /* every parameter given in order: nothing for contract_match to report */
+        for (int i = 0; i < npos; i++) {
+            bound[i] = pos[i];
+            have[i] = 1;
+        }
+    } else {
+        const char *anames[MAX_ARGS];
+        int required[MAX_ARGS], slot[MAX_ARGS];
+        for (int j = 0; j < l->nparams; j++) {
+            required[j] = l->kids[j] == NULL;
+            have[j] = 0;
+        }
+        for (int i = 0; i < npos; i++)
+            anames[i] = NULL;
+        for (int k = 0; k < nnamed; k++)
+            anames[npos + k] = names[k];
+        if (contract_match(I, fname, l->names, required, l->nparams, 0, "", anames, anodes, npos + nnamed, call,
+                           slot))
+            return -1;
+        for (int i = 0; i < npos + nnamed; i++) {
+            bound[slot[i]] = i < npos ? pos[i] : named[i - npos];
+            have[slot[i]] = 1;
+        }
     }
     env *e = val_env_new(I, f->closure);
     if (!e)
@@ -242,8 +282,14 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
             if (eval_expr(I, e, l->kids[j], &v))
                 goto done;
         }
-        if (val_env_define(I, e, l->names[j], v))
+        if ((size_t)j == e->n && e->n < e->cap) {
+            /* parameter j goes to slot j: the parser refuses duplicate names */
+            e->names[j] = l->names[j];
+            e->vals[j] = v;
+            e->n++;
+        } else if (val_env_define(I, e, l->names[j], v)) {
             goto done;
+        }
     }
     if (push_frame(I, fname, call))
         goto done;
@@ -306,8 +352,13 @@ static int call_builtin(interp *I, const builtin *b, const value *pos, int npos,
         }
         if (args[s].k == V_NIL && cp->def_nil)
             continue;
-        char what[160];
-        snprintf(what, sizeof what, "argument '%s'", cp->name);
+        char what[160]; /* "argument 'NAME'", without snprintf: every call builds it */
+        size_t nl = strlen(cp->name);
+        if (nl > sizeof what - 13)
+            nl = sizeof what - 13;
+        memcpy(what, "argument '", 10);
+        memcpy(what + 10, cp->name, nl);
+        memcpy(what + 10 + nl, "'", 2);
         cpos at = {nodes[s] ? nodes[s] : call, -1, 0, 0};
         if (contract_check_value(I, cp->type, args[s], b->name, what, at))
             return -1;
@@ -346,8 +397,14 @@ int eval_call_value(interp *I, value fn, const value *args, int nargs, value *ou
 }
 
 /* Kept out of eval_expr so its argument arrays do not enlarge every nested
- * evaluation's frame (the C stack is the nesting limit, see cstack.h). */
-__attribute__((noinline)) static int eval_call(interp *I, env *e, const node *n, value *out)
+ * evaluation's frame (the C stack is the nesting limit, see cstack.h).
+ * lazy (may be NULL): if the callee is the builtin range, its items are
+ * described there instead of built (`for` and comprehensions). assign (may
+ * be NULL): the `x = …` this call is the value of; if the callee is the
+ * builtin concat and its first argument is the list x still holds, concat
+ * may extend that list in place (builtins_core.c checks nothing else holds it). */
+__attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node *n, value *out, range_spec *lazy,
+                                                  const node *assign)
 {
     value fn;
     if (eval_expr(I, e, n->kids[0], &fn))
@@ -377,7 +434,19 @@ __attribute__((noinline)) static int eval_call(interp *I, env *e, const node *n,
     /* argument nodes in call order: positional ones, then named ones */
     for (int k = 0; k < nnamed; k++)
         posn[npos + k] = anodes[MAX_ARGS - 1 - k];
-    rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
+    if (lazy && fn.k == V_BUILTIN && strcmp(fn.u.bi->name, "range") == 0) {
+        I->lazy_range = lazy;
+        rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
+        I->lazy_range = NULL;
+    } else if (assign && npos > 0 && pos[0].k == V_LIST && fn.k == V_BUILTIN &&
+               strcmp(fn.u.bi->name, "concat") == 0) {
+        value *x = lookup(e, assign); /* the arguments may have reassigned it */
+        I->append_target = x && x->k == V_LIST && x->u.h == pos[0].u.h ? pos[0].u.h : NULL;
+        rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
+        I->append_target = NULL;
+    } else {
+        rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
+    }
 done:
     for (int i = 0; i < npos; i++)
         val_unref(I, pos[i]);
@@ -385,6 +454,11 @@ done:
         val_unref(I, named[i]);
     val_unref(I, fn);
     return rc;
+}
+
+static int eval_call(interp *I, env *e, const node *n, value *out)
+{
+    return eval_call_in(I, e, n, out, NULL, NULL);
 }
 
 /* ---- indexing --------------------------------------------------------------- */
@@ -494,28 +568,74 @@ static int iterate_list(interp *I, value it, const node *at)
     return 0;
 }
 
+/* What a `for` or comprehension walks: a list in *it, or (rs->used) the
+ * items of range(…) without the list, *it nil. *count is the number of items. */
+static int eval_iterable(interp *I, env *e, const node *n, value *it, range_spec *rs, size_t *count)
+{
+    memset(rs, 0, sizeof *rs);
+    if (n->kind == N_CALL) {
+        if (eval_call_in(I, e, n, it, rs, NULL))
+            return -1;
+    } else if (eval_expr(I, e, n, it)) {
+        return -1;
+    }
+    if (rs->used) {
+        *count = rs->count;
+        return 0;
+    }
+    if (iterate_list(I, *it, n)) {
+        val_unref(I, *it);
+        return -1;
+    }
+    *count = AS_LIST(*it)->n;
+    return 0;
+}
+
+/* Item i of what eval_iterable gave (a new reference). */
+static inline value iter_item(value it, const range_spec *rs, size_t i)
+{
+    if (rs->used)
+        return val_num(rs->start + rs->step * (double)i);
+    value x = AS_LIST(it)->items[i];
+    val_ref(x);
+    return x;
+}
+
+/* After an iteration: the scope is emptied for the next one unless a
+ * closure made in the body kept it (then the next iteration gets a new
+ * one, so each closure keeps its own iteration's values). */
+static env *iter_scope_next(interp *I, env *s)
+{
+    if (s->h.rc == 1 && !s->index) {
+        for (size_t k = 0; k < s->n; k++)
+            val_unref(I, s->vals[k]);
+        s->n = 0;
+        return s;
+    }
+    val_heap_unref(I, &s->h);
+    return NULL;
+}
+
 __attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n, value *out)
 {
     value it;
-    if (eval_expr(I, e, n->kids[1], &it))
+    range_spec rs;
+    size_t count;
+    env *s = NULL;
+    if (eval_iterable(I, e, n->kids[1], &it, &rs, &count))
         return -1;
-    if (iterate_list(I, it, n->kids[1])) {
-        val_unref(I, it);
-        return -1;
-    }
-    value res = val_list(I, AS_LIST(it)->n);
+    /* with a filter the result may be much shorter: grow it as it fills */
+    value res = val_list(I, n->kids[2] ? 0 : count);
     if (res.k == V_NIL) {
         val_unref(I, it);
         return -1;
     }
-    for (size_t i = 0; i < AS_LIST(it)->n; i++) {
+    for (size_t i = 0; i < count; i++) {
         if (check_interrupt(I, n))
             goto fail;
-        env *s = val_env_new(I, e);
-        if (!s)
+        if (!s && !(s = val_env_new(I, e)))
             goto fail;
-        value x = AS_LIST(it)->items[i];
-        val_ref(x);
+        value x = iter_item(it, &rs, i);
         int ok = val_env_define(I, s, n->str, x) == 0;
         int keep = 1;
         if (ok && n->kids[2]) {
@@ -530,14 +650,18 @@ __attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n,
         if (ok && keep) {
             ok = eval_expr(I, s, n->kids[0], &v) == 0 && val_list_push(I, AS_LIST(res), v) == 0;
         }
-        val_heap_unref(I, &s->h);
         if (!ok)
             goto fail;
+        s = iter_scope_next(I, s);
     }
+    if (s)
+        val_heap_unref(I, &s->h);
     val_unref(I, it);
     *out = res;
     return 0;
 fail:
+    if (s)
+        val_heap_unref(I, &s->h);
     val_unref(I, it);
     val_unref(I, res);
     return -1;
@@ -553,12 +677,14 @@ static int stack_overflow(interp *I, const node *n)
     return cstack_error(I, n, "calls and expressions nested too deeply");
 }
 
-int eval_expr(interp *I, env *e, const node *n, value *out)
+static int binary_values(interp *I, const node *n, value a, value b, value *out);
+
+/* The node kinds eval_expr leaves to this function: kept out of it so the
+ * frequent ones (numbers, names, arithmetic, calls, conditions) run in a
+ * small frame. */
+__attribute__((noinline)) static int eval_cold(interp *I, env *e, const node *n, value *out)
 {
     *out = val_nil();
-    /* every nested evaluation passes here: the C stack bounds the nesting */
-    if (cstack_exhausted())
-        return stack_overflow(I, n);
     switch (n->kind) {
     case N_NUM:
         *out = val_num(n->num);
@@ -572,7 +698,7 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
     case N_NIL:
         return 0;
     case N_NAME: {
-        value *v = val_env_lookup(e, n->str);
+        value *v = lookup(e, n);
         if (!v)
             return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
         *out = *v;
@@ -627,6 +753,49 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
             val_unref(I, a);
             return -1;
         }
+        return binary_values(I, n, a, b, out);
+    }
+    case N_INDEX: {
+        value a, ix;
+        if (eval_expr(I, e, n->kids[0], &a))
+            return -1;
+        if (eval_expr(I, e, n->kids[1], &ix)) {
+            val_unref(I, a);
+            return -1;
+        }
+        int r = eval_index(I, a, ix, out, n);
+        val_unref(I, a);
+        val_unref(I, ix);
+        return r;
+    }
+    case N_FIELD: {
+        value a;
+        if (eval_expr(I, e, n->kids[0], &a))
+            return -1;
+        int r = eval_field(I, a, n->str, out, n);
+        val_unref(I, a);
+        return r;
+    }
+    case N_BLOCK: {
+        env *s = val_env_new(I, e);
+        if (!s)
+            return -1;
+        int r = eval_block(I, s, n, out);
+        val_heap_unref(I, &s->h);
+        return r;
+    }
+    case N_LAMBDA:
+        *out = val_func(I, n, e, n->str);
+        return out->k == V_NIL ? -1 : 0;
+    default:
+        return err_at(I, n, ERR_RUNTIME, "internal error: statement in expression position");
+    }
+}
+
+/* a op b for the operator node n; takes a and b. */
+__attribute__((noinline)) static int binary_values(interp *I, const node *n, value a, value b, value *out)
+{
+    {
         int r;
         if (n->op == T_EQ || n->op == T_NE) {
             int handled = 0;
@@ -650,6 +819,70 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
         val_unref(I, b);
         return r;
     }
+}
+
+/* An operand that needs no recursion: a number or a resolved name. */
+static inline int eval_leaf(interp *I, env *e, const node *n, value *out)
+{
+    if (n->kind == N_NUM) {
+        *out = val_num(n->num);
+        return 0;
+    }
+    if (n->kind == N_NAME) {
+        value *v = lookup(e, n);
+        if (v) {
+            *out = *v;
+            val_ref(*out);
+            return 0;
+        }
+    }
+    return eval_expr(I, e, n, out);
+}
+
+int eval_expr(interp *I, env *e, const node *n, value *out)
+{
+    *out = val_nil();
+    /* every nested evaluation passes here: the C stack bounds the nesting */
+    if (cstack_exhausted())
+        return stack_overflow(I, n);
+    switch (n->kind) {
+    case N_NUM:
+        *out = val_num(n->num);
+        return 0;
+    case N_NAME: {
+        value *v = lookup(e, n);
+        if (!v)
+            return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
+        *out = *v;
+        val_ref(*out);
+        return 0;
+    }
+    case N_BINARY: {
+        value a, b;
+        if (eval_leaf(I, e, n->kids[0], &a))
+            return -1;
+        if (eval_leaf(I, e, n->kids[1], &b)) {
+            val_unref(I, a);
+            return -1;
+        }
+        if (a.k == V_NUM && b.k == V_NUM) {
+            double x = a.u.n, y = b.u.n;
+            switch (n->op) {
+            case T_PLUS: *out = val_num(x + y); return 0;
+            case T_MINUS: *out = val_num(x - y); return 0;
+            case T_STAR: *out = val_num(x * y); return 0;
+            case T_SLASH: *out = val_num(x / y); return 0;
+            case T_LT: *out = val_bool(x < y); return 0;
+            case T_LE: *out = val_bool(x <= y); return 0;
+            case T_GT: *out = val_bool(x > y); return 0;
+            case T_GE: *out = val_bool(x >= y); return 0;
+            case T_EQ: *out = val_bool(x == y); return 0; /* as val_equal */
+            case T_NE: *out = val_bool(x != y); return 0;
+            default: break;
+            }
+        }
+        return binary_values(I, n, a, b, out);
+    }
     case N_AND:
     case N_OR: {
         value a;
@@ -665,27 +898,6 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
     }
     case N_CALL:
         return eval_call(I, e, n, out);
-    case N_INDEX: {
-        value a, ix;
-        if (eval_expr(I, e, n->kids[0], &a))
-            return -1;
-        if (eval_expr(I, e, n->kids[1], &ix)) {
-            val_unref(I, a);
-            return -1;
-        }
-        int r = eval_index(I, a, ix, out, n);
-        val_unref(I, a);
-        val_unref(I, ix);
-        return r;
-    }
-    case N_FIELD: {
-        value a;
-        if (eval_expr(I, e, n->kids[0], &a))
-            return -1;
-        int r = eval_field(I, a, n->str, out, n);
-        val_unref(I, a);
-        return r;
-    }
     case N_IF: {
         value c;
         if (eval_expr(I, e, n->kids[0], &c))
@@ -698,19 +910,8 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
             return eval_expr(I, e, n->kids[2], out);
         return 0;
     }
-    case N_BLOCK: {
-        env *s = val_env_new(I, e);
-        if (!s)
-            return -1;
-        int r = eval_block(I, s, n, out);
-        val_heap_unref(I, &s->h);
-        return r;
-    }
-    case N_LAMBDA:
-        *out = val_func(I, n, e, n->str);
-        return out->k == V_NIL ? -1 : 0;
     default:
-        return err_at(I, n, ERR_RUNTIME, "internal error: statement in expression position");
+        return eval_cold(I, e, n, out);
     }
 }
 
@@ -796,6 +997,88 @@ static int apply_param_override(interp *I, const node *n, value def, value *out)
     return 0;
 }
 
+__attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
+{
+    value it;
+    range_spec rs;
+    size_t count;
+    if (eval_iterable(I, e, n->kids[0], &it, &rs, &count))
+        return -1;
+    int rc = 0;
+    env *s = NULL;
+    for (size_t i = 0; i < count && rc == 0; i++) {
+        if (check_interrupt(I, n)) {
+            rc = -1;
+            break;
+        }
+        if (!s && !(s = val_env_new(I, e))) {
+            rc = -1;
+            break;
+        }
+        if (s->n == 0 && s->cap > 0) { /* a new or emptied scope: the variable is its first name */
+            s->names[0] = n->str;
+            s->vals[0] = iter_item(it, &rs, i);
+            s->n = 1;
+        } else {
+            rc = val_env_define(I, s, n->str, iter_item(it, &rs, i));
+        }
+        if (rc == 0)
+            rc = eval_block(I, s, n->kids[1], NULL);
+        if (rc == 0)
+            s = iter_scope_next(I, s);
+    }
+    if (s)
+        val_heap_unref(I, &s->h);
+    val_unref(I, it);
+    return rc;
+}
+
+__attribute__((noinline)) static int exec_param(interp *I, env *e, const node *n)
+{
+    value def;
+    if (eval_expr(I, e, n->kids[0], &def))
+        return -1;
+    value ov;
+    /* -D overrides the params of the script run, not those of the
+     * modules it imports */
+    int r = n->src >= 0 && I->srcs[n->src].is_module ? 0 : apply_param_override(I, n, def, &ov);
+    if (r < 0) {
+        val_unref(I, def);
+        return -1;
+    }
+    if (r == 1) {
+        val_unref(I, def);
+        def = ov;
+    }
+    return define(I, e, n, def);
+}
+
+__attribute__((noinline)) static int exec_import(interp *I, env *e, const node *n)
+{
+    env *m;
+    if (eval_import(I, n, n->str, &m))
+        return -1;
+    if (n->names[0]) {
+        value r = val_rec(I);
+        if (r.k == V_NIL)
+            return -1;
+        for (size_t i = 0; i < m->n; i++) {
+            val_ref(m->vals[i]);
+            if (val_rec_set(I, AS_REC(r), m->names[i], m->vals[i])) {
+                val_unref(I, r);
+                return -1;
+            }
+        }
+        return val_env_define(I, e, n->names[0], r);
+    }
+    for (size_t i = 0; i < m->n; i++) {
+        val_ref(m->vals[i]);
+        if (val_env_define(I, e, m->names[i], m->vals[i]))
+            return -1;
+    }
+    return 0;
+}
+
 static int exec_stmt(interp *I, env *e, const node *n, value *last)
 {
     switch (n->kind) {
@@ -803,98 +1086,34 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         value v;
         if (eval_expr(I, e, n->kids[0], &v))
             return -1;
-        return val_env_define(I, e, n->str, v);
+        return define(I, e, n, v);
     }
     case N_ASSIGN: {
-        value *slot = val_env_lookup(e, n->str);
+        value *slot = lookup(e, n);
         if (!slot)
             return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                           n->str, n->str);
         value v;
-        if (eval_expr(I, e, n->kids[0], &v))
+        const node *rhs = n->kids[0];
+        if (rhs->kind == N_CALL ? eval_call_in(I, e, rhs, &v, NULL, n) : eval_expr(I, e, rhs, &v))
             return -1;
-        slot = val_env_lookup(e, n->str); /* the evaluation may have grown the scope */
+        slot = lookup(e, n); /* the evaluation may have grown the scope */
         val_unref(I, *slot);
         *slot = v;
         return 0;
     }
-    case N_PARAM: {
-        value def;
-        if (eval_expr(I, e, n->kids[0], &def))
-            return -1;
-        value ov;
-        /* -D overrides the params of the script run, not those of the
-         * modules it imports */
-        int r = n->src >= 0 && I->srcs[n->src].is_module ? 0 : apply_param_override(I, n, def, &ov);
-        if (r < 0) {
-            val_unref(I, def);
-            return -1;
-        }
-        if (r == 1) {
-            val_unref(I, def);
-            def = ov;
-        }
-        return val_env_define(I, e, n->str, def);
-    }
+    case N_PARAM:
+        return exec_param(I, e, n);
     case N_FNDEF: {
         value f = val_func(I, n->kids[0], e, n->str);
         if (f.k == V_NIL)
             return -1;
-        return val_env_define(I, e, n->str, f);
+        return define(I, e, n, f);
     }
-    case N_IMPORT: {
-        env *m;
-        if (eval_import(I, n, n->str, &m))
-            return -1;
-        if (n->names[0]) {
-            value r = val_rec(I);
-            if (r.k == V_NIL)
-                return -1;
-            for (size_t i = 0; i < m->n; i++) {
-                val_ref(m->vals[i]);
-                if (val_rec_set(I, AS_REC(r), m->names[i], m->vals[i])) {
-                    val_unref(I, r);
-                    return -1;
-                }
-            }
-            return val_env_define(I, e, n->names[0], r);
-        }
-        for (size_t i = 0; i < m->n; i++) {
-            val_ref(m->vals[i]);
-            if (val_env_define(I, e, m->names[i], m->vals[i]))
-                return -1;
-        }
-        return 0;
-    }
-    case N_FOR: {
-        value it;
-        if (eval_expr(I, e, n->kids[0], &it))
-            return -1;
-        if (iterate_list(I, it, n->kids[0])) {
-            val_unref(I, it);
-            return -1;
-        }
-        int rc = 0;
-        for (size_t i = 0; i < AS_LIST(it)->n && rc == 0; i++) {
-            if (check_interrupt(I, n)) {
-                rc = -1;
-                break;
-            }
-            env *s = val_env_new(I, e);
-            if (!s) {
-                rc = -1;
-                break;
-            }
-            value x = AS_LIST(it)->items[i];
-            val_ref(x);
-            rc = val_env_define(I, s, n->str, x);
-            if (rc == 0)
-                rc = eval_block(I, s, n->kids[1], NULL);
-            val_heap_unref(I, &s->h);
-        }
-        val_unref(I, it);
-        return rc;
-    }
+    case N_IMPORT:
+        return exec_import(I, e, n);
+    case N_FOR:
+        return exec_for(I, e, n);
     case N_EXPR: {
         value v;
         if (eval_expr(I, e, n->kids[0], &v))

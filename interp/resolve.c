@@ -359,7 +359,9 @@ static int resolve_block(resolver *r, scope *s, const node *b)
     return 0;
 }
 
-int resolve_program(interp *I, const node *prog, env *globals)
+static int resolve_slots(interp *I, node *prog, env *globals);
+
+int resolve_program(interp *I, node *prog, env *globals)
 {
     resolver r;
     memset(&r, 0, sizeof r);
@@ -371,5 +373,258 @@ int resolve_program(interp *I, const node *prog, env *globals)
         rc = resolve_block(&r, &top, prog);
     scope_free(I, &top);
     check_names_free(I, &r.bound);
+    if (rc == 0)
+        rc = resolve_slots(I, prog, globals);
+    return rc;
+}
+
+/* ---- slots ------------------------------------------------------------------------------------------
+ *
+ * After the checks above pass, a second walk gives each name its place in the
+ * evaluator's scopes, so eval.c finds a variable with an index instead of a
+ * search by name. It mirrors how eval.c makes scopes: one per call (the
+ * parameters, then the statements of a block body), per `do … end` block,
+ * per loop iteration (the variable, then the body's statements) and per
+ * comprehension item; a scope's names take slots in the order its statements
+ * first define them, as val_env_define appends them.
+ *
+ * A use of x is bound to the innermost scope among those around it that
+ * defines x anywhere in its statements (a scope that never defines x cannot
+ * hold it at run time, so lookups skip it). Whether x is defined yet when the
+ * use runs is the evaluator's question: it checks that the slot holds x and
+ * otherwise searches by name, which is then the same search as before. The
+ * REPL's top level is open (later inputs add names), so uses are not bound
+ * past it. */
+
+typedef struct rscope {
+    struct rscope *parent;
+    const char **keys; /* open addressing: name -> slot */
+    int *slots;
+    size_t cap, n;
+    int next;     /* the next slot to give */
+    int open;     /* may hold names this walk does not know */
+    env *fixed;   /* the builtins' scope: slots are its own */
+} rscope;
+
+static int rs_slot(const rscope *s, const char *name)
+{
+    if (s->fixed) {
+        value *v = val_env_lookup(s->fixed, name);
+        return v ? (int)(v - s->fixed->vals) : -1;
+    }
+    if (!s->cap)
+        return -1;
+    for (size_t h = name_hash(name) & (s->cap - 1); s->keys[h]; h = (h + 1) & (s->cap - 1))
+        if (s->keys[h] == name)
+            return s->slots[h];
+    return -1;
+}
+
+static int rs_put(interp *I, rscope *s, const char *name, int slot)
+{
+    if ((s->n + 1) * 2 > s->cap) {
+        size_t cap = s->cap ? s->cap * 2 : 16;
+        const char **nk = mem_calloc(I, cap, sizeof *nk);
+        int *ns = mem_alloc(I, cap * sizeof *ns);
+        if (!nk || !ns) {
+            mem_free(I, nk);
+            mem_free(I, ns);
+            return -1;
+        }
+        for (size_t i = 0; i < s->cap; i++)
+            if (s->keys[i]) {
+                size_t h = name_hash(s->keys[i]) & (cap - 1);
+                while (nk[h])
+                    h = (h + 1) & (cap - 1);
+                nk[h] = s->keys[i];
+                ns[h] = s->slots[i];
+            }
+        mem_free(I, s->keys);
+        mem_free(I, s->slots);
+        s->keys = nk;
+        s->slots = ns;
+        s->cap = cap;
+    }
+    size_t h = name_hash(name) & (s->cap - 1);
+    while (s->keys[h])
+        h = (h + 1) & (s->cap - 1);
+    s->keys[h] = name;
+    s->slots[h] = slot;
+    s->n++;
+    return 0;
+}
+
+/* A definition: a new name takes the next slot; a redefinition keeps its own. */
+static int rs_define(interp *I, rscope *s, const char *name)
+{
+    if (rs_slot(s, name) >= 0)
+        return 0;
+    return rs_put(I, s, name, s->next++);
+}
+
+static void rs_free(interp *I, rscope *s)
+{
+    mem_free(I, s->keys);
+    mem_free(I, s->slots);
+}
+
+static void bind_use(const rscope *s, const char *name, node *n)
+{
+    for (int hops = 0; s; s = s->parent, hops++) {
+        int slot = rs_slot(s, name);
+        if (slot >= 0) {
+            n->slot = slot + 1;
+            n->hops = hops;
+            return;
+        }
+        if (s->open)
+            return;
+    }
+}
+
+static int slots_node(interp *I, rscope *s, node *n);
+static int slots_stmts(interp *I, rscope *s, const node *b);
+
+/* The names a block's statements define, in the order they define them. */
+static int slots_defs(interp *I, rscope *s, const node *b)
+{
+    for (int i = 0; i < b->nkids; i++) {
+        node *st = b->kids[i];
+        switch (st->kind) {
+        case N_LET:
+        case N_PARAM:
+        case N_FNDEF:
+            if (rs_define(I, s, st->str))
+                return -1;
+            st->slot = rs_slot(s, st->str) + 1;
+            break;
+        case N_IMPORT:
+            if (st->names[0]) {
+                if (rs_define(I, s, st->names[0]))
+                    return -1;
+            } else {
+                env *m;
+                /* loaded by the checks above: this finds it in the cache */
+                if (eval_import(I, st, st->str, &m))
+                    return -1;
+                for (size_t k = 0; k < m->n; k++)
+                    if (rs_define(I, s, m->names[k]))
+                        return -1;
+            }
+            break;
+        default:
+            break;
+        }
+    }
+    return 0;
+}
+
+static int slots_block(interp *I, rscope *s, const node *b)
+{
+    return slots_defs(I, s, b) || slots_stmts(I, s, b) ? -1 : 0;
+}
+
+static int slots_stmts(interp *I, rscope *s, const node *b)
+{
+    if (cstack_exhausted())
+        return cstack_error(I, b, "blocks nested too deeply");
+    for (int i = 0; i < b->nkids; i++) {
+        node *st = b->kids[i];
+        switch (st->kind) {
+        case N_LET:
+        case N_PARAM:
+        case N_FNDEF:
+        case N_EXPR:
+            if (slots_node(I, s, st->kids[0]))
+                return -1;
+            break;
+        case N_ASSIGN:
+            bind_use(s, st->str, st);
+            if (slots_node(I, s, st->kids[0]))
+                return -1;
+            break;
+        case N_IMPORT:
+            break;
+        case N_FOR: {
+            if (slots_node(I, s, st->kids[0]))
+                return -1;
+            rscope inner = {.parent = s};
+            int rc = rs_define(I, &inner, st->str);
+            if (rc == 0)
+                rc = st->kids[1]->kind == N_BLOCK ? slots_block(I, &inner, st->kids[1])
+                                                  : slots_node(I, &inner, st->kids[1]);
+            rs_free(I, &inner);
+            if (rc)
+                return -1;
+            break;
+        }
+        default:
+            if (slots_node(I, s, st))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+static int slots_node(interp *I, rscope *s, node *n)
+{
+    if (!n)
+        return 0;
+    if (cstack_exhausted())
+        return cstack_error(I, n, "expression nested too deeply");
+    int rc = 0;
+    switch (n->kind) {
+    case N_NAME:
+        bind_use(s, n->str, n);
+        return 0;
+    case N_LAMBDA: {
+        rscope inner = {.parent = s};
+        for (int i = 0; i < n->nparams && rc == 0; i++)
+            rc = rs_define(I, &inner, n->names[i]);
+        if (rc == 0 && n->body->kind == N_BLOCK)
+            rc = slots_defs(I, &inner, n->body);
+        for (int i = 0; i < n->nparams && rc == 0; i++)
+            rc = slots_node(I, &inner, n->kids[i]);
+        if (rc == 0)
+            rc = n->body->kind == N_BLOCK ? slots_stmts(I, &inner, n->body) : slots_node(I, &inner, n->body);
+        rs_free(I, &inner);
+        return rc;
+    }
+    case N_BLOCK: {
+        rscope inner = {.parent = s};
+        rc = slots_block(I, &inner, n);
+        rs_free(I, &inner);
+        return rc;
+    }
+    case N_COMP: {
+        if (slots_node(I, s, n->kids[1]))
+            return -1;
+        rscope inner = {.parent = s};
+        rc = rs_define(I, &inner, n->str);
+        if (rc == 0)
+            rc = slots_node(I, &inner, n->kids[2]);
+        if (rc == 0)
+            rc = slots_node(I, &inner, n->kids[0]);
+        rs_free(I, &inner);
+        return rc;
+    }
+    default:
+        for (int i = 0; i < n->nkids && rc == 0; i++)
+            rc = slots_node(I, s, n->kids[i]);
+        return rc;
+    }
+}
+
+static int resolve_slots(interp *I, node *prog, env *globals)
+{
+    rscope root = {.fixed = globals->parent};
+    rscope top = {.parent = globals->parent ? &root : NULL, .open = I->is_repl};
+    int rc = 0;
+    /* the names the scope already holds keep their slots */
+    for (size_t i = 0; i < globals->n && rc == 0; i++)
+        rc = rs_define(I, &top, globals->names[i]);
+    if (rc == 0)
+        rc = slots_block(I, &top, prog);
+    rs_free(I, &top);
     return rc;
 }

@@ -12,7 +12,8 @@
 
 #include "state.h"
 
-/* Check a parsed program against the names visible in scope `globals`. */
-int resolve_program(interp *I, const node *prog, env *globals);
+/* Check a parsed program against the names visible in scope `globals`,
+ * then give its names their slots (node.slot, node.hops) for the evaluator. */
+int resolve_program(interp *I, node *prog, env *globals);
 
 #endif

@@ -114,6 +114,8 @@ typedef struct interp {
 
     /* scopes and values */
     heap *heap_all;
+    env *env_pool;       /* freed small scopes kept for reuse (value.c) */
+    int env_pool_n;
     env *globals;
     module *mods;
     int nmods, cap_mods;
@@ -158,7 +160,17 @@ typedef struct interp {
     int nbuiltins, cap_builtins;
     struct contract_cache *contract; /* compiled declarations (contract.c) */
     const struct bcall *bcall;       /* the builtin call running, for positions */
+    struct range_spec *lazy_range;   /* set by `for`: range() describes its items here (eval.c) */
+    const heap *append_target;       /* x = concat(x, …): x's list, which concat may extend (eval.c) */
 } interp;
+
+/* The items start + step * i, i < count, of a range() that a `for` loop or
+ * comprehension walks without building the list. */
+typedef struct range_spec {
+    double start, step;
+    size_t count;
+    int used; /* range() filled it in */
+} range_spec;
 
 /* Allocation: every interpreter allocation goes through mem_alloc /
  * mem_calloc / mem_realloc / mem_free, which are the runtime's allocator

@@ -102,6 +102,14 @@ static void free_storage(interp *I, heap *h)
         break;
     case H_ENV: {
         env *e = (env *)h;
+        if (!e->index && e->cap <= ENV_POOL_CAP && I->env_pool_n < ENV_POOL_MAX) {
+            /* kept for the next call or block: most scopes are small and
+             * short-lived, and a call would otherwise pay three allocations */
+            e->h.next = I->env_pool ? &I->env_pool->h : NULL;
+            I->env_pool = e;
+            I->env_pool_n++;
+            return;
+        }
         mem_free(I, e->names);
         mem_free(I, e->vals);
         mem_free(I, e->index);
@@ -141,22 +149,19 @@ void val_heap_unref(interp *I, heap *h)
     }
 }
 
-void val_ref(value v)
-{
-    if (v.k >= V_STR && v.k != V_BUILTIN)
-        v.u.h->rc++;
-}
-
-void val_unref(interp *I, value v)
-{
-    if (v.k >= V_STR && v.k != V_BUILTIN)
-        val_heap_unref(I, v.u.h);
-}
 
 void val_heap_free_all(interp *I)
 {
     while (I->heap_all)
         heap_destroy(I, I->heap_all);
+    while (I->env_pool) {
+        env *e = I->env_pool;
+        I->env_pool = (env *)e->h.next;
+        mem_free(I, e->names);
+        mem_free(I, e->vals);
+        mem_free(I, e);
+    }
+    I->env_pool_n = 0;
 }
 
 value val_str(interp *I, const char *s, size_t len)
@@ -304,7 +309,21 @@ value val_obj(interp *I, const obj_class *cls, void *payload)
 
 env *val_env_new(interp *I, env *parent)
 {
-    env *e = heap_new(I, sizeof(env), H_ENV);
+    env *e = I->env_pool;
+    if (e) {
+        /* a pooled scope keeps its arrays (capacity e->cap) */
+        I->env_pool = (env *)e->h.next;
+        I->env_pool_n--;
+        e->h.rc = 1;
+        e->h.prev = NULL;
+        e->h.next = I->heap_all;
+        if (I->heap_all)
+            I->heap_all->prev = &e->h;
+        I->heap_all = &e->h;
+        e->n = 0;
+    } else {
+        e = heap_new(I, sizeof(env), H_ENV);
+    }
     if (!e)
         return NULL;
     e->parent = parent;

@@ -86,6 +86,11 @@ struct env {
     size_t index_cap;
 };
 
+/* Freed scopes with at most ENV_POOL_CAP slots are kept (up to ENV_POOL_MAX)
+ * and reused by val_env_new. */
+#define ENV_POOL_CAP 8
+#define ENV_POOL_MAX 256
+
 /* Hash of an interned name (its address). */
 static inline size_t name_hash(const char *name)
 {
@@ -130,9 +135,18 @@ static inline value val_num(double n) { value v; v.k = V_NUM; v.u.n = n; return 
 #define AS_FUNC(v) ((vfunc *)(v).u.h)
 #define AS_OBJ(v) ((vobj *)(v).u.h)
 
-void val_ref(value v);
-void val_unref(struct interp *I, value v);
 void val_heap_unref(struct interp *I, heap *h);
+/* Inline: numbers, booleans and nil (most values in a loop) cost a test. */
+static inline void val_ref(value v)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN)
+        v.u.h->rc++;
+}
+static inline void val_unref(struct interp *I, value v)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN)
+        val_heap_unref(I, v.u.h);
+}
 
 /* Constructors return a new reference, or a nil value with an out-of-memory
  * error raised in I (check I->err.active or use the eval helpers). */
