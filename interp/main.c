@@ -22,6 +22,7 @@
 #include "contract.h"
 #include "cstack.h"
 #include "eval.h"
+#include "fit_cli.h"
 #include "fileio.h"
 #include "par.h"
 #include "parser.h"
@@ -37,6 +38,11 @@ static const char usage_text[] =
     "                                          parse and check without running anything\n"
     "       frac repl                          interactive session (also: `frac` alone)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
+    "       frac fit TARGET.png --maps N|A..B [--seed S] [--iterations K] [--time SECONDS]\n"
+    "                [--foreground auto|dark|light|alpha] [--threshold T] [-o FIT.frac]\n"
+    "                                          fit an IFS to a picture; writes a script\n"
+    "                                          (default fit.frac) that saves fit.png\n"
+    "                                          (docs/fit.md)\n"
     "       frac --version | --help\n"
     "\n"
     "SCRIPT may be - to read the script from standard input. A script may start\n"
@@ -575,7 +581,9 @@ static int frac_main(int argc, char **argv)
     o.args = mem_calloc(I, (size_t)argc, sizeof *o.args);
     o.ov = mem_calloc(I, (size_t)argc, sizeof *o.ov);
     int rc = EX_SOFTWARE;
-    if (o.args && o.ov) {
+    if (o.args && o.ov && argc > 1 && strcmp(argv[1], "fit") == 0) {
+        rc = fit_command(I, argc - 1, argv + 1, &interrupted); /* its own options (interp/bind_fit.c) */
+    } else if (o.args && o.ov) {
         rc = parse_command_line(I, argc, argv, &o);
         if (rc < 0)
             rc = run_frac(I, &o);
