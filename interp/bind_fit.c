@@ -150,7 +150,7 @@ static int b_fit(interp *I, value *a, int n, value *out)
 
 static const bparam p_fit[] = {
     {"target", "image|list", NULL},         {"maps", "int[1,16]|str", "nil"},
-    {"iterations", "int[1,1000000]", "400"}, {"seed", "int>=0", "nil"},
+    {"iterations", "int[1,1000000]", "1000"}, {"seed", "int>=0", "nil"},
     {"time", "num>0", "nil"},               {"start", "ifs", "nil"},
     {"rifs", "bool", "false"},              {"threshold", "num[0,1]", "0.5"},
     {"foreground", "str{auto,dark,light,alpha}", "\"auto\""},
@@ -223,7 +223,7 @@ static size_t write_script(char *buf, size_t cap, const char *target, int w, int
 int fit_command(interp *I, int argc, char **argv, volatile sig_atomic_t *cancel)
 {
     const char *target = NULL, *outp = "fit.frac", *maps = NULL, *fgname = "auto";
-    fit_opts o = {.iterations = 400, .seed = I->seed};
+    fit_opts o = {.iterations = 1000, .seed = I->seed};
     double thresh = 0.5;
     int quiet = 0;
     for (int i = 1; i < argc; i++) {

@@ -439,9 +439,81 @@ static rt_code fitter_init(fitter *F, const fit_mask *t, rt_error *e)
     return RT_OK;
 }
 
-/* ---- one map count ---------------------------------------------------------------------- */
+/* ---- the level schedule ---------------------------------------------------------------- */
+
+static const double share[NLEVELS][NLEVELS] = {
+    {1, 0, 0, 0}, {0.6, 0.4, 0, 0}, {0.45, 0.35, 0.2, 0}, {0.4, 0.3, 0.2, 0.1}};
+
+/* generations of level li (li == nlv: the probability stage) */
+static long level_gens(const fitter *F, int li)
+{
+    long total = F->o->iterations;
+    if (li == F->nlv)
+        return total / 10 > 0 ? total / 10 : 1;
+    return (long)ceil(total * share[F->nlv - 1][li]);
+}
+
+/* levels run from every start: the 32- and 64-cell grids (or only the first when there
+ * are at most two levels) */
+static int coarse_levels(const fitter *F) { return F->nlv >= 3 ? 2 : 1; }
+
+static long gens_per_count(const fitter *F, int starts)
+{
+    long g = 0;
+    for (int li = 0; li <= F->nlv; li++)
+        g += level_gens(F, li) * (li < coarse_levels(F) ? starts : 1);
+    return g;
+}
 
 static int cancelled(const rt_run *run) { return run && run->cancel && *run->cancel; }
+
+/* Levels lo .. hi-1 of the schedule (hi = nlv + 1 includes the probability stage) on x. */
+static rt_code run_levels(fitter *F, double *x, int lo, int hi, int start, const rt_run *run, const rt_run *prun,
+                          progress *pg, double t0, long *gens_done, int *timed_out)
+{
+    int n = F->n, np = n * NPAR + n;
+    F->x = x;
+    for (int li = lo; li < hi && !*timed_out; li++) {
+        int last = li == F->nlv; /* the probability stage, on the finest level */
+        F->li = last ? F->nlv - 1 : li;
+        F->mode = last;
+        long gens = level_gens(F, li);
+        double cur = eval_loss(F, x, n, &F->lv[F->li], &F->sc[0]);
+        if (li > 0 && !last)
+            F->sigma = fmax(0.02, F->sigma * 0.6);
+        for (long g = 0; g < gens; g++) {
+            F->gen = g;
+            F->stream = 0x657300 + (uint64_t)li + 16 * (uint64_t)start;
+            rt_code c = par_for(prun, NULL, FIT_LAMBDA, offspring, F);
+            if (c)
+                return c;
+            int best = 0;
+            for (int k = 1; k < FIT_LAMBDA; k++)
+                if (F->loss[k] < F->loss[best])
+                    best = k;
+            if (F->loss[best] <= cur) {
+                int improved = F->loss[best] < cur;
+                cur = F->loss[best];
+                memcpy(x, F->cand[best], sizeof(double) * (size_t)np);
+                if (improved)
+                    F->sigma = fmin(0.5, F->sigma * 1.2);
+            } else {
+                F->sigma = fmax(0.003, F->sigma * 0.97);
+            }
+            (*gens_done)++;
+            progress_step(pg, 1);
+            if (cancelled(run))
+                return RT_ECANCEL;
+            if (F->o->time_s > 0 && now_s() - t0 > F->o->time_s) {
+                *timed_out = 1;
+                break;
+            }
+        }
+    }
+    return RT_OK;
+}
+
+/* ---- one map count ---------------------------------------------------------------------- */
 
 static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, double t0, double *x, double *loss,
                          long *gens_done, int *timed_out)
@@ -484,50 +556,38 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
     }
     rt_run prun = run ? *run : (rt_run){.threads = 1};
     prun.progress = 0; /* the fit draws its own bar */
-    static const double share[NLEVELS][NLEVELS] = {
-        {1, 0, 0, 0}, {0.6, 0.4, 0, 0}, {0.45, 0.35, 0.2, 0}, {0.4, 0.3, 0.2, 0.1}};
-    long total = o->iterations, pgens = total / 10 > 0 ? total / 10 : 1;
-    int np = n * NPAR + n;
     F->n = n;
-    F->x = x;
-    F->sigma = 0.15;
-    double cur = 0;
-    for (int li = 0; li <= F->nlv && !*timed_out; li++) {
-        int last = li == F->nlv; /* the probability stage, on the finest level */
-        F->li = last ? F->nlv - 1 : li;
-        F->mode = last;
-        long gens = last ? pgens : (long)ceil(total * share[F->nlv - 1][li]);
-        cur = eval_loss(F, x, n, &F->lv[F->li], &F->sc[0]);
-        if (li > 0 && !last)
-            F->sigma = fmax(0.02, F->sigma * 0.6);
-        for (long g = 0; g < gens; g++) {
-            F->gen = g;
-            F->stream = 0x657300 + (uint64_t)li;
-            rt_code c = par_for(&prun, NULL, FIT_LAMBDA, offspring, F);
-            if (c)
-                return c;
-            int best = 0;
-            for (int k = 1; k < FIT_LAMBDA; k++)
-                if (F->loss[k] < F->loss[best])
-                    best = k;
-            if (F->loss[best] <= cur) {
-                int improved = F->loss[best] < cur;
-                cur = F->loss[best];
-                memcpy(x, F->cand[best], sizeof(double) * (size_t)np);
-                if (improved)
-                    F->sigma = fmin(0.5, F->sigma * 1.2);
-            } else {
-                F->sigma = fmax(0.003, F->sigma * 0.97);
-            }
-            (*gens_done)++;
-            progress_step(pg, 1);
-            if (cancelled(run))
-                return RT_ECANCEL;
-            if (o->time_s > 0 && now_s() - t0 > o->time_s) {
-                *timed_out = 1;
-                break;
-            }
+    /* the coarse levels from FIT_STARTS starts (the collage and perturbed copies of it); the
+     * best on the last coarse level goes on to the fine levels */
+    int hi = coarse_levels(F), starts = o->start ? 1 : FIT_STARTS, np = n * NPAR + n;
+    double bestx[FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS], best = HUGE_VAL, bsigma = 0.15;
+    for (int st = 0; st < starts && !*timed_out; st++) {
+        double xs[FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS];
+        memcpy(xs, x, sizeof(double) * (size_t)np);
+        if (st > 0) {
+            rng r;
+            rng_init(&r, o->seed, rng_hash3(0x7374617274ull, (uint64_t)st, (uint64_t)n, 0));
+            for (int m = 0; m < n; m++)
+                for (int i = 0; i < NPAR; i++)
+                    xs[m * NPAR + i] += 0.1 * step_scale[i] * rng_normal(&r);
         }
+        F->sigma = 0.15;
+        rt_code c = run_levels(F, xs, 0, hi, st, run, &prun, pg, t0, gens_done, timed_out);
+        if (c)
+            return c;
+        double l = eval_loss(F, xs, n, &F->lv[hi - 1], &F->sc[0]);
+        if (l < best) {
+            best = l;
+            bsigma = F->sigma;
+            memcpy(bestx, xs, sizeof(double) * (size_t)np);
+        }
+    }
+    memcpy(x, bestx, sizeof(double) * (size_t)np);
+    F->sigma = bsigma;
+    if (!*timed_out) {
+        rt_code c = run_levels(F, x, hi, F->nlv + 1, 0, run, &prun, pg, t0, gens_done, timed_out);
+        if (c)
+            return c;
     }
     *loss = eval_loss(F, x, n, &F->lv[F->nlv - 1], &F->sc[0]);
     return RT_OK;
@@ -557,7 +617,7 @@ rt_code fit_run(const fit_mask *t, const fit_opts *o, const rt_run *run, fit_res
     F->o = o;
     rt_code c = fitter_init(F, t, e);
     progress pg;
-    long per = o->iterations + (o->iterations / 10 > 0 ? o->iterations / 10 : 1);
+    long per = c ? 0 : gens_per_count(F, o->start ? 1 : FIT_STARTS);
     progress_begin(&pg, "fit", (size_t)per * (size_t)(o->nmax - o->nmin + 1), run ? run->progress : 0);
     double t0 = now_s(), best = HUGE_VAL;
     int timed_out = 0;

@@ -53,6 +53,13 @@
  *     the step size grows by 1.2 on success and shrinks by 0.97 otherwise.
  *     The generations are split among the levels 40/30/20/10 % (coarse to
  *     fine); the step size restarts at each level at 0.6 of the last one.
+ *     Multi-start: the coarse levels (the 32- and 64-cell grids when there
+ *     are three or more levels, else the first) are run FIT_STARTS = 4 times,
+ *     from the collage and from three copies of it with every parameter
+ *     moved by a Gaussian step (0.1 of the step scales); the start with the
+ *     smallest loss on the last coarse level goes on to the finer levels.
+ *     (Without this, a fit often settles on a covering by misplaced copies.)
+ *     With `start`, one start only.
  *  4. Probabilities: on the finest level, a few generations perturb the
  *     log-weights only (the support of the attractor does not depend on
  *     them, but with a finite number of points, coverage does).
@@ -81,6 +88,7 @@
 #define FIT_MAX_MAPS 16
 #define FIT_PENALTY 0.5
 #define FIT_LAMBDA 4
+#define FIT_STARTS 4
 
 typedef struct fit_mask {
     int w, h;                /* >= 2 each */

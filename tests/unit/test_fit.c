@@ -115,7 +115,7 @@ static void test_deterministic(void)
           "threads change the fit");
     /* a range returns one of its counts and runs every count */
     CHECK(a.n >= 2 && a.n <= 3, "n %d", a.n);
-    CHECK(a.generations == 2 * (30 + 3), "generations %ld", a.generations);
+    CHECK(a.generations == 2 * (4 * 30 + 3), "generations %ld", a.generations);
 }
 
 static void test_svd(void)
