@@ -92,8 +92,7 @@ static int b_fit(interp *I, value *a, int n, value *out)
         return err_arg(I, A_MAPS, ERR_VALUE, "fit: maps must be a count from 1 to %d or a range \"A..B\" (like \"2..6\"), got \"%s\"",
                        FIT_MAX_MAPS, AS_STR(a[A_MAPS])->s);
     }
-    if (val_truthy(a[A_RIFS]))
-        return err_arg(I, A_RIFS, ERR_VALUE, "fit: rifs: true is not supported yet (fit fits an IFS; see docs/fit.md)");
+    o.rifs = val_truthy(a[A_RIFS]);
     if (lang_arg_seed(I, a[A_SEED], &o.seed, "fit"))
         return -1;
     if (a[A_TIME].k == V_NUM)
@@ -137,6 +136,18 @@ static int b_fit(interp *I, value *a, int n, value *out)
     mem_free(I, m);
     if (c)
         return lang_rt_error(I, c, &e, "fit");
+    if (r.rifs) {
+        lang_rifs *lr = mem_calloc(I, 1, sizeof *lr);
+        if (!lr)
+            return -1;
+        c = rifs_build(&lr->r, r.maps, r.n, 1, r.P, RIFS_NORMALISE, &e);
+        if (c) {
+            mem_free(I, lr);
+            return lang_rt_error(I, c, &e, "fit");
+        }
+        *out = val_obj(I, &lang_rifs_class, lr);
+        return out->k == V_NIL ? -1 : 0;
+    }
     lang_ifs *li = mem_calloc(I, 1, sizeof *li);
     if (!li)
         return -1;
@@ -161,7 +172,8 @@ static const builtin fit_builtins[] = {
             "or a table of 0/1 rows. Coordinates: the target's pixels normalised to [0, 1]², y up; draw it "
             "with chaos(f, size: [w, h], window: [0, 1, 0, 1]). maps: a count or a range \"2..6\" (a "
             "penalty per map picks the count); iterations: generations of the optimiser (deterministic); "
-            "time: a budget in seconds (not deterministic); start: an IFS to refine. See docs/fit.md."),
+            "time: a budget in seconds (not deterministic); start: an IFS to refine; rifs: true fits a "
+            "Recurrent IFS (which transitions are forbidden) and returns a rifs. See docs/fit.md."),
 };
 
 int bind_fit_init(interp *I) { return BUILTIN_REGISTER(I, fit_builtins); }

@@ -16,6 +16,8 @@
 #define NLEVELS 4
 #define BURN 20
 #define PI 3.14159265358979323846
+/* parameters: n maps × NPAR, n log-weights, and for a RIFS n×n transition flags (1 allowed, 0 forbidden) */
+#define XLEN (FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS + FIT_MAX_MAPS * FIT_MAX_MAPS)
 
 typedef struct level {
     int gw, gh, nt;
@@ -35,7 +37,7 @@ typedef struct fitter {
     level lv[NLEVELS];
     int nlv;
     scratch sc[FIT_LAMBDA];
-    double cand[FIT_LAMBDA][FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS];
+    double cand[FIT_LAMBDA][XLEN];
     double loss[FIT_LAMBDA];
     /* the generation being evaluated */
     const double *x;   /* current parameters (n*NPAR) then log-weights (n) */
@@ -145,24 +147,69 @@ void fit_svd2(const double m[2][2], double *theta, double *s1, double *s2, doubl
     *phi = (a2 - a1) / 2;
 }
 
+static int nparams(const fitter *F, int n) { return n * NPAR + n + (F->o->rifs ? n * n : 0); }
+
+/* The transition graph i -> j (allowed[i*n + j] != 0) is strongly connected: every map
+ * reaches map 1 and map 1 reaches every map. */
+static int irreducible(const double *allowed, int n)
+{
+    for (int dir = 0; dir < 2; dir++) {
+        int seen[FIT_MAX_MAPS] = {1}, stack[FIT_MAX_MAPS], top = 0, count = 1;
+        stack[top++] = 0;
+        while (top) {
+            int i = stack[--top];
+            for (int j = 0; j < n; j++)
+                if (!seen[j] && allowed[dir ? j * n + i : i * n + j]) {
+                    seen[j] = 1;
+                    count++;
+                    stack[top++] = j;
+                }
+        }
+        if (count < n)
+            return 0;
+    }
+    return 1;
+}
+
+/* Row-stochastic transition matrix: P_ij ∝ allowed_ij · p_j (an IFS: every row is p). */
+static void transitions(const fitter *F, const double *x, int n, const double *p, double *P)
+{
+    const double *al = x + n * NPAR + n;
+    for (int i = 0; i < n; i++) {
+        double sum = 0;
+        for (int j = 0; j < n; j++)
+            sum += P[i * n + j] = F->o->rifs ? p[j] * (al[i * n + j] != 0) : p[j];
+        for (int j = 0; j < n; j++)
+            P[i * n + j] = sum > 0 ? P[i * n + j] / sum : 0;
+    }
+}
+
 /* ---- the loss ---------------------------------------------------------------------------- */
 
 static double eval_loss(const fitter *F, const double *x, int n, const level *L, scratch *s)
 {
     double ma[FIT_MAX_MAPS], mb[FIT_MAX_MAPS], mc[FIT_MAX_MAPS], md[FIT_MAX_MAPS], me[FIT_MAX_MAPS],
         mf[FIT_MAX_MAPS], p[FIT_MAX_MAPS];
-    uint64_t cum[FIT_MAX_MAPS];
+    uint64_t cum[FIT_MAX_MAPS][FIT_MAX_MAPS];
+    double P[FIT_MAX_MAPS * FIT_MAX_MAPS];
     weights(x, n, p);
-    double acc = 0;
+    transitions(F, x, n, p, P);
     for (int i = 0; i < n; i++) {
         affine a;
         to_affine(x + i * NPAR, &a);
         ma[i] = a.m[0][0], mb[i] = a.m[0][1], mc[i] = a.m[1][0], md[i] = a.m[1][1];
         me[i] = a.t[0], mf[i] = a.t[1];
-        acc += p[i];
-        cum[i] = (uint64_t)(acc * 4294967296.0);
+        double acc = 0;
+        int lastj = 0;
+        for (int j = 0; j < n; j++) {
+            acc += P[i * n + j];
+            cum[i][j] = (uint64_t)(acc * 4294967296.0);
+            if (P[i * n + j] > 0)
+                lastj = j;
+        }
+        for (int j = lastj; j < n; j++) /* the last allowed map takes the rounding */
+            cum[i][j] = UINT64_MAX;
     }
-    cum[n - 1] = UINT64_MAX;
     /* start at the fixed point of map 1: (I - A) z = t */
     double det = (1 - ma[0]) * (1 - md[0]) - mb[0] * mc[0];
     double zx = ((1 - md[0]) * me[0] + mb[0] * mf[0]) / det;
@@ -173,11 +220,13 @@ static double eval_loss(const fitter *F, const double *x, int n, const level *L,
     rng r;
     rng_init(&r, F->o->seed, 0x6669740000000000ull + (uint64_t)(L - F->lv));
     uint32_t out = 0, total = L->points;
+    int state = 0; /* the last map applied (a RIFS chooses the next by its row) */
     for (uint32_t i = 0; i < total + BURN; i++) {
         uint64_t r32 = rng_next(&r) >> 32;
         int k = 0;
-        while (r32 >= cum[k])
+        while (r32 >= cum[state][k])
             k++;
+        state = k;
         double nx = ma[k] * zx + mb[k] * zy + me[k];
         double ny = mc[k] * zx + md[k] * zy + mf[k];
         zx = nx;
@@ -323,7 +372,7 @@ static void offspring(void *ctx, size_t k, int worker)
 {
     (void)worker;
     fitter *F = ctx;
-    int n = F->n, np = n * NPAR + n;
+    int n = F->n, np = nparams(F, n);
     double *c = F->cand[k];
     memcpy(c, F->x, sizeof(double) * (size_t)np);
     rng r;
@@ -331,6 +380,14 @@ static void offspring(void *ctx, size_t k, int worker)
     if (F->mode == 1) {
         int j = (int)(rng_uniform(&r) * n);
         c[n * NPAR + j] += 0.5 * rng_normal(&r);
+    } else if (F->o->rifs && rng_uniform(&r) < 0.2) { /* forbid or allow one transition */
+        int t = (int)(rng_uniform(&r) * n * n);
+        double *al = c + n * NPAR + n;
+        al[t] = al[t] != 0 ? 0 : 1;
+        if (!irreducible(al, n)) {
+            F->loss[k] = HUGE_VAL;
+            return;
+        }
     } else {
         double u = rng_uniform(&r);
         int j = (int)(rng_uniform(&r) * n);
@@ -471,7 +528,7 @@ static int cancelled(const rt_run *run) { return run && run->cancel && *run->can
 static rt_code run_levels(fitter *F, double *x, int lo, int hi, int start, const rt_run *run, const rt_run *prun,
                           progress *pg, double t0, long *gens_done, int *timed_out)
 {
-    int n = F->n, np = n * NPAR + n;
+    int n = F->n, np = nparams(F, n);
     F->x = x;
     for (int li = lo; li < hi && !*timed_out; li++) {
         int last = li == F->nlv; /* the probability stage, on the finest level */
@@ -554,15 +611,17 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
         rt_free(covered);
         rt_free(stamp);
     }
+    for (int i = 0; i < n * n; i++) /* a RIFS starts as the IFS: every transition allowed */
+        x[n * NPAR + n + i] = 1;
     rt_run prun = run ? *run : (rt_run){.threads = 1};
     prun.progress = 0; /* the fit draws its own bar */
     F->n = n;
     /* the coarse levels from FIT_STARTS starts (the collage and perturbed copies of it); the
      * best on the last coarse level goes on to the fine levels */
-    int hi = coarse_levels(F), starts = o->start ? 1 : FIT_STARTS, np = n * NPAR + n;
-    double bestx[FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS], best = HUGE_VAL, bsigma = 0.15;
+    int hi = coarse_levels(F), starts = o->start ? 1 : FIT_STARTS, np = nparams(F, n);
+    double bestx[XLEN], best = HUGE_VAL, bsigma = 0.15;
     for (int st = 0; st < starts && !*timed_out; st++) {
-        double xs[FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS];
+        double xs[XLEN];
         memcpy(xs, x, sizeof(double) * (size_t)np);
         if (st > 0) {
             rng r;
@@ -624,7 +683,7 @@ rt_code fit_run(const fit_mask *t, const fit_opts *o, const rt_run *run, fit_res
     const level *fine = &F->lv[F->nlv - 1];
     double to256 = 256.0 / (fine->gw > fine->gh ? fine->gw : fine->gh);
     for (int n = o->nmin; !c && n <= o->nmax && !timed_out; n++) {
-        double x[FIT_MAX_MAPS * NPAR + FIT_MAX_MAPS], loss;
+        double x[XLEN], loss;
         c = fit_count(F, n, run, &pg, t0, x, &loss, &r->generations, &timed_out);
         if (c == RT_ENOMEM)
             rt_fail(e, c, "out of memory");
@@ -643,6 +702,8 @@ rt_code fit_run(const fit_mask *t, const fit_opts *o, const rt_run *run, fit_res
             for (int i = 0; i < n; i++)
                 to_affine(x + i * NPAR, &r->maps[i]);
             weights(x, n, r->p);
+            r->rifs = o->rifs;
+            transitions(F, x, n, r->p, r->P);
         }
     }
     progress_end(&pg);

@@ -71,6 +71,13 @@
  * generation: the result then depends on the machine's speed; only an
  * iteration budget is deterministic.
  *
+ * Recurrent IFS (opts.rifs). The parameters also hold an n×n pattern of
+ * allowed transitions, all allowed at first; P_ij ∝ allowed_ij · p_j. A
+ * fifth of the shape offspring flip one entry instead of moving a map; an
+ * offspring whose pattern is not irreducible (seed 001 §2, condition (ii))
+ * is rejected without being drawn. The chaos game of a RIFS picks the next
+ * map from the row of the last one.
+ *
  * Map counts: opts.nmin..opts.nmax (one number when equal). For a range,
  * every count is fitted with the full budget and the one with the smallest
  *     loss_256 + FIT_PENALTY · N
@@ -102,12 +109,15 @@ typedef struct fit_opts {
     double time_s;           /* > 0: stop after this many seconds (not deterministic) */
     const affine *start;     /* optional: nstart maps (frame coordinates) to refine */
     int nstart;
+    int rifs;                /* fit a Recurrent IFS: the maps and which transitions are forbidden */
 } fit_opts;
 
 typedef struct fit_result {
     int n;
     affine maps[FIT_MAX_MAPS];  /* 2-D, frame coordinates */
     double p[FIT_MAX_MAPS];     /* sum 1 */
+    int rifs;                   /* opts.rifs: P holds the fitted transition matrix */
+    double P[FIT_MAX_MAPS * FIT_MAX_MAPS]; /* n×n row-major, rows sum 1 (an IFS: every row is p) */
     double loss;                /* final loss on the finest level (cells) */
     double loss256;             /* the same, rescaled to a 256-cell grid */
     long generations;           /* generations run (all map counts) */

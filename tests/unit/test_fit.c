@@ -118,6 +118,40 @@ static void test_deterministic(void)
     CHECK(a.generations == 2 * (4 * 30 + 3), "generations %ld", a.generations);
 }
 
+static void test_rifs(void)
+{
+    /* rifs: rows of P sum to 1; the zero pattern keeps the chain irreducible (checked here
+     * by a reachability closure, Floyd–Warshall style) */
+    unsigned char T[32 * 32];
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++)
+            T[y * 32 + x] = (x < 16) != (y < 16);
+    fit_opts o = {.nmin = 4, .nmax = 4, .iterations = 40, .seed = 9, .rifs = 1};
+    fit_result r;
+    rt_error e;
+    CHECK(fit_run(&(fit_mask){32, 32, T}, &o, NULL, &r, &e) == RT_OK, "%s", e.msg);
+    CHECK(r.rifs == 1 && r.n == 4, "rifs %d n %d", r.rifs, r.n);
+    int reach[4][4];
+    for (int i = 0; i < 4; i++) {
+        double sum = 0;
+        for (int j = 0; j < 4; j++) {
+            sum += r.P[i * 4 + j];
+            CHECK(r.P[i * 4 + j] >= 0, "P %d %d", i, j);
+            reach[i][j] = r.P[i * 4 + j] > 0;
+        }
+        CHECK_NEAR(sum, 1, 1e-12, "row sum");
+    }
+    for (int k = 0; k < 4; k++)
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++)
+                reach[i][j] |= reach[i][k] && reach[k][j];
+    int all = 1;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            all &= reach[i][j];
+    CHECK(all, "the fitted chain is not irreducible");
+}
+
 static void test_svd(void)
 {
     double m[2][2] = {{0.2, -0.26}, {0.23, 0.22}}, th, s1, s2, ph;
@@ -160,6 +194,7 @@ int main(void)
     test_svd();
     test_errors();
     test_deterministic();
+    test_rifs();
     test_recover();
     return check_done("test_fit");
 }
