@@ -2,7 +2,7 @@
  * here by an independent plain C chaos loop (its own generator, its own
  * window), not by frac's chaos game.
  *
- *   build/bench/fit_bench [SIZE [ITERATIONS [NAME]]]     (default 128 600, all)
+ *   build/bench/fit_bench [SIZE [ITERATIONS [NAME [SEED]]]]     (default 128 600, all, 1)
  *
  * For each target: draw it at SIZE×SIZE, fit it with its reference number of
  * maps, render the fit with the same plain loop in the target's frame, and
@@ -201,7 +201,8 @@ int main(int argc, char **argv)
 {
     int s = argc > 1 ? atoi(argv[1]) : 128;
     long iters = argc > 2 ? atol(argv[2]) : 600;
-    const char *only = argc > 3 ? argv[3] : NULL;
+    const char *only = argc > 3 && strcmp(argv[3], "all") != 0 ? argv[3] : NULL;
+    uint64_t seed = argc > 4 ? (uint64_t)atoll(argv[4]) : 1;
     unsigned char *T = malloc((size_t)s * s), *A = malloc((size_t)s * s);
     unsigned char T32[32 * 32], A32[32 * 32];
     printf("| target | maps | overlap (1 px) | Hausdorff (px) | CPU s | Tu et al. MSE 32² |\n|---|---|---|---|---|---|\n");
@@ -210,7 +211,7 @@ int main(int argc, char **argv)
         if (only && strcmp(only, t->name) != 0)
             continue;
         draw_target(t, s, T);
-        fit_opts o = {.nmin = t->fit_maps, .nmax = t->fit_maps, .iterations = iters, .seed = 1};
+        fit_opts o = {.nmin = t->fit_maps, .nmax = t->fit_maps, .iterations = iters, .seed = seed};
         rt_run run = {.threads = 1};
         fit_result r;
         rt_error e;
