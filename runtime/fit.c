@@ -264,12 +264,58 @@ static double eval_loss(const fitter *F, const double *x, int n, const level *L,
 
 /* ---- collage initialisation -------------------------------------------------------------- */
 
-static void collage_init(fitter *F, int n, double *x, unsigned char *covered, uint32_t *stamp)
+/* the level the collage is searched on: the 64-cell grid (holes of a fractal show there;
+ * at 32 cells they are mostly filled in) */
+static int collage_level(const fitter *F) { return F->nlv >= 2 ? 1 : 0; }
+
+/* Target cells newly covered by the image w(T) minus the distance-transform sum of the
+ * image points outside T (times |s1 s2|, the image's area per mapped cell). */
+static double collage_score(const level *L, const double *q, const unsigned char *covered, uint32_t *stamp,
+                            uint32_t *gen, int every)
 {
-    const level *L = &F->lv[0];
     int gw = L->gw, gh = L->gh;
     size_t cells = (size_t)gw * gh;
     double g = gw > gh ? gw : gh;
+    affine a;
+    to_affine(q, &a);
+    (*gen)++;
+    double gain = 0, pen = 0;
+    int seen = 0;
+    for (size_t c = 0; c < cells; c++) {
+        if (!L->T[c] || seen++ % every)
+            continue;
+        double ux = ((double)(c % gw) + 0.5) / gw, uy = 1 - ((double)(c / gw) + 0.5) / gh;
+        double vx = a.m[0][0] * ux + a.m[0][1] * uy + a.t[0];
+        double vy = a.m[1][0] * ux + a.m[1][1] * uy + a.t[1];
+        if (!(vx >= 0 && vx < 1 && vy > 0 && vy <= 1)) {
+            pen += 0.25 * g;
+            continue;
+        }
+        int ix = (int)(vx * gw), iy = (int)((1 - vy) * gh);
+        if (ix >= gw)
+            ix = gw - 1;
+        if (iy >= gh)
+            iy = gh - 1;
+        size_t k = (size_t)iy * gw + ix;
+        if (L->T[k]) {
+            if (!covered[k] && stamp[k] != *gen) {
+                stamp[k] = *gen;
+                gain++;
+            }
+        } else {
+            pen += L->dT[k];
+        }
+    }
+    return gain - pen * fabs(SMAX * tanh(q[2]) * SMAX * tanh(q[3]));
+}
+
+/* variant 0: on collage_level, positions on a grid over the bounding box, each winner
+ * polished; variant 1: on the coarsest level, positions on up to 64 target cells */
+static void collage_init(fitter *F, int n, double *x, unsigned char *covered, uint32_t *stamp, int variant)
+{
+    const level *L = &F->lv[variant ? 0 : collage_level(F)];
+    int gw = L->gw, gh = L->gh;
+    size_t cells = (size_t)gw * gh;
     /* moments */
     double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
     for (int cy = 0; cy < gh; cy++)
@@ -282,19 +328,30 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
     double vxx = sxx / L->nt - mx * mx, vyy = syy / L->nt - my * my, vxy = sxy / L->nt - mx * my;
     double alpha = 0.5 * atan2(2 * vxy, vxx - vyy);
     F->cx = mx, F->cy = my;
-    /* target cells as points; candidate positions: a regular subsample of them */
-    int nt = L->nt, stride = (nt + 63) / 64, npos = 0;
-    double px[64], py[64];
-    int t = 0;
+    /* candidate positions: a 12×12 grid over the target's bounding box (the image of the
+     * centroid often lies in a hole of the target, so not only target cells) */
+    double x0 = 1, x1 = 0, y0 = 1, y1 = 0;
     for (size_t c = 0; c < cells; c++)
         if (L->T[c]) {
-            if (t % stride == 0 && npos < 64) {
-                px[npos] = ((double)(c % gw) + 0.5) / gw;
-                py[npos] = 1 - ((double)(c / gw) + 0.5) / gh;
-                npos++;
-            }
-            t++;
+            double ux = ((double)(c % gw) + 0.5) / gw, uy = 1 - ((double)(c / gw) + 0.5) / gh;
+            x0 = fmin(x0, ux), x1 = fmax(x1, ux), y0 = fmin(y0, uy), y1 = fmax(y1, uy);
         }
+    int npos = 0;
+    double px[144], py[144];
+    for (int j = 0; j < 12 && !variant; j++)
+        for (int i = 0; i < 12; i++) {
+            px[npos] = x0 + (x1 - x0) * (i + 0.5) / 12;
+            py[npos++] = y0 + (y1 - y0) * (j + 0.5) / 12;
+        }
+    if (variant) {
+        int stride = (L->nt + 63) / 64, t = 0;
+        for (size_t c = 0; c < cells; c++)
+            if (L->T[c] && t++ % stride == 0 && npos < 64) {
+                px[npos] = ((double)(c % gw) + 0.5) / gw;
+                py[npos++] = 1 - ((double)(c / gw) + 0.5) / gh;
+            }
+    }
+    int every = variant ? 1 : (L->nt + 599) / 600; /* the search scores at most ~600 target cells */
     static const double sc[8][2] = {{0.5, 0.5},  {0.35, 0.35}, {0.65, 0.65}, {0.8, 0.8},
                                     {0.25, 0.25}, {0.6, 0.3},  {0.3, 0.6},   {0.5, 0.15}};
     memset(covered, 0, cells);
@@ -302,49 +359,53 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
     memset(stamp, 0, cells * sizeof *stamp);
     for (int m = 0; m < n; m++) {
         double best = -HUGE_VAL, bq[NPAR] = {0};
-        for (int bi = 0; bi < 12; bi++)
-            for (int refl = 0; refl < 2; refl++)
-                for (int si = 0; si < 8; si++)
-                    for (int pi = 0; pi < npos; pi++) {
-                        double q[NPAR] = {bi * PI / 6 + alpha, -alpha, atanh(sc[si][0] / SMAX),
-                                          (refl ? -1 : 1) * atanh(sc[si][1] / SMAX), 0, 0};
-                        affine a;
-                        to_affine(q, &a);
-                        q[4] = px[pi] - (a.m[0][0] * mx + a.m[0][1] * my);
-                        q[5] = py[pi] - (a.m[1][0] * mx + a.m[1][1] * my);
-                        gen++;
-                        double gain = 0, pen = 0;
-                        for (size_t c = 0; c < cells; c++) {
-                            if (!L->T[c])
-                                continue;
-                            double ux = ((double)(c % gw) + 0.5) / gw, uy = 1 - ((double)(c / gw) + 0.5) / gh;
-                            double vx = a.m[0][0] * ux + a.m[0][1] * uy + q[4];
-                            double vy = a.m[1][0] * ux + a.m[1][1] * uy + q[5];
-                            if (!(vx >= 0 && vx < 1 && vy > 0 && vy <= 1)) {
-                                pen += 0.25 * g;
-                                continue;
-                            }
-                            int ix = (int)(vx * gw), iy = (int)((1 - vy) * gh);
-                            if (ix >= gw)
-                                ix = gw - 1;
-                            if (iy >= gh)
-                                iy = gh - 1;
-                            size_t k = (size_t)iy * gw + ix;
-                            if (L->T[k]) {
-                                if (!covered[k] && stamp[k] != gen) {
-                                    stamp[k] = gen;
-                                    gain++;
-                                }
-                            } else {
-                                pen += L->dT[k];
+        /* frames: the principal axes, and the picture's axes (the principal axis of a
+         * shape with isotropic moments, like an equilateral triangle, is noise) */
+        for (int ai = 0; ai < 2; ai++)
+            for (int bi = 0; bi < 12; bi++)
+                for (int refl = 0; refl < 2; refl++)
+                    for (int si = 0; si < 8; si++)
+                        for (int pi = 0; pi < npos; pi++) {
+                            double al = ai ? 0 : alpha;
+                            double q[NPAR] = {bi * PI / 6 + al, -al, atanh(sc[si][0] / SMAX),
+                                              (refl ? -1 : 1) * atanh(sc[si][1] / SMAX), 0, 0};
+                            affine a;
+                            to_affine(q, &a);
+                            q[4] = px[pi] - (a.m[0][0] * mx + a.m[0][1] * my);
+                            q[5] = py[pi] - (a.m[1][0] * mx + a.m[1][1] * my);
+                            double score = collage_score(L, q, covered, stamp, &gen, every);
+                            if (score > best) {
+                                best = score;
+                                memcpy(bq, q, sizeof bq);
                             }
                         }
-                        double score = gain - pen * sc[si][0] * sc[si][1];
-                        if (score > best) {
-                            best = score;
-                            memcpy(bq, q, sizeof bq);
+        best = collage_score(L, bq, covered, stamp, &gen, 1);
+        /* local polish of the winner: shifts of up to 2 cells, scale ±10 %, rotation ±5° */
+        for (int round = 0; round < (variant ? 0 : 2); round++) {
+            double base[NPAR];
+            memcpy(base, bq, sizeof base);
+            for (int dy = -2; dy <= 2; dy++)
+                for (int dx = -2; dx <= 2; dx++)
+                    for (int ds = -1; ds <= 1; ds++)
+                        for (int dr = -1; dr <= 1; dr++) {
+                            double q[NPAR];
+                            memcpy(q, base, sizeof q);
+                            double f = 1 + 0.1 * ds;
+                            for (int i = 2; i < 4; i++) {
+                                double sv = SMAX * tanh(q[i]) * f;
+                                sv = sv > 0.97 ? 0.97 : sv < -0.97 ? -0.97 : sv;
+                                q[i] = atanh(sv / SMAX);
+                            }
+                            q[0] += dr * PI / 36;
+                            q[4] += (double)dx / gw;
+                            q[5] += (double)dy / gh;
+                            double score = collage_score(L, q, covered, stamp, &gen, 1);
+                            if (score > best) {
+                                best = score;
+                                memcpy(bq, q, sizeof bq);
+                            }
                         }
-                    }
+        }
         memcpy(x + m * NPAR, bq, sizeof bq);
         affine a;
         to_affine(bq, &a);
@@ -576,6 +637,7 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
                          long *gens_done, int *timed_out)
 {
     const fit_opts *o = F->o;
+    double x2[XLEN]; /* the second collage variant (starts 1 and 3) */
     size_t cells0 = (size_t)F->lv[0].gw * F->lv[0].gh;
     if (o->start) {
         for (int i = 0; i < n; i++) {
@@ -600,19 +662,24 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
             }
         F->cx = sx / L->nt, F->cy = sy / L->nt;
     } else {
-        unsigned char *covered = rt_malloc(cells0);
-        uint32_t *stamp = rt_mallocn(cells0, sizeof *stamp);
+        const level *CLv = &F->lv[collage_level(F)];
+        size_t ccells = (size_t)CLv->gw * CLv->gh;
+        unsigned char *covered = rt_malloc(ccells);
+        uint32_t *stamp = rt_mallocn(ccells, sizeof *stamp);
         if (!covered || !stamp) {
             rt_free(covered);
             rt_free(stamp);
             return RT_ENOMEM;
         }
-        collage_init(F, n, x, covered, stamp);
+        collage_init(F, n, x2, covered, stamp, 1);
+        collage_init(F, n, x, covered, stamp, 0);
         rt_free(covered);
         rt_free(stamp);
     }
+    if (o->start)
+        memcpy(x2, x, sizeof x2);
     for (int i = 0; i < n * n; i++) /* a RIFS starts as the IFS: every transition allowed */
-        x[n * NPAR + n + i] = 1;
+        x[n * NPAR + n + i] = x2[n * NPAR + n + i] = 1;
     rt_run prun = run ? *run : (rt_run){.threads = 1};
     prun.progress = 0; /* the fit draws its own bar */
     F->n = n;
@@ -622,8 +689,8 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
     double bestx[XLEN], best = HUGE_VAL, bsigma = 0.15;
     for (int st = 0; st < starts && !*timed_out; st++) {
         double xs[XLEN];
-        memcpy(xs, x, sizeof(double) * (size_t)np);
-        if (st > 0) {
+        memcpy(xs, st % 2 ? x2 : x, sizeof(double) * (size_t)np);
+        if (st > 1) {
             rng r;
             rng_init(&r, o->seed, rng_hash3(0x7374617274ull, (uint64_t)st, (uint64_t)n, 0));
             for (int m = 0; m < n; m++)

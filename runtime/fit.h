@@ -23,17 +23,23 @@
  *     has the target's Euclidean distance transform D_T (Felzenszwalb and
  *     Huttenlocher 2012, the 1-D lower envelope of parabolas, per axis).
  *  2. Collage initialisation (Barnsley's collage theorem: if the union of
- *     the w_i(T) is close to T, the attractor is close to T), on the
- *     coarsest level. The target's centroid c and principal axis angle α
- *     come from its moments. Maps are chosen greedily, one at a time, among
- *     A = R(β + α) diag(s1, ±s2) R(-α) with β in 12 steps of 30°, six
+ *     the w_i(T) is close to T, the attractor is close to T). The target's
+ *     centroid c and principal axis angle α come from its moments. Maps are
+ *     chosen greedily, one at a time, among A = R(β + a) diag(s1, ±s2) R(-a)
+ *     with a = α or 0 (the principal axis of a shape with isotropic moments,
+ *     like an equilateral triangle, is noise), β in 12 steps of 30°, eight
  *     (s1, s2) pairs and a reflection or not, translated so that A c lands on
- *     one of up to 64 target cells (a regular subsample). A candidate's score
- *     is the number of target cells its image w(T) newly covers minus the
- *     sum of D_T over the image points that fall outside T (times s1·s2, the
- *     image's area per mapped cell; points outside the frame count as a
- *     quarter of the grid's side). The best candidate is kept, its image
- *     marked covered, and the next map chosen.
+ *     a candidate position. A candidate's score is the number of target
+ *     cells its image w(T) newly covers minus the sum of D_T over the image
+ *     points that fall outside T (times |s1·s2|, the image's area per mapped
+ *     cell; points outside the frame count as a quarter of the grid's side).
+ *     The best candidate is kept, its image marked covered, and the next map
+ *     chosen. Two variants: (a) on the 64-cell grid, positions on a 12×12
+ *     grid over the target's bounding box (the image of the centroid often
+ *     falls in a hole), the search scoring at most ~600 target cells, each
+ *     winner then polished (shifts of up to 2 cells, scale ±10 %, rotation
+ *     ±5°, twice); (b) on the 32-cell grid, positions on up to 64 target
+ *     cells. Neither wins on every target, so both start the refinement.
  *  3. Refinement against the attractor, level by level, coarse to fine. The
  *     loss of a parameter vector is computed from its attractor A rendered
  *     by a chaos game of P = clamp(10·|T|, 20000, 2^20) points (after 20
@@ -55,7 +61,7 @@
  *     fine); the step size restarts at each level at 0.6 of the last one.
  *     Multi-start: the coarse levels (the 32- and 64-cell grids when there
  *     are three or more levels, else the first) are run FIT_STARTS = 4 times,
- *     from the collage and from three copies of it with every parameter
+ *     from collage (a), collage (b), and a copy of each with every parameter
  *     moved by a Gaussian step (0.1 of the step scales); the start with the
  *     smallest loss on the last coarse level goes on to the finer levels.
  *     (Without this, a fit often settles on a covering by misplaced copies.)
