@@ -294,10 +294,6 @@ const lang_ifs *lang_as_ifs(value v)
     return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_ifs_class ? AS_OBJ(v)->payload : NULL;
 }
 
-typedef struct lang_rifs {
-    rifs r;
-} lang_rifs;
-
 static void rifs_destroy(void *p)
 {
     lang_rifs *lr = p;

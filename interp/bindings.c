@@ -8,5 +8,5 @@ int bind_all_init(interp *I)
     return bind_volume_init(I) || bind_field_init(I) || bind_ifs_init(I) || bind_solid_init(I) ||
            bind_ist_init(I) || bind_wrinkly_init(I) || bind_raster_init(I) || bind_show_init(I) ||
            bind_fset_init(I) || bind_shape_init(I) || bind_tops_init(I) || bind_superifs_init(I) ||
-           bind_tiles_init(I);
+           bind_tiles_init(I) || bind_fit_init(I);
 }

@@ -94,6 +94,7 @@ int bind_shape_init(interp *I);
 int bind_tops_init(interp *I);
 int bind_superifs_init(interp *I);
 int bind_tiles_init(interp *I);
+int bind_fit_init(interp *I);
 
 /* Call any function value with positional arguments (borrowed). */
 int eval_call_value(interp *I, value fn, const value *args, int nargs, value *out);

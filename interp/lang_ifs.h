@@ -12,6 +12,10 @@ typedef struct lang_ifs {
     ifs f;
 } lang_ifs;
 
+typedef struct lang_rifs { /* the payload of lang_rifs_class */
+    rifs r;
+} lang_rifs;
+
 extern const obj_class lang_ifs_class, lang_rifs_class, lang_map_class;
 
 const lang_ifs *lang_as_ifs(value v);

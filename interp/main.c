@@ -23,6 +23,7 @@
 #include "cstack.h"
 #include "eval.h"
 #include "apng.h"
+#include "fit_cli.h"
 #include "fileio.h"
 #include "par.h"
 #include "parser.h"
@@ -65,6 +66,11 @@ static const char usage_text[] =
     "                                          an animated PNG: MS per frame (default 40),\n"
     "                                          N plays (default 0: forever)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
+    "       frac fit TARGET.png --maps N|A..B [--seed S] [--iterations K] [--time SECONDS]\n"
+    "                [--foreground auto|dark|light|alpha] [--threshold T] [-o FIT.frac]\n"
+    "                                          fit an IFS to a picture; writes a script\n"
+    "                                          (default fit.frac) that saves fit.png\n"
+    "                                          (docs/fit.md)\n"
     "       frac --version | --help\n"
     "\n"
     "SCRIPT may be - to read the script from standard input. A script may start\n"
@@ -1164,6 +1170,15 @@ static int run_frames(interp *T, opts *o)
 
 static int frac_main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "fit") == 0) { /* its own options (interp/bind_fit.c) */
+        interp st, *I = &st;
+        interp_init(I);
+        I->threads = par_cores();
+        I->progress = 1;
+        int frc = fit_command(I, argc - 1, argv + 1, &interrupted);
+        interp_free(I);
+        return finish_output(frc);
+    }
     shard sh; /* --shard / merge: lives across the re-runs, each in a fresh interpreter */
     int rc, again = 0;
     do {
