@@ -25,6 +25,7 @@
 #include "apng.h"
 #include "fit_cli.h"
 #include "fileio.h"
+#include "lexer.h"
 #include "par.h"
 #include "parser.h"
 #include "recipe.h"
@@ -703,6 +704,39 @@ static int finish_output(int rc)
 
 /* The recipe of this run (recipe.h), handed to the writers. text NULL: no
  * script (the REPL). */
+/* Frame f of the range a..b:step: the names `frame` and `clock`, what %f
+ * becomes, and the range for the recipe (run_frames, and rerun of a frame). */
+static void set_frame(interp *I, long f, long a, long b, long step)
+{
+    long big = labs(a) > labs(b) ? labs(a) : labs(b);
+    int width = 1;
+    for (; big >= 10; big /= 10)
+        width++;
+    I->frame = f;
+    I->frames_given = 1;
+    I->clock = b > a ? (double)(f - a) / (double)(b - a) : 0.0;
+    I->frame_width = width;
+    I->frame_count = (b - a) / step + 1;
+    I->frame_first = a, I->frame_last = b, I->frame_step = step;
+}
+
+/* Does the script (NUL-terminated) use the name `clock`? Then its recipe
+ * records the --frames range, which clock depends on, so a rerun of the
+ * frame has the same clock; otherwise frame N's files stay identical to
+ * those of --frames N..N. (A module of the script's own that reads clock is
+ * not seen: docs/provenance.md.) Unsure (out of memory): yes. */
+static int names_clock(const char *text)
+{
+    token_list tl = {0};
+    if (lex_all(text, 0, 1, &tl))
+        return 1;
+    int found = 0;
+    for (size_t i = 0; i < tl.n && !found; i++)
+        found = tl.toks[i].type == T_IDENT && tl.toks[i].len == 5 && memcmp(tl.toks[i].start, "clock", 5) == 0;
+    lex_free(&tl);
+    return found;
+}
+
 static int install_recipe(interp *I, const opts *o, const char *path, const char *text, size_t len,
                           recipe_store *st)
 {
@@ -715,6 +749,8 @@ static int install_recipe(interp *I, const opts *o, const char *path, const char
     r.seed = I->seed;
     r.frame_given = I->frames_given;
     r.frame = I->frame;
+    r.frames_range = I->frames_given && text && names_clock(text);
+    r.frames_a = I->frame_first, r.frames_b = I->frame_last, r.frames_step = I->frame_step;
     char **params = mem_alloc(I, (size_t)(o->nov ? o->nov : 1) * sizeof *params);
     if (!params)
         return -1;
@@ -865,8 +901,10 @@ static int rerun_prepare(interp *I, opts *o, recipe *r, char **text, size_t *len
         o->args[k] = r->args[k];
     o->nargs = r->nargs;
     I->seed = r->seed;
-    I->frame = r->frame;
-    I->frames_given = r->frame_given;
+    if (r->frame_given) /* a frame of --frames A..B:STEP: the same frame, clock and %f */
+        set_frame(I, r->frame, r->frames_range ? r->frames_a : r->frame, r->frames_range ? r->frames_b : r->frame,
+                  r->frames_range ? r->frames_step : 1);
+    session_set_frame(I);
     o->script = r->script_path;
     *text = r->script;
     *len = r->script_len;
@@ -1136,10 +1174,7 @@ static int run_frames(interp *T, opts *o)
         return rc;
     o->text = text;
     o->len = len;
-    long count = (o->fb - o->fa) / o->fstep + 1, big = labs(o->fa) > labs(o->fb) ? labs(o->fa) : labs(o->fb);
-    int width = 1;
-    for (; big >= 10; big /= 10)
-        width++;
+    long count = (o->fb - o->fa) / o->fstep + 1;
     int tty = !T->quiet && isatty(2);
     rc = EX_OK;
     for (long k = 0; k < count && rc == EX_OK; k++) {
@@ -1152,11 +1187,7 @@ static int run_frames(interp *T, opts *o)
             fprintf(stderr, "frame %ld (%ld of %ld)\n", f, k + 1, count);
         interp st, *I = &st;
         fresh_interp(I, T);
-        I->frame = f;
-        I->frames_given = 1;
-        I->clock = o->fb > o->fa ? (double)(f - o->fa) / (double)(o->fb - o->fa) : 0.0;
-        I->frame_width = width;
-        I->frame_count = count;
+        set_frame(I, f, o->fa, o->fb, o->fstep);
         rc = run_frac(I, o);
         interp_free(I);
         rt_alloc_set_hook(&T->hook); /* T's blocks (the script, the options) are counted by T */

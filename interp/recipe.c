@@ -41,9 +41,11 @@ void recipe_text(const recipe *r, bytebuf *out, size_t *header_len, char *onelin
     if (r->sha256[0])
         bytebuf_printf(out, "script-sha256: %s\n", r->sha256);
     bytebuf_printf(out, "seed: %llu\n", (unsigned long long)r->seed);
-    if (r->frame_given)
+    if (r->frame_given) {
         bytebuf_printf(out, "frame: %ld\n", r->frame);
-    else
+        if (r->frames_range)
+            bytebuf_printf(out, "frames: %ld..%ld:%ld\n", r->frames_a, r->frames_b, r->frames_step);
+    } else
         bytebuf_printf(out, "frame: none\n");
     for (int i = 0; i < r->nparams; i++) {
         bytebuf_printf(out, "param ");
@@ -189,6 +191,17 @@ static int parse_u64(const char *s, size_t n, unsigned long long max, unsigned l
     return 0;
 }
 
+/* A whole number with an optional '-', |v| <= max. */
+static int parse_long(const char *s, size_t n, unsigned long long max, long *out)
+{
+    int neg = n > 0 && s[0] == '-';
+    unsigned long long v;
+    if (parse_u64(s + neg, n - (size_t)neg, max, &v))
+        return -1;
+    *out = neg ? -(long)v : (long)v;
+    return 0;
+}
+
 int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn)
 {
     memset(r, 0, sizeof *r);
@@ -244,12 +257,21 @@ int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn
             seen_frame = 1;
             if (vl == 4 && memcmp(val, "none", 4) == 0) {
                 r->frame_given = 0;
-            } else if (!parse_u64(val, vl, 1000000000000ULL, &v)) {
+            } else if (!parse_long(val, vl, 1000000000000ULL, &r->frame)) {
                 r->frame_given = 1;
-                r->frame = (long)v;
             } else {
                 return fail(r, err, errn, "recipe line %d: frame is not 'none' or a whole number", lineno);
             }
+            (void)v;
+        } else if (KEY("frames:")) {
+            const char *dots = memchr(val, '.', vl), *colon = memchr(val, ':', vl);
+            if (!r->frame_given || !dots || !colon || colon < dots || dots + 1 >= val + vl || dots[1] != '.' ||
+                parse_long(val, (size_t)(dots - val), 1000000000000ULL, &r->frames_a) ||
+                parse_long(dots + 2, (size_t)(colon - dots - 2), 1000000000000ULL, &r->frames_b) ||
+                parse_long(colon + 1, (size_t)(val + vl - colon - 1), 1000000000000ULL, &r->frames_step) ||
+                r->frames_step < 1 || r->frames_b < r->frames_a)
+                return fail(r, err, errn, "recipe line %d: frames is not A..B:STEP after a frame", lineno);
+            r->frames_range = 1;
         } else if (KEY("param") || KEY("arg")) {
             char *s = unescape(val, vl, &bad);
             if (!s)

@@ -10,6 +10,7 @@
  *   script-sha256: 64 hex digits         (of the script text)
  *   seed: 1
  *   frame: none | N
+ *   frames: A..B:STEP                    (with a frame: the --frames range, for clock)
  *   param NAME=TEXT                      (each -D, in the order given)
  *   arg TEXT                             (each of the script's args)
  *   script: N | omitted                  (its length in bytes, or --no-recipe)
@@ -41,6 +42,8 @@ typedef struct recipe {
     uint64_t seed;
     int frame_given;
     long frame;
+    int frames_range;  /* the frames: line was there (frame_given) */
+    long frames_a, frames_b, frames_step;
     int nparams;
     char **params;     /* "NAME=TEXT", unescaped */
     int nargs;

@@ -31,6 +31,15 @@ int session_setup(interp *I)
     return I->globals ? 0 : -1;
 }
 
+void session_set_frame(interp *I)
+{
+    env *root = I->globals ? I->globals->parent : NULL;
+    value *fv = root ? val_env_lookup(root, interp_intern(I, "frame", 5)) : NULL;
+    value *cv = root ? val_env_lookup(root, interp_intern(I, "clock", 5)) : NULL;
+    if (fv && cv) /* numbers: nothing to release */
+        *fv = val_num((double)I->frame), *cv = val_num(I->clock);
+}
+
 int session_run(interp *I, const char *name, const char *text, size_t len, int check_only, value *last)
 {
     return session_run_lines(I, name, text, len, 1, check_only, last);

@@ -8,6 +8,9 @@
 
 /* Create the builtin scope and the global scope, register every builtin. */
 int session_setup(interp *I);
+/* After session_setup: the names `frame` and `clock` take I->frame and
+ * I->clock again (frac rerun of a frame sets them from the recipe). */
+void session_set_frame(interp *I);
 /* Parse, resolve and run source text; the value of the last expression
  * statement goes to *last (if not NULL). check_only: parse and resolve
  * without running. */

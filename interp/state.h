@@ -153,6 +153,7 @@ typedef struct interp {
     double clock;        /* 0 at A, 1 at B (0 for A..A) */
     int frame_width;     /* digits of %f: those of the largest |A|, |B| */
     long frame_count;    /* frames in the range (>= 2: every path needs %f) */
+    long frame_first, frame_last, frame_step; /* the range A..B:STEP (for the recipe) */
     struct shard *shard; /* --shard / merge (shard.h); NULL otherwise */
 
     /* builtin registry */

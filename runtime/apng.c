@@ -150,6 +150,13 @@ rt_code apng_assemble(const unsigned char *const *pngs, const size_t *lens, int 
     put_u32(actl, (uint32_t)n);
     put_u32(actl + 4, (uint32_t)o->loop);
     png_write_chunk(out, "acTL", actl, 8);
+    rt_code rc = png_put_recipe(out, e); /* the run's recipe, when one is installed (save of a list) */
+    if (rc) {
+        for (int i = 0; i < n; i++)
+            bytebuf_free(&p[i].data);
+        rt_free(p);
+        return rc;
+    }
     if (p[0].nplte)
         png_write_chunk(out, "PLTE", p[0].plte, p[0].nplte);
     if (p[0].ntrns)
