@@ -39,8 +39,14 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 #undef KHASH
 
 #ifdef NOISE_X86
+/* every function from here to the pop is compiled for AVX2 (clang spells
+ * GCC's push_options/target pragma as an attribute pragma) */
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 /* The same with AVX2 gathers: p32 is the permutation widened to int32
  * (512 entries), so each step of the chain is one 4-lane gather. */
 ALWAYS_INLINE v4i gather(const int32_t *p32, v4i i)
@@ -64,7 +70,11 @@ ALWAYS_INLINE void hash_gather(const uint8_t *p, const int32_t *p32, v4i X, v4i 
 #include "noise_kernel.inc"
 #undef K
 #undef KHASH
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
