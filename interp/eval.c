@@ -33,6 +33,17 @@ static inline value *lookup(env *e, const node *n)
     return val_env_lookup(e, n->str);
 }
 
+/* A name's value (a new reference), or the error for an unknown one. */
+static inline int eval_name(interp *I, env *e, const node *n, value *out)
+{
+    value *v = lookup(e, n);
+    if (!v)
+        return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
+    *out = *v;
+    val_ref(*out);
+    return 0;
+}
+
 /* Define n->str in e (takes v), in place when the slot already holds it. */
 static inline int define(interp *I, env *e, const node *n, value v)
 {
@@ -697,14 +708,8 @@ __attribute__((noinline)) static int eval_cold(interp *I, env *e, const node *n,
         return 0;
     case N_NIL:
         return 0;
-    case N_NAME: {
-        value *v = lookup(e, n);
-        if (!v)
-            return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
-        *out = *v;
-        val_ref(*out);
-        return 0;
-    }
+    case N_NAME:
+        return eval_name(I, e, n, out);
     case N_LIST: {
         value l = val_list(I, (size_t)n->nkids);
         if (l.k == V_NIL)
@@ -849,14 +854,8 @@ int eval_expr(interp *I, env *e, const node *n, value *out)
     case N_NUM:
         *out = val_num(n->num);
         return 0;
-    case N_NAME: {
-        value *v = lookup(e, n);
-        if (!v)
-            return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
-        *out = *v;
-        val_ref(*out);
-        return 0;
-    }
+    case N_NAME:
+        return eval_name(I, e, n, out);
     case N_BINARY: {
         value a, b;
         if (eval_leaf(I, e, n->kids[0], &a))

@@ -325,6 +325,23 @@ typedef struct chaos_ctx {
     int failed;       /* a worker could not allocate */
 } chaos_ctx;
 
+/* Every set's cumulative probabilities, FSET_MAX_MAPS per set (rt_free it);
+ * NULL when out of memory. */
+static double *cumulative_tables(const fset *fs)
+{
+    double *cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *cum);
+    for (int s = 0; cum && s < fs->n; s++)
+        fset_cumulative(fs->sets[s].p, fs->sets[s].n, cum + (size_t)s * FSET_MAX_MAPS);
+    return cum;
+}
+
+/* The chaos game's fixed chunks: a walk's are shorter (FSET_WALK_CHUNK). */
+static size_t chunk_count(const fset_chaos_opts *opts)
+{
+    uint64_t per = opts->mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
+    return (size_t)((opts->points + per - 1) / per);
+}
+
 static void chaos_step(const chaos_ctx *c, uint64_t k, rng *r, double *x, double *y)
 {
     int s = fset_order_at(c->o, c->fs->n, k);
@@ -419,18 +436,15 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
         return RT_OK;
 
     chaos_ctx c = {fs, o, opts, hs, NULL, NULL, 0};
-    uint64_t per = opts->mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
-    size_t nchunks = (size_t)((opts->points + per - 1) / per);
+    size_t nchunks = chunk_count(opts);
     int nw = par_workers(run, nchunks);
     size_t nbins = (size_t)hs->w * (size_t)hs->h;
-    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.cum = cumulative_tables(fs);
     c.count = rt_calloc((size_t)nw, sizeof *c.count);
     if (!c.cum || !c.count) {
         code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
         goto done;
     }
-    for (int s = 0; s < fs->n; s++)
-        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
     for (int i = 0; i < nw; i++) {
         c.count[i] = rt_calloc(nbins, sizeof **c.count);
         if (!c.count[i]) {
@@ -686,15 +700,13 @@ rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opt
     bo.points = FSET_BOX_POINTS; /* one chunk in either mode */
     bo.seed = rng_hash3(opts->seed, 1ull << 63, 0, 0);
     view_ctx c = {fs, o, &bo, NULL, 0, 0, NULL, NULL, NULL, 0};
-    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.cum = cumulative_tables(fs);
     c.pts = rt_malloc(3 * FSET_BOX_POINTS * sizeof *c.pts);
     double *ax = rt_malloc(FSET_BOX_POINTS * sizeof *ax);
     if (!c.cum || !c.pts || !ax) {
         code = rt_fail(e, RT_ENOMEM, "out of memory fitting the view");
         goto done;
     }
-    for (int s = 0; s < fs->n; s++)
-        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
     uint64_t per = bo.mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
     for (size_t ch = 0; ch * per < FSET_BOX_POINTS; ch++) {
         if (bo.mode == FSET_WALK)
@@ -733,18 +745,15 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
     if (code)
         return code;
     view_ctx c = {fs, o, opts, cam, im->w, im->h, NULL, NULL, NULL, 0};
-    uint64_t per = opts->mode == FSET_WALK ? FSET_WALK_CHUNK : CHAOS_CHUNK;
-    size_t nchunks = (size_t)((opts->points + per - 1) / per);
+    size_t nchunks = chunk_count(opts);
     int nw = par_workers(run, nchunks ? nchunks : 1);
     size_t nb = (size_t)im->w * (size_t)im->h;
-    c.cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *c.cum);
+    c.cum = cumulative_tables(fs);
     c.zb = rt_calloc((size_t)nw, sizeof *c.zb);
     if (!c.cum || !c.zb) {
         code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
         goto done;
     }
-    for (int s = 0; s < fs->n; s++)
-        fset_cumulative(fs->sets[s].p, fs->sets[s].n, c.cum + (size_t)s * FSET_MAX_MAPS);
     for (int i = 0; i < nw; i++) {
         if (!(c.zb[i] = rt_mallocn(nb, sizeof **c.zb))) {
             code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread depth buffers", nw);
