@@ -932,6 +932,8 @@ static int set_overrides(interp *I, const opts *o)
     return 0;
 }
 
+static int rerun_apng(interp *T, opts *o, recipe *r);
+
 static int run_frac(interp *I, opts *o)
 {
     int rc;
@@ -1000,6 +1002,11 @@ static int run_frac(interp *I, opts *o)
     } else if (rerun) {
         char *t = NULL;
         if ((rc = rerun_prepare(I, o, &rr, &t, &len))) {
+            recipe_free(&rr);
+            return rc;
+        }
+        if (rr.apng_output) { /* an APNG of frac apng: its frames, then the file */
+            rc = rerun_apng(I, o, &rr);
             recipe_free(&rr);
             return rc;
         }
@@ -1073,6 +1080,128 @@ static void fresh_interp(interp *I, const interp *T)
     I->fail_alloc_at = T->fail_alloc_at;
 }
 
+/* frac rerun of an APNG that frac apng assembled: each frame the recipe
+ * lists is rendered again as in rerun_prepare (in a fresh interpreter, like
+ * run_frames), the file of each input found among what that render wrote
+ * (by its name; or the one PNG the render wrote), and the frames assembled
+ * with the same delay and loop into OUT (the recipe's apng-output, under -o
+ * DIR), carrying the same recipe: the same bytes as the original. */
+typedef struct apng_rerun {
+    const recipe *r;
+    int from;       /* the entries of this render: from.. with its frame */
+    char **path;    /* each entry's file, once found (FILEIO_PATH_MAX) */
+    int *hits;
+    int npng;       /* PNG files this render wrote */
+    char last_png[FILEIO_PATH_MAX];
+} apng_rerun;
+
+static const char *base_name(const char *p)
+{
+    const char *s = strrchr(p, '/');
+    return s ? s + 1 : p;
+}
+
+static int assemble_apng(interp *I, const char **names, int n, const apng_opts *ao, const char *out, recipe *ar,
+                         int make_recipe);
+
+static int same_apng_frame(const recipe *r, int i, int j)
+{
+    return r->apng_framed[i] == r->apng_framed[j] && (!r->apng_framed[i] || r->apng_frame[i] == r->apng_frame[j]);
+}
+
+static void on_rerun_write(void *ud, const char *path, int wrote)
+{
+    apng_rerun *w = ud;
+    size_t pl = strlen(path);
+    if (!wrote || pl >= FILEIO_PATH_MAX)
+        return;
+    if (pl > 4 && strcmp(path + pl - 4, ".png") == 0) {
+        w->npng++;
+        memcpy(w->last_png, path, pl + 1);
+    }
+    for (int j = w->from; j < w->r->napng; j++)
+        if (w->path[j] && same_apng_frame(w->r, w->from, j) &&
+            strcmp(base_name(path), base_name(w->r->apng_name[j])) == 0 && w->hits[j]++ == 0)
+            memcpy(w->path[j], path, pl + 1);
+}
+
+static void fresh_interp(interp *I, const interp *T);
+
+static int rerun_apng(interp *T, opts *o, recipe *r)
+{
+    int n = r->napng, rc = EX_OK;
+    char **path = mem_calloc(T, (size_t)n, sizeof *path);
+    int *hits = mem_calloc(T, (size_t)n, sizeof *hits);
+    if (!path || !hits)
+        rc = session_report(T);
+    /* without a frames line the script does not read clock: the range only
+     * sets the width of %f, which the listed frames' extremes give */
+    long lo = 0, hi = 0;
+    for (int i = 0, first = 1; i < n; i++)
+        if (r->apng_framed[i]) {
+            lo = first || r->apng_frame[i] < lo ? r->apng_frame[i] : lo;
+            hi = first || r->apng_frame[i] > hi ? r->apng_frame[i] : hi;
+            first = 0;
+        }
+    o->mode = "run";
+    o->text = (unsigned char *)r->script;
+    o->len = r->script_len;
+    for (int i = 0; i < n && rc == EX_OK; i++) {
+        if (path[i])
+            continue; /* found by an earlier render of its frame */
+        for (int j = i; j < n && rc == EX_OK; j++)
+            if (!path[j] && same_apng_frame(r, i, j) && !(path[j] = mem_calloc(T, 1, FILEIO_PATH_MAX)))
+                rc = session_report(T);
+        if (rc)
+            break;
+        apng_rerun w = {r, i, path, hits, 0, ""};
+        interp st, *I = &st;
+        fresh_interp(I, T);
+        if (r->apng_framed[i])
+            set_frame(I, r->apng_frame[i], r->frames_range ? r->frames_a : lo, r->frames_range ? r->frames_b : hi,
+                      r->frames_range ? r->frames_step : 1);
+        fileio_set_path_hook(on_rerun_write, &w);
+        rc = run_frac(I, o);
+        fileio_set_path_hook(NULL, NULL);
+        interp_free(I);
+        rt_alloc_set_hook(&T->hook);
+        for (int j = i; j < n && rc == EX_OK; j++) {
+            if (!same_apng_frame(r, i, j) || hits[j] == 1)
+                continue;
+            if (hits[j] == 0 && w.npng == 1) {
+                memcpy(path[j], w.last_png, strlen(w.last_png) + 1);
+                continue;
+            }
+            char fr[32] = "the run";
+            if (r->apng_framed[j])
+                snprintf(fr, sizeof fr, "frame %ld", r->apng_frame[j]);
+            fprintf(stderr, "frac: error: %s of '%s' wrote %s file named '%s' (input %d of the APNG): cannot "
+                            "assemble it again\n", fr, r->script_path, hits[j] ? "more than one" : "no",
+                    base_name(r->apng_name[j]), j + 1);
+            rc = EX_SCRIPT;
+        }
+    }
+    o->text = NULL;
+    char out[FILEIO_PATH_MAX];
+    if (rc == EX_OK) {
+        int k = T->out_dir ? snprintf(out, sizeof out, "%s/%s", T->out_dir, r->apng_output)
+                           : snprintf(out, sizeof out, "%s", r->apng_output);
+        if (k < 0 || (size_t)k >= sizeof out) {
+            fprintf(stderr, "frac: error: the path of '%s' under '%s' is too long\n", r->apng_output, T->out_dir);
+            rc = EX_IO;
+        }
+    }
+    if (rc == EX_OK) {
+        apng_opts ao = {(int)r->apng_delay, r->apng_loop};
+        rc = assemble_apng(T, (const char **)path, n, &ao, out, r, 0);
+    }
+    for (int i = 0; path && i < n; i++)
+        mem_free(T, path[i]);
+    mem_free(T, path);
+    mem_free(T, hits);
+    return rc;
+}
+
 /* frac watch: each render is a plain run of the script, read again, in a
  * fresh interpreter whose interrupt flag is the watcher's cancel flag. An
  * interruption there is a change of a file (or Ctrl-C), not an error. */
@@ -1108,9 +1237,151 @@ static int run_watch(interp *T, opts *o)
     return rc < 0 ? session_report(T) : rc;
 }
 
+/* The recipe an APNG made by `frac apng` carries: the frames' common recipe
+ * (all inputs must be files of one run, recipe_same_run) plus the assembly —
+ * the output's name, delay, loop, and each input's frame and name — so that
+ * `frac rerun` can render the frames again and assemble the same file.
+ * Returns 1 with *ar built, 0 when the frames have no common recipe (a note
+ * says why, unless quiet), -1 out of memory. */
+static int apng_recipe(const interp *I, unsigned char *const *data, const size_t *lens, const char **names, int n,
+                       const apng_opts *ao, const char *out, recipe *ar)
+{
+    char why[768] = "", err[256], one[256];
+    int ok = 1;
+    memset(ar, 0, sizeof *ar);
+    for (int i = 0; i < n && ok; i++) {
+        recipe cur, *r = i ? &cur : ar;
+        char *text;
+        size_t len;
+        int f = recipe_find(data[i], lens[i], &text, &len, one, sizeof one, err, sizeof err);
+        int bad = f == 0 ? recipe_parse(text, len, r, err, sizeof err) : -1;
+        if (f == 0)
+            rt_free(text);
+        if (!bad && r->script) {
+            char hex[65];
+            sha256_hex(r->script, r->script_len, hex);
+            bad = strcmp(hex, r->sha256) != 0;
+            if (bad)
+                recipe_free(r);
+        }
+        if (bad) {
+            snprintf(why, sizeof why, "'%s' %s", names[i], f > 0 ? "carries none" : "has a damaged one");
+            ok = 0;
+            break;
+        }
+        if (i == 0) {
+            ar->apng_frame = rt_calloc((size_t)n, sizeof *ar->apng_frame);
+            ar->apng_framed = rt_calloc((size_t)n, 1);
+            ar->apng_name = rt_calloc((size_t)n, sizeof *ar->apng_name);
+            if (!ar->apng_frame || !ar->apng_framed || !ar->apng_name) {
+                recipe_free(ar);
+                return -1;
+            }
+        } else if (!recipe_same_run(ar, &cur, err, sizeof err)) {
+            snprintf(why, sizeof why, "'%s' and '%s' differ in %s", names[0], names[i], err);
+            ok = 0;
+        }
+        ar->apng_frame[i] = r->frame;
+        ar->apng_framed[i] = (char)r->frame_given;
+        if (i)
+            recipe_free(&cur);
+        if (ok) {
+            size_t k = strlen(names[i]);
+            if (!(ar->apng_name[i] = rt_malloc(k + 1))) {
+                recipe_free(ar);
+                return -1;
+            }
+            memcpy(ar->apng_name[i], names[i], k + 1);
+            ar->napng = i + 1;
+        }
+    }
+    const char *bn = base_name(out);
+    if (ok && !*bn) {
+        snprintf(why, sizeof why, "'%s' is not a file name", out);
+        ok = 0;
+    }
+    if (ok && !(ar->apng_output = rt_malloc(strlen(bn) + 1)))
+        ok = -1;
+    if (ok <= 0) {
+        if (!ok && !I->quiet)
+            fprintf(stderr, "frac: note: %s carries no recipe: the frames are not all files of one run with a "
+                            "recipe (%s)\n", out, why);
+        recipe_free(ar);
+        return ok;
+    }
+    memcpy(ar->apng_output, bn, strlen(bn) + 1);
+    ar->apng_delay = ao->delay_ms;
+    ar->apng_loop = ao->loop;
+    return 1;
+}
+
+/* Read n PNG files, assemble them (apng_assemble) and write OUT; with ar the
+ * APNG carries that recipe. Every frame is checked before anything is
+ * written. */
+static int assemble_apng(interp *I, const char **names, int n, const apng_opts *ao, const char *out, recipe *ar,
+                         int make_recipe)
+{
+    unsigned char **data = mem_calloc(I, (size_t)n, sizeof *data);
+    size_t *lens = mem_calloc(I, (size_t)n, sizeof *lens);
+    int rc = data && lens ? EX_OK : session_report(I);
+    rt_error e;
+    for (int i = 0; i < n && rc == EX_OK; i++) {
+        rt_code c = fileio_read_all(names[i], (size_t)1 << 30, &data[i], &lens[i], &e);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : EX_IO;
+        }
+    }
+    recipe built;
+    int have = 0;
+    if (rc == EX_OK && make_recipe) {
+        have = apng_recipe(I, data, lens, names, n, ao, out, &built);
+        if (have < 0) {
+            mem_engine_error(I, "apng", "out of memory building the recipe");
+            rc = session_report(I);
+        }
+        ar = have > 0 ? &built : NULL;
+    }
+    recipe_store st;
+    int installed = 0;
+    if (rc == EX_OK && ar) {
+        if (recipe_install(ar, &st)) {
+            mem_engine_error(I, "apng", "out of memory building the recipe");
+            rc = session_report(I);
+        } else {
+            installed = 1;
+        }
+    }
+    if (rc == EX_OK) {
+        bytebuf b;
+        bytebuf_init(&b);
+        rt_code c = apng_assemble((const unsigned char *const *)data, lens, n, names, ao, &b, &e);
+        if (!c)
+            c = fileio_write_atomic(out, b.data, b.len, &e);
+        bytebuf_free(&b);
+        if (c) {
+            fprintf(stderr, "frac: error: %s\n", e.msg);
+            rc = c == RT_ENOMEM ? EX_SOFTWARE : c == RT_EIO ? EX_IO : EX_SCRIPT;
+        } else if (!I->quiet) {
+            fprintf(stderr, "wrote %s (%d frames)\n", out, n);
+        }
+    }
+    if (installed)
+        recipe_uninstall(&st);
+    if (have > 0)
+        recipe_free(&built);
+    for (int i = 0; data && i < n; i++)
+        rt_free(data[i]);
+    mem_free(I, data);
+    mem_free(I, lens);
+    return rc;
+}
+
 /* frac apng -o OUT.png [--delay MS] [--loop N] FRAME.png...: the frames'
  * image data copied into one animated PNG (runtime/apng.h); every frame is
- * checked before anything is written. */
+ * checked before anything is written. When the frames are files of one run
+ * (one script, params and seed; `--frames` frames differ only in the
+ * frame), the APNG carries their recipe and the assembly, for frac rerun. */
 static int run_apng(interp *I, opts *o)
 {
     apng_opts ao = {APNG_DEFAULT_DELAY_MS, 0};
@@ -1127,37 +1398,12 @@ static int run_apng(interp *I, opts *o)
         ao.loop = (long)d;
     int n = 1 + o->nargs;
     const char **names = mem_calloc(I, (size_t)n, sizeof *names);
-    unsigned char **data = mem_calloc(I, (size_t)n, sizeof *data);
-    size_t *lens = mem_calloc(I, (size_t)n, sizeof *lens);
-    int rc = names && data && lens ? EX_OK : session_report(I);
-    rt_error e;
-    for (int i = 0; i < n && rc == EX_OK; i++) {
+    if (!names)
+        return session_report(I);
+    for (int i = 0; i < n; i++)
         names[i] = i ? o->args[i - 1] : o->script;
-        rt_code c = fileio_read_all(names[i], (size_t)1 << 30, &data[i], &lens[i], &e);
-        if (c) {
-            fprintf(stderr, "frac: error: %s\n", e.msg);
-            rc = c == RT_ENOMEM ? EX_SOFTWARE : EX_IO;
-        }
-    }
-    if (rc == EX_OK) {
-        bytebuf b;
-        bytebuf_init(&b);
-        rt_code c = apng_assemble((const unsigned char *const *)data, lens, n, names, &ao, &b, &e);
-        if (!c)
-            c = fileio_write_atomic(I->out_dir, b.data, b.len, &e);
-        bytebuf_free(&b);
-        if (c) {
-            fprintf(stderr, "frac: error: %s\n", e.msg);
-            rc = c == RT_ENOMEM ? EX_SOFTWARE : c == RT_EIO ? EX_IO : EX_SCRIPT;
-        } else if (!I->quiet) {
-            fprintf(stderr, "wrote %s (%d frames)\n", I->out_dir, n);
-        }
-    }
-    for (int i = 0; data && i < n; i++)
-        rt_free(data[i]);
+    int rc = assemble_apng(I, names, n, &ao, I->out_dir, NULL, 1);
     mem_free(I, names);
-    mem_free(I, data);
-    mem_free(I, lens);
     return rc;
 }
 

@@ -47,6 +47,19 @@ void recipe_text(const recipe *r, bytebuf *out, size_t *header_len, char *onelin
             bytebuf_printf(out, "frames: %ld..%ld:%ld\n", r->frames_a, r->frames_b, r->frames_step);
     } else
         bytebuf_printf(out, "frame: none\n");
+    if (r->apng_output) {
+        bytebuf_printf(out, "apng-output: ");
+        put_escaped(out, r->apng_output);
+        bytebuf_printf(out, "\napng-delay: %ld\napng-loop: %ld\n", r->apng_delay, r->apng_loop);
+        for (int i = 0; i < r->napng; i++) {
+            if (r->apng_framed[i])
+                bytebuf_printf(out, "apng-frame: %ld ", r->apng_frame[i]);
+            else
+                bytebuf_printf(out, "apng-frame: none ");
+            put_escaped(out, r->apng_name[i]);
+            bytebuf_byte(out, '\n');
+        }
+    }
     for (int i = 0; i < r->nparams; i++) {
         bytebuf_printf(out, "param ");
         put_escaped(out, r->params[i]);
@@ -164,7 +177,46 @@ void recipe_free(recipe *r)
         rt_free(r->args[i]);
     rt_free(r->args);
     rt_free(r->script);
+    rt_free(r->apng_output);
+    for (int i = 0; i < r->napng; i++)
+        rt_free(r->apng_name[i]);
+    rt_free(r->apng_name);
+    rt_free(r->apng_frame);
+    rt_free(r->apng_framed);
     memset(r, 0, sizeof *r);
+}
+
+static int same_list(char **a, int na, char **b, int nb)
+{
+    if (na != nb)
+        return 0;
+    for (int i = 0; i < na; i++)
+        if (strcmp(a[i], b[i]) != 0)
+            return 0;
+    return 1;
+}
+
+int recipe_same_run(const recipe *a, const recipe *b, char *why, size_t whyn)
+{
+    const char *d = strcmp(a->version, b->version) ? "the frac version"
+                    : strcmp(a->script_path, b->script_path) ? "the script path"
+                    : strcmp(a->sha256, b->sha256) ? "the script (its SHA-256)"
+                    : a->seed != b->seed ? "the seed"
+                    : a->frames_range != b->frames_range ||
+                            (a->frames_range && (a->frames_a != b->frames_a || a->frames_b != b->frames_b ||
+                                                 a->frames_step != b->frames_step))
+                        ? "the --frames range"
+                    : !same_list(a->params, a->nparams, b->params, b->nparams) ? "the params (-D)"
+                    : !same_list(a->args, a->nargs, b->args, b->nargs) ? "the script's arguments"
+                    : a->has_script != b->has_script || a->script_len != b->script_len ||
+                            (a->script && b->script && memcmp(a->script, b->script, a->script_len) != 0) ||
+                            !a->script != !b->script
+                        ? "the script text carried"
+                    : a->apng_output || b->apng_output ? "being an APNG already"
+                                                       : NULL;
+    if (d)
+        snprintf(why, whyn, "%s", d);
+    return d == NULL;
 }
 
 __attribute__((format(printf, 4, 5))) static int fail(recipe *r, char *err, size_t errn, const char *fmt, ...)
@@ -272,6 +324,45 @@ int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn
                 r->frames_step < 1 || r->frames_b < r->frames_a)
                 return fail(r, err, errn, "recipe line %d: frames is not A..B:STEP after a frame", lineno);
             r->frames_range = 1;
+        } else if (KEY("apng-output:")) {
+            if (r->apng_output)
+                return fail(r, err, errn, "recipe line %d: 'apng-output:' is given twice", lineno);
+            if (!(r->apng_output = unescape(val, vl, &bad)) || !r->apng_output[0] || strchr(r->apng_output, '/'))
+                return fail(r, err, errn,
+                            !r->apng_output && !bad ? "recipe line %d: out of memory"
+                                                    : "recipe line %d: apng-output is not a file name",
+                            lineno);
+        } else if (KEY("apng-delay:") || KEY("apng-loop:")) {
+            long v;
+            long max = KEY("apng-delay:") ? 65535 : 2147483647L;
+            if (parse_long(val, vl, (unsigned long long)max, &v) || v < 0)
+                return fail(r, err, errn, "recipe line %d: %.*s is not a whole number from 0 to %ld", lineno,
+                            (int)kl - 1, line, max);
+            *(KEY("apng-delay:") ? &r->apng_delay : &r->apng_loop) = v;
+        } else if (KEY("apng-frame:")) {
+            const char *sp2 = memchr(val, ' ', vl);
+            long f = 0;
+            int framed = !(sp2 && sp2 - val == 4 && memcmp(val, "none", 4) == 0);
+            if (!sp2 || (framed && parse_long(val, (size_t)(sp2 - val), 1000000000000ULL, &f)))
+                return fail(r, err, errn, "recipe line %d: apng-frame is not 'F NAME' (F a frame or none)", lineno);
+            if (r->napng >= 100000)
+                return fail(r, err, errn, "recipe line %d: more than 100000 APNG frames", lineno);
+            char *nm = unescape(sp2 + 1, (size_t)(val + vl - sp2 - 1), &bad);
+            if (!nm)
+                return fail(r, err, errn, bad ? "recipe line %d: a bad escape" : "recipe line %d: out of memory",
+                            lineno);
+            long *nf = rt_realloc(r->apng_frame, (size_t)(r->napng + 1) * sizeof *nf);
+            if (nf)
+                r->apng_frame = nf;
+            char *nd = nf ? rt_realloc(r->apng_framed, (size_t)(r->napng + 1)) : NULL;
+            if (nd)
+                r->apng_framed = nd;
+            if (!nd || push(&r->apng_name, &r->napng, nm)) {
+                rt_free(nm);
+                return fail(r, err, errn, "recipe line %d: out of memory", lineno);
+            }
+            r->apng_frame[r->napng - 1] = f;
+            r->apng_framed[r->napng - 1] = (char)framed;
         } else if (KEY("param") || KEY("arg")) {
             char *s = unescape(val, vl, &bad);
             if (!s)
@@ -307,6 +398,9 @@ int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn
                     : !seen_seed      ? "seed:"
                     : !seen_frame     ? "frame:"
                                       : "script:");
+    if (!r->apng_output != !r->napng)
+        return fail(r, err, errn, "the recipe's APNG lines are incomplete (%s)",
+                    r->apng_output ? "no apng-frame line" : "apng-frame without apng-output");
     if (r->has_script && p < end) {
         if (*p != '\n' || (size_t)(end - p - 1) != r->script_len)
             return fail(r, err, errn, "the recipe's script text is not the %zu bytes its header says", r->script_len);

@@ -11,6 +11,10 @@
  *   seed: 1
  *   frame: none | N
  *   frames: A..B:STEP                    (with a frame: the --frames range, for clock)
+ *   apng-output: NAME                    (an APNG that `frac apng` assembled from
+ *   apng-delay: MS                        frames of this run: the output's file name,
+ *   apng-loop: N                          the options, and for each input in order
+ *   apng-frame: F NAME                    its frame (a number or none) and file name)
  *   param NAME=TEXT                      (each -D, in the order given)
  *   arg TEXT                             (each of the script's args)
  *   script: N | omitted                  (its length in bytes, or --no-recipe)
@@ -44,6 +48,12 @@ typedef struct recipe {
     long frame;
     int frames_range;  /* the frames: line was there (frame_given) */
     long frames_a, frames_b, frames_step;
+    char *apng_output; /* non-NULL: the recipe of a `frac apng` file */
+    long apng_delay, apng_loop;
+    int napng;
+    long *apng_frame;   /* each input's frame; apng_framed[i] 0: none */
+    char *apng_framed;
+    char **apng_name;   /* each input's file name, as given to frac apng */
     int nparams;
     char **params;     /* "NAME=TEXT", unescaped */
     int nargs;
@@ -59,6 +69,11 @@ typedef struct recipe {
  * leaves its line out (a REPL session has no script). oneline (n bytes) receives the one-line form for VTK titles
  * and STL headers: "frac VERSION seed=S sha256=HEX [frame=F] [NAME=TEXT]…". */
 void recipe_text(const recipe *r, bytebuf *out, size_t *header_len, char *oneline, size_t n);
+
+/* 1 when a and b are recipes of one run's files (script, its text,
+ * version, seed, params, args and the frames range alike; the frame may
+ * differ), else 0 with what differs in why. */
+int recipe_same_run(const recipe *a, const recipe *b, char *why, size_t whyn);
 
 /* Parse a recipe (header alone or whole). 0, or -1 with a message in err. */
 int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn);
