@@ -19,6 +19,7 @@
 #include "lang_image.h"
 #include "lang_objects.h"
 #include "lexer.h"
+#include "report.h"
 
 /* ---- shapes ---------------------------------------------------------------------------- */
 
@@ -424,11 +425,13 @@ static int iterate_mesh(interp *I, const lang_fset *f, const fset_order *o, long
     if (!m)
         return -1;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     c = fset_iterate_mesh(&f->fs, o, (size_t)steps, copies, k0, m, &run, &e);
     if (c) {
         mem_free(I, m);
         return lang_rt_error(I, c, &e, "iterate");
     }
+    report_work(I, "iterate", "triangles", (double)m->nt, t0);
     return lang_mesh_value(I, m, out);
 }
 
@@ -505,11 +508,13 @@ static int b_iterate(interp *I, value *a, int n, value *out)
         goto done;
     rt_run run = lang_run(I);
     detiter_shape res;
+    double t0 = report_clock();
     c = detiter_run(&f->fs, &o, (size_t)steps, k0, (size_t)need, &res, &run, &e);
     if (c) {
         lang_rt_error(I, c, &e, "iterate");
         goto done;
     }
+    report_work(I, "iterate", "vertices", (double)need, t0);
     rc = shape_value(I, &res, out);
 done:
     if (own_k0)

@@ -320,7 +320,11 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     }
     rt_run run = lang_run(I);
     rt_error e;
+    double t0 = report_clock();
     rt_code rc = mpd_init(&c->m, &p, &run, &e);
+    if (!rc && bytes)
+        report_work(I, "midpoint displacement", "lattice points",
+                    pow(ldexp(1.0, type == MPD_TYPE1 ? p.R : R2) + 1, 3), t0);
     if (rc) {
         mem_free(I, c);
         if (rc == RT_EINVAL && bytes > maxmem) /* the array is over --max-memory */

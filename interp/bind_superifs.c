@@ -18,6 +18,7 @@
 #include "lang_objects.h"
 #include "superifs.h"
 #include "tonemap.h"
+#include "report.h"
 
 /* ---- super IFS ------------------------------------------------------------------------- */
 
@@ -141,7 +142,10 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     }
     rt_error e;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     rt_code c = superifs_run(&f->fs, P, &so, &ls->st, &run, &e);
+    if (!c)
+        report_work(I, "super IFS", "points", (double)so.points * (double)so.V, t0);
     if (c) {
         mem_free(I, ls);
         lang_rt_error(I, c, &e, "superifs");

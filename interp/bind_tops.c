@@ -14,6 +14,7 @@
 #include "lang_image.h"
 #include "lang_objects.h"
 #include "tops.h"
+#include "report.h"
 
 /* ---- fractal tops and colour stealing ---------------------------------------------------- */
 
@@ -72,11 +73,13 @@ static int b_top(interp *I, value *a, int n, value *out)
     rt_run run = lang_run(I);
     fset_ifs f = ifs_view(li);
     image *im = NULL;
+    double t0 = report_clock();
     rt_code c = draw_view_fit(&view, w, h, lo, hi, 1, &e);
     if (!c)
         c = tops_run(&f, &view, &to, &tb, &run, &e);
     if (c)
         return lang_rt_error(I, c, &e, "top");
+    report_work(I, "fractal top", "points", (double)to.points, t0);
     if (nsym > tb.depth) {
         tops_free(&tb);
         return err_arg(I, 5, ERR_VALUE, "top: symbols must be between 1 and the address depth %d, got %ld", tb.depth, nsym);
@@ -150,6 +153,7 @@ static int b_steal(interp *I, value *a, int n, value *out)
     tops_buf tb;
     rt_error e;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     rt_code c = draw_view_fit(&sv, s.w, s.h, s.lo, s.hi, 1, &e);
     if (!c)
         c = draw_view_fit(&srcv, pic->w, pic->h, s.slo, s.shi, 0, &e);
@@ -157,6 +161,7 @@ static int b_steal(interp *I, value *a, int n, value *out)
         c = tops_steal(&s.f, &sv, &s.g, &srcv, &s.to, &tb, &run, &e);
     if (c)
         return lang_rt_error(I, c, &e, "steal");
+    report_work(I, "colour stealing", "points", (double)s.to.points, t0);
     image *im;
     if (lang_image_new(I, s.w, s.h, &im)) {
         tops_free(&tb);
@@ -214,9 +219,12 @@ static int b_fractal_filter(interp *I, value *a, int n, value *out)
     draw_view sv;
     rt_error e;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     rt_code c = !res ? rt_fail(&e, RT_ENOMEM, "out of memory") : draw_view_fit(&sv, s.w, s.h, s.lo, s.hi, 1, &e);
     if (!c && l.k != V_NIL)
         c = tops_filter(&s.f, &sv, &s.g, s.slo, s.shi, frames, (int)fl->n, &s.to, s.bg, res, &run, &e);
+    if (!c && l.k != V_NIL)
+        report_work(I, "fractal filter", "points", (double)s.to.points, t0);
     mem_free(I, frames);
     if (c || l.k == V_NIL) {
         if (res)

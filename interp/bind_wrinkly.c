@@ -16,6 +16,7 @@
 #include "lang_objects.h"
 #include "lang_wrinkly.h"
 #include "wrinkly.h"
+#include "report.h"
 
 /* ---- small helpers ------------------------------------------------------------------ */
 
@@ -315,9 +316,11 @@ static int curve_sample(interp *I, const curve_obj *c, const lod *l, wrinkly_pol
     if (mem_precheck(I, count * 40, "the curve samples"))
         return -1;
     rt_error e;
+    double t0 = report_clock();
     rt_code rc = wrinkly_curve_sample(&wc, &o, pl, &e);
     if (rc)
         return lang_rt_error(I, rc, &e, what);
+    report_work(I, "wrinkly curve", "points", (double)pl->n, t0);
     return 0;
 }
 
@@ -757,12 +760,14 @@ int lang_surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int 
     }
     rt_run run = lang_run(I);
     rt_error e;
+    double t0 = report_clock();
     rt_code rc = wrinkly_surface_mesh(&ws, &o, &run, m, NULL, &e);
     if (rc) {
         mesh_free(m);
         mem_free(I, m);
         return lang_rt_error(I, rc, &e, what);
     }
+    report_work(I, "wrinkly surface", "triangles", (double)m->nt, t0);
     *out = m;
     return 0;
 }
