@@ -703,7 +703,7 @@ static int finish_output(int rc)
 /* ---- recipes: what every output carries, frac info, frac rerun ------------------------- */
 
 /* The recipe of this run (recipe.h), handed to the writers. text NULL: no
- * script (the REPL). */
+ * script text (--no-recipe drops it too). */
 /* Frame f of the range a..b:step: the names `frame` and `clock`, what %f
  * becomes, and the range for the recipe (run_frames, and rerun of a frame). */
 static void set_frame(interp *I, long f, long a, long b, long step)
@@ -870,7 +870,7 @@ static int rerun_prepare(interp *I, opts *o, recipe *r, char **text, size_t *len
         fprintf(stderr, "frac: error: '%s' cannot be rerun: %s\n", file,
                 r->has_script ? "the file carries the recipe's header only, not the script text (only PNG files "
                                 "carry it)"
-                              : "its recipe was written with --no-recipe (or from the REPL) and has no script text");
+                              : "its recipe was written with --no-recipe and has no script text");
         if (r->script_path[0] != '<') /* not <repl> */
             print_run_line(r);
         return EX_SCRIPT;
@@ -934,6 +934,27 @@ static int set_overrides(interp *I, const opts *o)
 
 static int rerun_apng(interp *T, opts *o, recipe *r);
 
+/* The REPL's recipe: the session so far as a script (repl.h), so a file
+ * saved in the REPL can be rerun. */
+typedef struct repl_recipe_ctx {
+    interp *I;
+    const opts *o;
+    recipe_store st;
+    int installed;
+} repl_recipe_ctx;
+
+static int repl_set_recipe(void *ud, const char *text, size_t len)
+{
+    repl_recipe_ctx *c = ud;
+    if (c->installed)
+        recipe_uninstall(&c->st);
+    c->installed = 0;
+    if (install_recipe(c->I, c->o, "<repl>", text, len, &c->st))
+        return -1;
+    c->installed = 1;
+    return 0;
+}
+
 static int run_frac(interp *I, opts *o)
 {
     int rc;
@@ -957,11 +978,14 @@ static int run_frac(interp *I, opts *o)
     if (strcmp(o->mode, "repl") == 0) {
         if (I->out_dir && (rc = make_out_dir(I->out_dir)))
             return rc;
-        recipe_store st;
-        if (install_recipe(I, o, "<repl>", NULL, 0, &st))
+        repl_recipe_ctx c;
+        memset(&c, 0, sizeof c);
+        c.I = I, c.o = o;
+        if (repl_set_recipe(&c, "", 0))
             return session_report(I);
-        rc = repl_main(I, &interrupted);
-        recipe_uninstall(&st);
+        rc = repl_main(I, &interrupted, repl_set_recipe, &c);
+        if (c.installed)
+            recipe_uninstall(&c.st);
         return rc;
     }
     if (strcmp(o->mode, "eval") == 0) {

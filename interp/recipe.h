@@ -42,7 +42,7 @@
 typedef struct recipe {
     char *version;
     char *script_path;
-    char sha256[65];   /* "" when absent (a REPL session) */
+    char sha256[65];   /* "" when absent (no script text was hashed) */
     uint64_t seed;
     int frame_given;
     long frame;

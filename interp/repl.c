@@ -47,7 +47,50 @@ typedef struct repl {
     int prev_first;
     value *snap; /* global values before it ran, one per binding then */
     size_t nsnap;
+    /* the session as a script, for the recipe (repl.h) */
+    bytebuf log;
+    size_t prev_mark; /* log's length before the previous entry */
+    repl_recipe_fn recipe;
+    void *recipe_ud;
 } repl;
+
+/* Add an entry's text to the log and install the recipe with it. Returns
+ * the log's length before, for log_end; -1 when the recipe could not be
+ * built (reported; the entry must not run). */
+static long log_begin(repl *r, const char *text, size_t len)
+{
+    size_t mark = r->log.len;
+    if (!r->recipe)
+        return (long)mark;
+    bytebuf_append(&r->log, text, len);
+    if (len && text[len - 1] != '\n')
+        bytebuf_byte(&r->log, '\n');
+    bytebuf_byte(&r->log, 0); /* NUL-terminated for the recipe's scan for clock */
+    r->log.len--;
+    if (r->log.failed || r->recipe(r->recipe_ud, (const char *)r->log.data, r->log.len)) {
+        r->log.failed = 0;
+        r->log.len = mark;
+        if (r->log.data)
+            r->log.data[mark] = 0;
+        fprintf(stderr, "error: out of memory building the recipe of the session\n");
+        r->failed = 1;
+        return -1;
+    }
+    return (long)mark;
+}
+
+/* After the entry: it stays in the log if it ran without error; otherwise
+ * the log (and the recipe) go back to what they were. */
+static void log_end(repl *r, long mark, int ok)
+{
+    if (!r->recipe || ok || mark < 0)
+        return;
+    r->log.len = (size_t)mark;
+    if (r->log.data)
+        r->log.data[mark] = 0;
+    if (r->recipe(r->recipe_ud, (const char *)r->log.data, r->log.len))
+        fprintf(stderr, "error: out of memory building the recipe of the session\n");
+}
 
 /* The tokens that continue a script's expression from the line before. */
 static int continues_previous(tok_type t) { return t == T_ELIF || t == T_ELSE || t == T_PIPE; }
@@ -229,7 +272,9 @@ static const char help_text[] =
     "Type any statement or expression; bare expressions print their value.\n"
     "Unfinished input continues on a '..' line; a line starting with elif, else\n"
     "or |> continues the entry before it (which then runs again, joined).\n"
-    "frame and clock are 0 here; `frac run --frames A..B` sets them (:help frame).\n";
+    "frame and clock are 0 here; `frac run --frames A..B` sets them (:help frame).\n"
+    "Files you save carry the session so far as their recipe: `frac rerun FILE`\n"
+    "makes them again (entries that failed are left out; docs/provenance.md).\n";
 
 static const char frame_help[] =
     "frame, clock\n"
@@ -289,12 +334,18 @@ static void cmd_vars(repl *r)
     }
 }
 
-static void eval_entry(repl *r, const char *text, int first_line, int timed)
+static void eval_entry(repl *r, const char *text, int first_line, int timed, int logged)
 {
     value v = val_nil();
     struct timespec t0, t1;
+    long mark = logged ? log_begin(r, text, strlen(text)) : 0;
+    if (mark < 0)
+        return;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    if (session_run_lines(r->I, "<repl>", text, strlen(text), first_line, 0, &v)) {
+    int bad = session_run_lines(r->I, "<repl>", text, strlen(text), first_line, 0, &v);
+    if (logged)
+        log_end(r, mark, !bad);
+    if (bad) {
         val_unref(r->I, v);
         report(r);
         return;
@@ -332,6 +383,7 @@ static int run_command(repl *r, char *line)
         if (fresh) {
             val_heap_unref(I, &I->globals->h);
             I->globals = fresh;
+            log_end(r, 0, 0); /* the session starts again: so does its script */
         }
     } else if (strcmp(cmd, "load") == 0) {
         unsigned char *text;
@@ -344,16 +396,19 @@ static int run_command(repl *r, char *line)
             fprintf(stderr, "error: %s\n", e.msg);
             r->failed = 1;
         } else {
-            if (session_run(I, arg, (char *)text, len, 0, NULL))
+            long mark = log_begin(r, (const char *)text, len);
+            int bad = mark < 0 || session_run(I, arg, (char *)text, len, 0, NULL);
+            log_end(r, mark, !bad);
+            if (bad && mark >= 0)
                 report(r);
             mem_free(I, text);
         }
     } else if (strcmp(cmd, "time") == 0) {
-        eval_entry(r, arg, r->line_no - 1, 1);
+        eval_entry(r, arg, r->line_no - 1, 1, 1);
     } else if (strcmp(cmd, "show") == 0) {
         char buf[512];
         snprintf(buf, sizeof buf, "show(%s)", arg);
-        eval_entry(r, buf, r->line_no - 1, 0);
+        eval_entry(r, buf, r->line_no - 1, 0, 0);
     } else {
         fprintf(stderr, "unknown command ':%s' (try :help)\n", cmd);
         r->failed = 1;
@@ -393,10 +448,13 @@ static int stdout_failed(repl *r)
     return 1;
 }
 
-int repl_main(interp *I, volatile sig_atomic_t *interrupted)
+int repl_main(interp *I, volatile sig_atomic_t *interrupted, repl_recipe_fn recipe, void *ud)
 {
     repl r = {0};
     r.I = I;
+    r.recipe = recipe;
+    r.recipe_ud = ud;
+    bytebuf_init(&r.log);
     r.in_tty = isatty(0);
     r.tty = r.in_tty && isatty(1);
     r.line_no = 1;
@@ -502,7 +560,11 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
             snap_restore(&r);
         else if (r.in_tty)
             snap_take(&r);
-        eval_entry(&r, text, first, 0);
+        if (joined) /* the entry before ran again as part of this one */
+            r.log.len = r.prev_mark;
+        else
+            r.prev_mark = r.log.len;
+        eval_entry(&r, text, first, 0, 1);
         if (r.in_tty) {
             rt_free(r.prev_text);
             r.prev_text = text;
@@ -517,6 +579,7 @@ int repl_main(interp *I, volatile sig_atomic_t *interrupted)
     rt_free(r.ahead);
     forget_prev(&r);
     lineedit_free(r.le);
+    bytebuf_free(&r.log);
     if (r.io_error)
         return 74;
     return r.failed && !r.tty ? 65 : 0;
