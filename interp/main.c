@@ -1265,10 +1265,11 @@ static int run_watch(interp *T, opts *o)
  * (all inputs must be files of one run, recipe_same_run) plus the assembly —
  * the output's name, delay, loop, and each input's frame and name — so that
  * `frac rerun` can render the frames again and assemble the same file.
- * Returns 1 with *ar built, 0 when the frames have no common recipe (a note
- * says why, unless quiet), -1 out of memory. */
-static int apng_recipe(const interp *I, unsigned char *const *data, const size_t *lens, const char **names, int n,
-                       const apng_opts *ao, const char *out, recipe *ar)
+ * Returns 1 with *ar built, 0 when the frames have no common recipe (note
+ * gets a line saying why, printed once the APNG is written), -1 out of
+ * memory. */
+static int apng_recipe(unsigned char *const *data, const size_t *lens, const char **names, int n,
+                       const apng_opts *ao, const char *out, recipe *ar, char *note, size_t noten)
 {
     char why[768] = "", err[256], one[256];
     int ok = 1;
@@ -1327,9 +1328,9 @@ static int apng_recipe(const interp *I, unsigned char *const *data, const size_t
     if (ok && !(ar->apng_output = rt_malloc(strlen(bn) + 1)))
         ok = -1;
     if (ok <= 0) {
-        if (!ok && !I->quiet)
-            fprintf(stderr, "frac: note: %s carries no recipe: the frames are not all files of one run with a "
-                            "recipe (%s)\n", out, why);
+        if (!ok)
+            snprintf(note, noten, "frac: note: %s carries no recipe: the frames are not all files of one run with a "
+                                  "recipe (%s)\n", out, why);
         recipe_free(ar);
         return ok;
     }
@@ -1358,8 +1359,9 @@ static int assemble_apng(interp *I, const char **names, int n, const apng_opts *
     }
     recipe built;
     int have = 0;
+    char note[1536] = "";
     if (rc == EX_OK && make_recipe) {
-        have = apng_recipe(I, data, lens, names, n, ao, out, &built);
+        have = apng_recipe(data, lens, names, n, ao, out, &built, note, sizeof note);
         if (have < 0) {
             mem_engine_error(I, "apng", "out of memory building the recipe");
             rc = session_report(I);
@@ -1387,7 +1389,7 @@ static int assemble_apng(interp *I, const char **names, int n, const apng_opts *
             fprintf(stderr, "frac: error: %s\n", e.msg);
             rc = c == RT_ENOMEM ? EX_SOFTWARE : c == RT_EIO ? EX_IO : EX_SCRIPT;
         } else if (!I->quiet) {
-            fprintf(stderr, "wrote %s (%d frames)\n", out, n);
+            fprintf(stderr, "%swrote %s (%d frames)\n", note, out, n);
         }
     }
     if (installed)
