@@ -109,7 +109,7 @@ FUZZ_HARNESSES := script $(FUZZ_LOADERS)
 FUZZ_SAN = -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
            -fsanitize-coverage-ignorelist=tests/fuzz/engines.ignorelist
 FUZZ_FLAGS = -timeout=10 -rss_limit_mb=1536 -malloc_limit_mb=1024 -print_final_stats=1
-FUZZ_SCRIPT_OBJ := $(filter-out $(BUILD)/interp/main.o,$(IN_OBJ))
+FUZZ_SCRIPT_OBJ := $(filter-out $(BUILD)/interp/main.o $(BUILD)/interp/cli_%.o,$(IN_OBJ))
 FUZZ_DIR := build-fuzz
 .PHONY: fuzz fuzz-build fuzz-bins fuzz-seeds fuzz-smoke $(FUZZ_HARNESSES:%=fuzz-%)
 
