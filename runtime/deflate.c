@@ -19,18 +19,27 @@
 
 /* ---------------------------------------------------------------- checksums */
 
-static uint32_t crc_table[256];
+/* Reflected CRC-32, polynomial 0xEDB88320 (PNG spec annex D, ISO 3309).
+ * crc_table[0] is the byte-at-a-time table; crc_table[k][b] is the CRC of
+ * byte b followed by k zero bytes, so eight table look-ups advance the CRC
+ * over eight input bytes at once ("slicing by 8": the CRC is linear, the
+ * eight bytes' contributions are independent and combine by XOR). */
+static uint32_t crc_table[8][256];
 static pthread_once_t crc_once = PTHREAD_ONCE_INIT;
 
 static void crc_init(void)
 {
-    /* reflected CRC-32, polynomial 0xEDB88320 (PNG spec annex D, ISO 3309) */
     for (uint32_t i = 0; i < 256; i++) {
         uint32_t c = i;
         for (int k = 0; k < 8; k++)
             c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        crc_table[i] = c;
+        crc_table[0][i] = c;
     }
+    for (int k = 1; k < 8; k++)
+        for (int i = 0; i < 256; i++) {
+            uint32_t c = crc_table[k - 1][i];
+            crc_table[k][i] = crc_table[0][c & 0xFF] ^ (c >> 8);
+        }
 }
 
 uint32_t deflate_crc32(uint32_t crc, const void *p, size_t n)
@@ -38,8 +47,15 @@ uint32_t deflate_crc32(uint32_t crc, const void *p, size_t n)
     pthread_once(&crc_once, crc_init);
     const unsigned char *s = p;
     uint32_t c = crc ^ 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++)
-        c = crc_table[(c ^ s[i]) & 0xFF] ^ (c >> 8);
+    for (; n >= 8; n -= 8, s += 8) {
+        uint32_t lo = c ^ ((uint32_t)s[0] | (uint32_t)s[1] << 8 | (uint32_t)s[2] << 16 |
+                           (uint32_t)s[3] << 24);
+        c = crc_table[7][lo & 0xFF] ^ crc_table[6][(lo >> 8) & 0xFF] ^
+            crc_table[5][(lo >> 16) & 0xFF] ^ crc_table[4][lo >> 24] ^ crc_table[3][s[4]] ^
+            crc_table[2][s[5]] ^ crc_table[1][s[6]] ^ crc_table[0][s[7]];
+    }
+    while (n--)
+        c = crc_table[0][(c ^ *s++) & 0xFF] ^ (c >> 8);
     return c ^ 0xFFFFFFFFu;
 }
 
@@ -52,6 +68,16 @@ uint32_t deflate_adler32(uint32_t adler, const void *p, size_t n)
     while (n > 0) {
         size_t k = n < 5552 ? n : 5552;
         n -= k;
+        for (; k >= 8; k -= 8, s += 8) {
+            a += s[0], b += a;
+            a += s[1], b += a;
+            a += s[2], b += a;
+            a += s[3], b += a;
+            a += s[4], b += a;
+            a += s[5], b += a;
+            a += s[6], b += a;
+            a += s[7], b += a;
+        }
         while (k--) {
             a += *s++;
             b += a;
@@ -329,6 +355,44 @@ static inline void dist_sym(int dist, int *sym, int *nextra, int *extra)
     }
 }
 
+/* The same mappings as tables, built once from len_sym and dist_sym: for
+ * length l, len_tab[l - 3] = symbol - 257; for distance d, the symbol is
+ * dist_tab[d - 1] if d <= 256, else dist_tab[256 + ((d - 1) >> 7)] (above
+ * 256 every symbol covers a multiple of 128 distances). sym_nx/sym_base:
+ * extra-bit count and first value of each length (0..28) and distance
+ * (32 + 0..29) symbol. */
+static uint8_t len_tab[256], dist_tab[512], sym_nx[64];
+static uint16_t sym_base[64];
+static pthread_once_t tab_once = PTHREAD_ONCE_INIT;
+
+static void tab_init(void)
+{
+    for (int l = 3; l <= 258; l++) {
+        int sym, nx, x;
+        len_sym(l, &sym, &nx, &x);
+        len_tab[l - 3] = (uint8_t)(sym - 257);
+        sym_nx[sym - 257] = (uint8_t)nx;
+        if (x == 0)
+            sym_base[sym - 257] = (uint16_t)l;
+    }
+    for (int d = 1; d <= 32768; d++) {
+        int sym, nx, x;
+        dist_sym(d, &sym, &nx, &x);
+        if (d <= 256)
+            dist_tab[d - 1] = (uint8_t)sym;
+        else
+            dist_tab[256 + ((d - 1) >> 7)] = (uint8_t)sym;
+        sym_nx[32 + sym] = (uint8_t)nx;
+        if (x == 0)
+            sym_base[32 + sym] = (uint16_t)d;
+    }
+}
+
+static inline int dist_code(int d)
+{
+    return d <= 256 ? dist_tab[d - 1] : dist_tab[256 + ((d - 1) >> 7)];
+}
+
 /* ---------------------------------------------------------------- LZ77 */
 
 #define WSIZE 32768
@@ -413,12 +477,21 @@ static int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_le
                 uint64_t a, b;
                 memcpy(&a, m + len, 8);
                 memcpy(&b, s + len, 8);
-                if (a != b)
+                if (a != b) {
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+                    len += __builtin_ctzll(a ^ b) >> 3; /* first differing byte */
+                    goto counted;
+#else
                     break;
+#endif
+                }
                 len += 8;
             }
             while (len < maxlen && m[len] == s[len])
                 len++;
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        counted:
+#endif
             if (len > best) {
                 best = len;
                 found = 1;
@@ -449,27 +522,49 @@ static void fixed_lengths(uint8_t *ll, uint8_t *dl)
         dl[i] = 5;
 }
 
+/* Write the block's symbols and its end code. Space for the worst case
+ * (48 bits per symbol: 15 + 5 + 15 + 13) is reserved first, so the loop
+ * keeps the bit buffer in registers and stores 4 bytes whenever 32 bits are
+ * pending, with no capacity checks. */
 static void write_symbols(deflater *d, const uint8_t *ll, const uint16_t *lc, const uint8_t *dl,
                           const uint16_t *dc)
 {
     bitw *w = &d->w;
+    if (!bw_reserve(w, (size_t)d->nsyms * 6 + 16))
+        return;
+    uint64_t bits = w->bits;
+    int nbits = w->nbits;
+    unsigned char *o = w->buf + w->len;
+#define PUTBITS(v, n)                                                                              \
+    do {                                                                                           \
+        bits |= (uint64_t)(v) << nbits;                                                            \
+        nbits += (n);                                                                              \
+        if (nbits >= 32) {                                                                         \
+            o[0] = (unsigned char)bits, o[1] = (unsigned char)(bits >> 8);                        \
+            o[2] = (unsigned char)(bits >> 16), o[3] = (unsigned char)(bits >> 24);               \
+            o += 4;                                                                                \
+            bits >>= 32;                                                                           \
+            nbits -= 32;                                                                           \
+        }                                                                                          \
+    } while (0)
     for (int i = 0; i < d->nsyms; i++) {
         int v = d->sym_ll[i], dist = d->sym_d[i];
         if (dist == 0) {
-            bw_put(w, lc[v], ll[v]);
+            PUTBITS(lc[v], ll[v]);
         } else {
-            int sym, nx, x;
-            len_sym(v, &sym, &nx, &x);
-            bw_put(w, lc[sym], ll[sym]);
-            if (nx)
-                bw_put(w, (uint32_t)x, nx);
-            dist_sym(dist, &sym, &nx, &x);
-            bw_put(w, dc[sym], dl[sym]);
-            if (nx)
-                bw_put(w, (uint32_t)x, nx);
+            int ls = len_tab[v - 3], ds = dist_code(dist);
+            /* code and extra bits together: at most 15 + 5 and 15 + 13 bits */
+            PUTBITS(lc[257 + ls] | (uint32_t)(v - sym_base[ls]) << ll[257 + ls],
+                    ll[257 + ls] + sym_nx[ls]);
+            PUTBITS(dc[ds] | (uint32_t)(dist - sym_base[32 + ds]) << dl[ds],
+                    dl[ds] + sym_nx[32 + ds]);
         }
     }
-    bw_put(w, lc[256], ll[256]);
+    PUTBITS(lc[256], ll[256]);
+#undef PUTBITS
+    w->len = (size_t)(o - w->buf);
+    w->bits = bits;
+    w->nbits = nbits;
 }
 
 /* Emit the pending symbols as one block (or several stored blocks). */
@@ -642,13 +737,10 @@ static inline void emit_lit(deflater *d, int c)
 
 static inline void emit_match(deflater *d, int len, int dist)
 {
-    int sym, nx, x;
     d->sym_ll[d->nsyms] = (uint16_t)len;
     d->sym_d[d->nsyms++] = (uint16_t)dist; /* 32768 fits in 16 bits */
-    len_sym(len, &sym, &nx, &x);
-    d->lfreq[sym]++;
-    dist_sym(dist, &sym, &nx, &x);
-    d->dfreq[sym]++;
+    d->lfreq[257 + len_tab[len - 3]]++;
+    d->dfreq[dist_code(dist)]++;
     d->covered += (size_t)len;
     if (d->nsyms == BLOCK_SYMS)
         flush_block(d, 0, 0);
@@ -722,6 +814,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     d->in = in ? in : no_input;
     d->n = n;
     d->cfg = level_cfgs[level];
+    pthread_once(&tab_once, tab_init);
     d->w = *w;
     if (level > 0) {
         d->head = rt_malloc(HSIZE * sizeof *d->head);
