@@ -6,9 +6,10 @@
  * memory, so positions are absolute and the 32 KiB window is enforced by a
  * distance check instead of sliding a buffer) -> symbols buffered per block
  * -> for each block the smallest of dynamic Huffman, fixed Huffman and stored
- * (RFC 1951 §3.2.4–3.2.7). The lazy-matching rule and the per-level
- * parameters (good/lazy/nice/chain) are zlib's, so level 6 behaves like
- * zlib's level 6; the code itself is ours.
+ * (RFC 1951 §3.2.4–3.2.7). The lazy-matching rule and the parameters of
+ * levels 6..9 (good/lazy/nice/chain, 3-byte hash) are zlib's, so level 6
+ * behaves like zlib's level 6; levels 1..5 hash 4 bytes (see level_cfgs).
+ * The code itself is ours.
  */
 #include "deflate.h"
 #include "rt_alloc.h"
@@ -398,25 +399,33 @@ static inline int dist_code(int d)
 #define WSIZE 32768
 #define WMASK (WSIZE - 1)
 #define MAX_DIST 32768
-#define HBITS 15
-#define HSIZE (1 << HBITS)
+#define HBITS_MAX 16
 #define MIN_MATCH 3
 #define MAX_MATCH 258
 #define TOO_FAR 4096
 #define BLOCK_SYMS 16384
 
 typedef struct level_cfg {
-    int good, lazy, nice, chain, lazy_mode;
+    int good, lazy, nice, chain, lazy_mode, hlen, hbits;
 } level_cfg;
 
-/* zlib's configuration table (deflate.c, configuration_table); for the
- * greedy levels 1..3 "lazy" is the longest match whose positions are all
- * inserted into the hash chains. */
+/* Levels 6..9 are zlib's configuration table (deflate.c,
+ * configuration_table) with its 3-byte hash of 15 bits, so level 6 behaves
+ * like zlib's level 6. Levels 1..5 are ours: they hash 4 bytes into 16 bits,
+ * so a chain holds only positions that share 4 bytes (a 3-byte hash chains
+ * every position that shares 3 bytes, or just the hash, and most of the
+ * walk is spent rejecting them); 3-byte matches are then found only by
+ * chance, which costs little on image data, where a 3-byte match is seldom
+ * cheaper than its literals. Levels 2..5 match lazily. On filtered PNG rows
+ * (bench/README_png.md) level 2 runs at about the speed of zlib's level 2
+ * and gives files the size of zlib's level 6 or smaller. For the greedy
+ * level 1 "lazy" is the longest match whose positions are all inserted into
+ * the hash chains. */
 static const level_cfg level_cfgs[10] = {
-    {0, 0, 0, 0, 0},         {4, 4, 8, 4, 0},       {4, 5, 16, 8, 0},
-    {4, 6, 32, 32, 0},       {4, 4, 16, 16, 1},     {8, 16, 32, 32, 1},
-    {8, 16, 128, 128, 1},    {8, 32, 128, 256, 1},  {32, 128, 258, 1024, 1},
-    {32, 258, 258, 4096, 1},
+    {0, 0, 0, 0, 0, 3, 15},         {4, 4, 8, 4, 0, 4, 16},         {4, 4, 16, 8, 1, 4, 16},
+    {4, 4, 16, 16, 1, 4, 16},       {4, 8, 32, 32, 1, 4, 16},       {8, 16, 64, 64, 1, 4, 16},
+    {8, 16, 128, 128, 1, 3, 15},    {8, 32, 128, 256, 1, 3, 15},    {32, 128, 258, 1024, 1, 3, 15},
+    {32, 258, 258, 4096, 1, 3, 15},
 };
 
 typedef struct deflater {
@@ -431,16 +440,27 @@ typedef struct deflater {
     bitw w;
 } deflater;
 
-static inline uint32_t hash3(const unsigned char *p)
+/* Hash of the cfg.hlen (3 or 4) bytes at p into cfg.hbits bits; the bytes
+ * are combined in a fixed order, so the output is the same on any byte
+ * order. */
+static inline uint32_t hash_at(const deflater *d, const unsigned char *p)
 {
-    uint32_t v = ((uint32_t)p[0] << 16) | ((uint32_t)p[1] << 8) | p[2];
-    return (v * 2654435761u) >> (32 - HBITS);
+    uint32_t v = d->cfg.hlen == 4 ? (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
+                                        (uint32_t)p[3] << 24
+                                  : ((uint32_t)p[0] << 16) | ((uint32_t)p[1] << 8) | p[2];
+    return (v * 2654435761u) >> (32 - d->cfg.hbits);
 }
 
-/* Insert position pos (pos + 2 < n) and return the previous chain head. */
+/* Can position pos be hashed (cfg.hlen bytes from pos inside the input)? */
+static inline int hashable(const deflater *d, size_t pos)
+{
+    return pos + (size_t)d->cfg.hlen <= d->n;
+}
+
+/* Insert position pos (hashable) and return the previous chain head. */
 static inline int32_t insert_pos(deflater *d, size_t pos)
 {
-    uint32_t h = hash3(d->in + pos);
+    uint32_t h = hash_at(d, d->in + pos);
     int32_t old = d->head[h];
     d->prev[pos & WMASK] = old;
     d->head[h] = (int32_t)pos;
@@ -449,7 +469,7 @@ static inline int32_t insert_pos(deflater *d, size_t pos)
 
 /* Longest match for pos among the chain starting at cur that is longer than
  * prev_len (and >= MIN_MATCH); returns its length or 0. */
-static int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_len, int *mdist)
+static inline int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_len, int *mdist)
 {
     const unsigned char *s = d->in + pos;
     size_t avail = d->n - pos;
@@ -750,14 +770,14 @@ static void lz_greedy(deflater *d)
 {
     size_t n = d->n, pos = 0;
     while (pos < n) {
-        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int32_t hh = hashable(d, pos) ? insert_pos(d, pos) : -1;
         int ml = 0, md = 0;
-        if (hh >= 0)
+        if (hh >= 0 && pos - (size_t)hh <= MAX_DIST)
             ml = longest_match(d, pos, hh, 0, &md);
         if (ml >= MIN_MATCH) {
             emit_match(d, ml, md);
             if (ml <= d->cfg.lazy)
-                for (size_t p = pos + 1; p < pos + (size_t)ml && p + 2 < n; p++)
+                for (size_t p = pos + 1; p < pos + (size_t)ml && hashable(d, p); p++)
                     insert_pos(d, p);
             pos += (size_t)ml;
         } else {
@@ -774,10 +794,10 @@ static void lz_lazy(deflater *d)
     size_t n = d->n, pos = 0;
     int match_len = 0, match_dist = 0, avail = 0;
     while (pos < n) {
-        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int32_t hh = hashable(d, pos) ? insert_pos(d, pos) : -1;
         int prev_len = match_len, prev_dist = match_dist;
         match_len = 0;
-        if (hh >= 0 && prev_len < d->cfg.lazy) {
+        if (hh >= 0 && pos - (size_t)hh <= MAX_DIST && prev_len < d->cfg.lazy) {
             match_len = longest_match(d, pos, hh, prev_len, &match_dist);
             if (match_len == MIN_MATCH && match_dist > TOO_FAR)
                 match_len = 0;
@@ -785,7 +805,7 @@ static void lz_lazy(deflater *d)
         if (prev_len >= MIN_MATCH && match_len <= prev_len) {
             emit_match(d, prev_len, prev_dist);
             size_t end = pos - 1 + (size_t)prev_len;
-            for (size_t p = pos + 1; p < end && p + 2 < n; p++)
+            for (size_t p = pos + 1; p < end && hashable(d, p); p++)
                 insert_pos(d, p);
             pos = end;
             avail = 0;
@@ -817,7 +837,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     pthread_once(&tab_once, tab_init);
     d->w = *w;
     if (level > 0) {
-        d->head = rt_malloc(HSIZE * sizeof *d->head);
+        d->head = rt_malloc(((size_t)1 << HBITS_MAX) * sizeof *d->head);
         d->prev = rt_malloc(WSIZE * sizeof *d->prev);
         d->sym_ll = rt_malloc(BLOCK_SYMS * sizeof *d->sym_ll);
         d->sym_d = rt_malloc(BLOCK_SYMS * sizeof *d->sym_d);
@@ -827,7 +847,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
             rt_free(d);
             return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
         }
-        for (int i = 0; i < HSIZE; i++)
+        for (int i = 0; i < (1 << d->cfg.hbits); i++)
             d->head[i] = -1;
         for (int i = 0; i < WSIZE; i++)
             d->prev[i] = -1;
