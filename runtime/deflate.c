@@ -407,6 +407,7 @@ static inline int dist_code(int d)
 
 typedef struct level_cfg {
     int good, lazy, nice, chain, lazy_mode, hlen, hbits;
+    int insert_max; /* lazy levels: a longer match inserts only its last 2 positions (0: all) */
 } level_cfg;
 
 /* Levels 6..9 are zlib's configuration table (deflate.c,
@@ -416,16 +417,20 @@ typedef struct level_cfg {
  * every position that shares 3 bytes, or just the hash, and most of the
  * walk is spent rejecting them); 3-byte matches are then found only by
  * chance, which costs little on image data, where a 3-byte match is seldom
- * cheaper than its literals. Levels 2..5 match lazily. On filtered PNG rows
+ * cheaper than its literals. Levels 2..5 match lazily; level 2 inserts
+ * only the last 2 positions of a match longer than 16 into the chains
+ * (long matches are runs and repeats, whose inner positions seldom start a
+ * better match; inserting them was a third of the time on images with empty
+ * areas). On filtered PNG rows
  * (bench/README_png.md) level 2 runs at about the speed of zlib's level 2
  * and gives files the size of zlib's level 6 or smaller. For the greedy
  * level 1 "lazy" is the longest match whose positions are all inserted into
  * the hash chains. */
 static const level_cfg level_cfgs[10] = {
-    {0, 0, 0, 0, 0, 3, 15},         {4, 4, 8, 4, 0, 4, 16},         {4, 4, 16, 8, 1, 4, 16},
-    {4, 4, 16, 16, 1, 4, 16},       {4, 8, 32, 32, 1, 4, 16},       {8, 16, 64, 64, 1, 4, 16},
-    {8, 16, 128, 128, 1, 3, 15},    {8, 32, 128, 256, 1, 3, 15},    {32, 128, 258, 1024, 1, 3, 15},
-    {32, 258, 258, 4096, 1, 3, 15},
+    {0, 0, 0, 0, 0, 3, 15, 0},        {4, 4, 8, 4, 0, 4, 16, 0},        {4, 8, 64, 16, 1, 4, 16, 16},
+    {4, 8, 64, 32, 1, 4, 16, 0},      {8, 16, 64, 64, 1, 4, 16, 0},     {8, 16, 128, 64, 1, 4, 16, 0},
+    {8, 16, 128, 128, 1, 3, 15, 0},   {8, 32, 128, 256, 1, 3, 15, 0},   {32, 128, 258, 1024, 1, 3, 15, 0},
+    {32, 258, 258, 4096, 1, 3, 15, 0},
 };
 
 typedef struct deflater {
@@ -804,8 +809,10 @@ static void lz_lazy(deflater *d)
         }
         if (prev_len >= MIN_MATCH && match_len <= prev_len) {
             emit_match(d, prev_len, prev_dist);
-            size_t end = pos - 1 + (size_t)prev_len;
-            for (size_t p = pos + 1; p < end && hashable(d, p); p++)
+            size_t end = pos - 1 + (size_t)prev_len, p = pos + 1;
+            if (d->cfg.insert_max && prev_len > d->cfg.insert_max)
+                p = end - 2;
+            for (; p < end && hashable(d, p); p++)
                 insert_pos(d, p);
             pos = end;
             avail = 0;

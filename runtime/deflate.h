@@ -10,7 +10,7 @@
  *
  *   level 0      stored blocks only (no compression; fastest)
  *   level 1      greedy matching, chains of 4, 4-byte hash
- *   level 2..5   lazy matching, chains of 8..64, 4-byte hash (2 is PNG's
+ *   level 2..5   lazy matching, chains of 16..64, 4-byte hash (2 is PNG's
  *                default: about zlib level 2's speed, zlib level 6's size
  *                on image data)
  *   level 6..9   lazy matching, longer chains, 3-byte hash: zlib's

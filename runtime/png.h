@@ -14,7 +14,7 @@
  * the smallest sum of absolute values as signed bytes (the heuristic of the
  * PNG specification §12.8, as libpng uses it); ties go to the lower type.
  * The filtered rows are deflated at PNG_DEFAULT_LEVEL = 2 (deflate.h: lazy
- * matching over chains of 8 positions that share 4 bytes). On the
+ * matching over chains of 16 positions that share 4 bytes). On the
  * benchmark images (bench/README_png.md) it runs at about the speed of
  * zlib's level 2 and gives files within a few per cent of zlib's level 6,
  * smaller on noisy and 16-bit images; png_encode_samples takes any level.

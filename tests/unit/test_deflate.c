@@ -119,6 +119,12 @@ static void test_roundtrips(void)
     size_t zrun = roundtrip(run, n, 6, "run");
     CHECK(zrun < 400, "a run of %zu bytes compressed to %zu bytes", n, zrun);
     roundtrip(run, n, 1, "run");
+    /* levels 2..5 (4-byte hash; level 2 inserts only the ends of long matches) */
+    for (int level = 2; level <= 5; level++) {
+        size_t zl = roundtrip(run, n, level, "run");
+        CHECK(zl < 400, "level %d: a run of %zu bytes compressed to %zu bytes", level, n, zl);
+        roundtrip(r, n, level, "random");
+    }
 
     /* repetitive with distances up to 32768: a random block repeated at 32768 */
     unsigned char *far = rt_malloc(70000);
@@ -130,6 +136,10 @@ static void test_roundtrips(void)
     /* the second copy must be found at distance exactly 32768 (the window) */
     CHECK(zfar < 32768 + 2000, "period-32768 data compressed to %zu bytes", zfar);
     roundtrip(far, 70000, 6, "distance 32768");
+    for (int level = 2; level <= 5; level++) {
+        size_t zl = roundtrip(far, 70000, level, "distance 32768");
+        CHECK(zl < 32768 + 2000, "level %d: period-32768 data compressed to %zu bytes", level, zl);
+    }
     /* a period one beyond the window cannot be matched */
     unsigned char *far2 = rt_malloc(65538);
     memcpy(far2, blk, 32768);
@@ -143,6 +153,8 @@ static void test_roundtrips(void)
     bytebuf_init(&t);
     gen_text(&t);
     size_t zt = roundtrip(t.data, t.len, 6, "text");
+    for (int level = 2; level <= 5; level++)
+        roundtrip(t.data, t.len, level, "text");
     CHECK(zt <= 1544 * 115 / 100, "text: %zu bytes vs zlib level 6's 1544", zt);
     bytebuf_free(&t);
 
@@ -174,6 +186,7 @@ static void test_roundtrips(void)
     }
     roundtrip(fib.data, fib.len, 6, "fibonacci");
     roundtrip(fib.data, fib.len, 1, "fibonacci");
+    roundtrip(fib.data, fib.len, 2, "fibonacci");
     bytebuf_free(&fib);
     rt_free(r);
     rt_free(run);
