@@ -1,7 +1,9 @@
 /* png_bench.c — PNG encoding speed and size on two deterministic 1024×1024
  * images: "texture", RGB 8-bit (smooth gradients + noise-like detail), and
  * "turb16", RGB 16-bit smooth (5-octave turbulence (3 cycles per image at the base) through a colour ramp,
- * the kind of image a field render saves at 16 bits).
+ * the kind of image a field render saves at 16 bits), and "render8", RGBA
+ * 8-bit: a soft turbulent ball on a transparent background (like a
+ * raymarched hypertexture: large empty areas, smooth detail).
  *
  *   build/bench/png_bench [PREFIX]
  *
@@ -83,15 +85,40 @@ static void make_turb16(unsigned char *px)
         }
 }
 
+/* RGBA 8-bit: inside a disc of radius 0.4 (image widths) colour and alpha
+ * follow 4-octave turbulence and the distance from the centre; outside all
+ * zero. */
+static void make_render8(unsigned char *px)
+{
+    noise_perm np;
+    noise_perm_init(&np, 3);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            double u = x / (double)W - 0.5, v = y / (double)H - 0.5, r = sqrt(u * u + v * v);
+            unsigned char *p = px + 4 * ((size_t)y * W + (size_t)x);
+            if (r >= 0.4) {
+                p[0] = p[1] = p[2] = p[3] = 0;
+                continue;
+            }
+            double t = noise_turbulence3(&np, 4, 4.0 * u, 4.0 * v, 0.61);
+            double a = (1 - r / 0.4) * (0.4 + t);
+            a = a > 1 ? 1 : a;
+            p[0] = clamp8(255 * a);
+            p[1] = clamp8(255 * a * (0.3 + 0.7 * t));
+            p[2] = clamp8(255 * a * t * t);
+            p[3] = clamp8(255 * a);
+        }
+}
+
 /* Encode once at level; returns seconds, fills *size. */
-static double encode_once(const unsigned char *px, int bits, int level, size_t *size,
+static double encode_once(const unsigned char *px, int channels, int bits, int level, size_t *size,
                           bytebuf *filtered, const char *save)
 {
     bytebuf out;
     bytebuf_init(&out);
     rt_error e;
     double t0 = now();
-    rt_code c = png_encode_samples(px, W, H, 3, bits, level, &out, filtered, &e);
+    rt_code c = png_encode_samples(px, W, H, channels, bits, level, &out, filtered, &e);
     double t1 = now();
     if (c) {
         fprintf(stderr, "png_bench: %s\n", e.msg);
@@ -106,9 +133,10 @@ static double encode_once(const unsigned char *px, int bits, int level, size_t *
     return t1 - t0;
 }
 
-static void run_image(const char *name, const unsigned char *px, int bits, const char *prefix)
+static void run_image(const char *name, const unsigned char *px, int channels, int bits,
+                      const char *prefix)
 {
-    size_t raw = (size_t)W * H * 3 * (size_t)bits / 8;
+    size_t raw = (size_t)W * H * (size_t)channels * (size_t)bits / 8;
     unsigned char *copy = malloc(raw);
     if (!copy)
         exit(1);
@@ -127,7 +155,7 @@ static void run_image(const char *name, const unsigned char *px, int bits, const
         if (t1 - t0 < t_memcpy)
             t_memcpy = t1 - t0;
         for (int k = 0; k < 4; k++) {
-            double s = encode_once(px, bits, levels[k], &size[k], NULL,
+            double s = encode_once(px, channels, bits, levels[k], &size[k], NULL,
                                    r == 0 && k == 2 ? png_path : NULL);
             if (s < t[k])
                 t[k] = s;
@@ -136,15 +164,15 @@ static void run_image(const char *name, const unsigned char *px, int bits, const
     bytebuf filt;
     bytebuf_init(&filt);
     size_t dummy;
-    encode_once(px, bits, 0, &dummy, &filt, NULL);
+    encode_once(px, channels, bits, 0, &dummy, &filt, NULL);
     rt_error e;
     if (fileio_write_atomic(bin_path, filt.data, filt.len, &e)) {
         fprintf(stderr, "png_bench: %s\n", e.msg);
         exit(1);
     }
     double mb = raw / 1e6;
-    printf("png_bench %s: %dx%d RGB %d-bit, %.2f MB raw pixels, best of %d (checksum %u)\n",
-           name, W, H, bits, mb, RUNS, sum);
+    printf("png_bench %s: %dx%d %s %d-bit, %.2f MB raw pixels, best of %d (checksum %u)\n",
+           name, W, H, channels == 4 ? "RGBA" : "RGB", bits, mb, RUNS, sum);
     printf("  memcpy (baseline)      %8.1f MB/s\n", mb / t_memcpy);
     for (int k = 0; k < 4; k++)
         printf("  PNG level %d%-12s %8.1f MB/s  %9zu bytes  time %6.1fx memcpy\n", levels[k],
@@ -162,9 +190,11 @@ int main(int argc, char **argv)
     if (!px)
         return 1;
     make_texture(px);
-    run_image("texture", px, 8, prefix);
+    run_image("texture", px, 3, 8, prefix);
     make_turb16(px);
-    run_image("turb16", px, 16, prefix);
+    run_image("turb16", px, 3, 16, prefix);
+    make_render8(px);
+    run_image("render8", px, 4, 8, prefix);
     free(px);
     return 0;
 }
