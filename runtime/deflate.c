@@ -6,9 +6,10 @@
  * memory, so positions are absolute and the 32 KiB window is enforced by a
  * distance check instead of sliding a buffer) -> symbols buffered per block
  * -> for each block the smallest of dynamic Huffman, fixed Huffman and stored
- * (RFC 1951 §3.2.4–3.2.7). The lazy-matching rule and the per-level
- * parameters (good/lazy/nice/chain) are zlib's, so level 6 behaves like
- * zlib's level 6; the code itself is ours.
+ * (RFC 1951 §3.2.4–3.2.7). The lazy-matching rule and the parameters of
+ * levels 6..9 (good/lazy/nice/chain, 3-byte hash) are zlib's, so level 6
+ * behaves like zlib's level 6; levels 1..5 hash 4 bytes (see level_cfgs).
+ * The code itself is ours.
  */
 #include "deflate.h"
 #include "rt_alloc.h"
@@ -19,18 +20,27 @@
 
 /* ---------------------------------------------------------------- checksums */
 
-static uint32_t crc_table[256];
+/* Reflected CRC-32, polynomial 0xEDB88320 (PNG spec annex D, ISO 3309).
+ * crc_table[0] is the byte-at-a-time table; crc_table[k][b] is the CRC of
+ * byte b followed by k zero bytes, so eight table look-ups advance the CRC
+ * over eight input bytes at once ("slicing by 8": the CRC is linear, the
+ * eight bytes' contributions are independent and combine by XOR). */
+static uint32_t crc_table[8][256];
 static pthread_once_t crc_once = PTHREAD_ONCE_INIT;
 
 static void crc_init(void)
 {
-    /* reflected CRC-32, polynomial 0xEDB88320 (PNG spec annex D, ISO 3309) */
     for (uint32_t i = 0; i < 256; i++) {
         uint32_t c = i;
         for (int k = 0; k < 8; k++)
             c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        crc_table[i] = c;
+        crc_table[0][i] = c;
     }
+    for (int k = 1; k < 8; k++)
+        for (int i = 0; i < 256; i++) {
+            uint32_t c = crc_table[k - 1][i];
+            crc_table[k][i] = crc_table[0][c & 0xFF] ^ (c >> 8);
+        }
 }
 
 uint32_t deflate_crc32(uint32_t crc, const void *p, size_t n)
@@ -38,8 +48,15 @@ uint32_t deflate_crc32(uint32_t crc, const void *p, size_t n)
     pthread_once(&crc_once, crc_init);
     const unsigned char *s = p;
     uint32_t c = crc ^ 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++)
-        c = crc_table[(c ^ s[i]) & 0xFF] ^ (c >> 8);
+    for (; n >= 8; n -= 8, s += 8) {
+        uint32_t lo = c ^ ((uint32_t)s[0] | (uint32_t)s[1] << 8 | (uint32_t)s[2] << 16 |
+                           (uint32_t)s[3] << 24);
+        c = crc_table[7][lo & 0xFF] ^ crc_table[6][(lo >> 8) & 0xFF] ^
+            crc_table[5][(lo >> 16) & 0xFF] ^ crc_table[4][lo >> 24] ^ crc_table[3][s[4]] ^
+            crc_table[2][s[5]] ^ crc_table[1][s[6]] ^ crc_table[0][s[7]];
+    }
+    while (n--)
+        c = crc_table[0][(c ^ *s++) & 0xFF] ^ (c >> 8);
     return c ^ 0xFFFFFFFFu;
 }
 
@@ -52,6 +69,16 @@ uint32_t deflate_adler32(uint32_t adler, const void *p, size_t n)
     while (n > 0) {
         size_t k = n < 5552 ? n : 5552;
         n -= k;
+        for (; k >= 8; k -= 8, s += 8) {
+            a += s[0], b += a;
+            a += s[1], b += a;
+            a += s[2], b += a;
+            a += s[3], b += a;
+            a += s[4], b += a;
+            a += s[5], b += a;
+            a += s[6], b += a;
+            a += s[7], b += a;
+        }
         while (k--) {
             a += *s++;
             b += a;
@@ -329,30 +356,81 @@ static inline void dist_sym(int dist, int *sym, int *nextra, int *extra)
     }
 }
 
+/* The same mappings as tables, built once from len_sym and dist_sym: for
+ * length l, len_tab[l - 3] = symbol - 257; for distance d, the symbol is
+ * dist_tab[d - 1] if d <= 256, else dist_tab[256 + ((d - 1) >> 7)] (above
+ * 256 every symbol covers a multiple of 128 distances). sym_nx/sym_base:
+ * extra-bit count and first value of each length (0..28) and distance
+ * (32 + 0..29) symbol. */
+static uint8_t len_tab[256], dist_tab[512], sym_nx[64];
+static uint16_t sym_base[64];
+static pthread_once_t tab_once = PTHREAD_ONCE_INIT;
+
+static void tab_init(void)
+{
+    for (int l = 3; l <= 258; l++) {
+        int sym, nx, x;
+        len_sym(l, &sym, &nx, &x);
+        len_tab[l - 3] = (uint8_t)(sym - 257);
+        sym_nx[sym - 257] = (uint8_t)nx;
+        if (x == 0)
+            sym_base[sym - 257] = (uint16_t)l;
+    }
+    for (int d = 1; d <= 32768; d++) {
+        int sym, nx, x;
+        dist_sym(d, &sym, &nx, &x);
+        if (d <= 256)
+            dist_tab[d - 1] = (uint8_t)sym;
+        else
+            dist_tab[256 + ((d - 1) >> 7)] = (uint8_t)sym;
+        sym_nx[32 + sym] = (uint8_t)nx;
+        if (x == 0)
+            sym_base[32 + sym] = (uint16_t)d;
+    }
+}
+
+static inline int dist_code(int d)
+{
+    return d <= 256 ? dist_tab[d - 1] : dist_tab[256 + ((d - 1) >> 7)];
+}
+
 /* ---------------------------------------------------------------- LZ77 */
 
 #define WSIZE 32768
 #define WMASK (WSIZE - 1)
 #define MAX_DIST 32768
-#define HBITS 15
-#define HSIZE (1 << HBITS)
+#define HBITS_MAX 16
 #define MIN_MATCH 3
 #define MAX_MATCH 258
 #define TOO_FAR 4096
 #define BLOCK_SYMS 16384
 
 typedef struct level_cfg {
-    int good, lazy, nice, chain, lazy_mode;
+    int good, lazy, nice, chain, lazy_mode, hlen, hbits;
+    int insert_max; /* lazy levels: a longer match inserts only its last 2 positions (0: all) */
 } level_cfg;
 
-/* zlib's configuration table (deflate.c, configuration_table); for the
- * greedy levels 1..3 "lazy" is the longest match whose positions are all
- * inserted into the hash chains. */
+/* Levels 6..9 are zlib's configuration table (deflate.c,
+ * configuration_table) with its 3-byte hash of 15 bits, so level 6 behaves
+ * like zlib's level 6. Levels 1..5 are ours: they hash 4 bytes into 16 bits,
+ * so a chain holds only positions that share 4 bytes (a 3-byte hash chains
+ * every position that shares 3 bytes, or just the hash, and most of the
+ * walk is spent rejecting them); 3-byte matches are then found only by
+ * chance, which costs little on image data, where a 3-byte match is seldom
+ * cheaper than its literals. Levels 2..5 match lazily; level 2 inserts
+ * only the last 2 positions of a match longer than 16 into the chains
+ * (long matches are runs and repeats, whose inner positions seldom start a
+ * better match; inserting them was a third of the time on images with empty
+ * areas). On filtered PNG rows
+ * (bench/README_png.md) level 2 runs at about the speed of zlib's level 2
+ * and gives files the size of zlib's level 6 or smaller. For the greedy
+ * level 1 "lazy" is the longest match whose positions are all inserted into
+ * the hash chains. */
 static const level_cfg level_cfgs[10] = {
-    {0, 0, 0, 0, 0},         {4, 4, 8, 4, 0},       {4, 5, 16, 8, 0},
-    {4, 6, 32, 32, 0},       {4, 4, 16, 16, 1},     {8, 16, 32, 32, 1},
-    {8, 16, 128, 128, 1},    {8, 32, 128, 256, 1},  {32, 128, 258, 1024, 1},
-    {32, 258, 258, 4096, 1},
+    {0, 0, 0, 0, 0, 3, 15, 0},        {4, 4, 8, 4, 0, 4, 16, 0},        {4, 8, 64, 16, 1, 4, 16, 16},
+    {4, 8, 64, 32, 1, 4, 16, 0},      {8, 16, 64, 64, 1, 4, 16, 0},     {8, 16, 128, 64, 1, 4, 16, 0},
+    {8, 16, 128, 128, 1, 3, 15, 0},   {8, 32, 128, 256, 1, 3, 15, 0},   {32, 128, 258, 1024, 1, 3, 15, 0},
+    {32, 258, 258, 4096, 1, 3, 15, 0},
 };
 
 typedef struct deflater {
@@ -367,16 +445,27 @@ typedef struct deflater {
     bitw w;
 } deflater;
 
-static inline uint32_t hash3(const unsigned char *p)
+/* Hash of the cfg.hlen (3 or 4) bytes at p into cfg.hbits bits; the bytes
+ * are combined in a fixed order, so the output is the same on any byte
+ * order. */
+static inline uint32_t hash_at(const deflater *d, const unsigned char *p)
 {
-    uint32_t v = ((uint32_t)p[0] << 16) | ((uint32_t)p[1] << 8) | p[2];
-    return (v * 2654435761u) >> (32 - HBITS);
+    uint32_t v = d->cfg.hlen == 4 ? (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
+                                        (uint32_t)p[3] << 24
+                                  : ((uint32_t)p[0] << 16) | ((uint32_t)p[1] << 8) | p[2];
+    return (v * 2654435761u) >> (32 - d->cfg.hbits);
 }
 
-/* Insert position pos (pos + 2 < n) and return the previous chain head. */
+/* Can position pos be hashed (cfg.hlen bytes from pos inside the input)? */
+static inline int hashable(const deflater *d, size_t pos)
+{
+    return pos + (size_t)d->cfg.hlen <= d->n;
+}
+
+/* Insert position pos (hashable) and return the previous chain head. */
 static inline int32_t insert_pos(deflater *d, size_t pos)
 {
-    uint32_t h = hash3(d->in + pos);
+    uint32_t h = hash_at(d, d->in + pos);
     int32_t old = d->head[h];
     d->prev[pos & WMASK] = old;
     d->head[h] = (int32_t)pos;
@@ -385,7 +474,7 @@ static inline int32_t insert_pos(deflater *d, size_t pos)
 
 /* Longest match for pos among the chain starting at cur that is longer than
  * prev_len (and >= MIN_MATCH); returns its length or 0. */
-static int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_len, int *mdist)
+static inline int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_len, int *mdist)
 {
     const unsigned char *s = d->in + pos;
     size_t avail = d->n - pos;
@@ -413,12 +502,21 @@ static int longest_match(const deflater *d, size_t pos, int32_t cur, int prev_le
                 uint64_t a, b;
                 memcpy(&a, m + len, 8);
                 memcpy(&b, s + len, 8);
-                if (a != b)
+                if (a != b) {
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+                    len += __builtin_ctzll(a ^ b) >> 3; /* first differing byte */
+                    goto counted;
+#else
                     break;
+#endif
+                }
                 len += 8;
             }
             while (len < maxlen && m[len] == s[len])
                 len++;
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        counted:
+#endif
             if (len > best) {
                 best = len;
                 found = 1;
@@ -449,27 +547,49 @@ static void fixed_lengths(uint8_t *ll, uint8_t *dl)
         dl[i] = 5;
 }
 
+/* Write the block's symbols and its end code. Space for the worst case
+ * (48 bits per symbol: 15 + 5 + 15 + 13) is reserved first, so the loop
+ * keeps the bit buffer in registers and stores 4 bytes whenever 32 bits are
+ * pending, with no capacity checks. */
 static void write_symbols(deflater *d, const uint8_t *ll, const uint16_t *lc, const uint8_t *dl,
                           const uint16_t *dc)
 {
     bitw *w = &d->w;
+    if (!bw_reserve(w, (size_t)d->nsyms * 6 + 16))
+        return;
+    uint64_t bits = w->bits;
+    int nbits = w->nbits;
+    unsigned char *o = w->buf + w->len;
+#define PUTBITS(v, n)                                                                              \
+    do {                                                                                           \
+        bits |= (uint64_t)(v) << nbits;                                                            \
+        nbits += (n);                                                                              \
+        if (nbits >= 32) {                                                                         \
+            o[0] = (unsigned char)bits, o[1] = (unsigned char)(bits >> 8);                        \
+            o[2] = (unsigned char)(bits >> 16), o[3] = (unsigned char)(bits >> 24);               \
+            o += 4;                                                                                \
+            bits >>= 32;                                                                           \
+            nbits -= 32;                                                                           \
+        }                                                                                          \
+    } while (0)
     for (int i = 0; i < d->nsyms; i++) {
         int v = d->sym_ll[i], dist = d->sym_d[i];
         if (dist == 0) {
-            bw_put(w, lc[v], ll[v]);
+            PUTBITS(lc[v], ll[v]);
         } else {
-            int sym, nx, x;
-            len_sym(v, &sym, &nx, &x);
-            bw_put(w, lc[sym], ll[sym]);
-            if (nx)
-                bw_put(w, (uint32_t)x, nx);
-            dist_sym(dist, &sym, &nx, &x);
-            bw_put(w, dc[sym], dl[sym]);
-            if (nx)
-                bw_put(w, (uint32_t)x, nx);
+            int ls = len_tab[v - 3], ds = dist_code(dist);
+            /* code and extra bits together: at most 15 + 5 and 15 + 13 bits */
+            PUTBITS(lc[257 + ls] | (uint32_t)(v - sym_base[ls]) << ll[257 + ls],
+                    ll[257 + ls] + sym_nx[ls]);
+            PUTBITS(dc[ds] | (uint32_t)(dist - sym_base[32 + ds]) << dl[ds],
+                    dl[ds] + sym_nx[32 + ds]);
         }
     }
-    bw_put(w, lc[256], ll[256]);
+    PUTBITS(lc[256], ll[256]);
+#undef PUTBITS
+    w->len = (size_t)(o - w->buf);
+    w->bits = bits;
+    w->nbits = nbits;
 }
 
 /* Emit the pending symbols as one block (or several stored blocks). */
@@ -642,13 +762,10 @@ static inline void emit_lit(deflater *d, int c)
 
 static inline void emit_match(deflater *d, int len, int dist)
 {
-    int sym, nx, x;
     d->sym_ll[d->nsyms] = (uint16_t)len;
     d->sym_d[d->nsyms++] = (uint16_t)dist; /* 32768 fits in 16 bits */
-    len_sym(len, &sym, &nx, &x);
-    d->lfreq[sym]++;
-    dist_sym(dist, &sym, &nx, &x);
-    d->dfreq[sym]++;
+    d->lfreq[257 + len_tab[len - 3]]++;
+    d->dfreq[dist_code(dist)]++;
     d->covered += (size_t)len;
     if (d->nsyms == BLOCK_SYMS)
         flush_block(d, 0, 0);
@@ -658,14 +775,14 @@ static void lz_greedy(deflater *d)
 {
     size_t n = d->n, pos = 0;
     while (pos < n) {
-        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int32_t hh = hashable(d, pos) ? insert_pos(d, pos) : -1;
         int ml = 0, md = 0;
-        if (hh >= 0)
+        if (hh >= 0 && pos - (size_t)hh <= MAX_DIST)
             ml = longest_match(d, pos, hh, 0, &md);
         if (ml >= MIN_MATCH) {
             emit_match(d, ml, md);
             if (ml <= d->cfg.lazy)
-                for (size_t p = pos + 1; p < pos + (size_t)ml && p + 2 < n; p++)
+                for (size_t p = pos + 1; p < pos + (size_t)ml && hashable(d, p); p++)
                     insert_pos(d, p);
             pos += (size_t)ml;
         } else {
@@ -682,18 +799,20 @@ static void lz_lazy(deflater *d)
     size_t n = d->n, pos = 0;
     int match_len = 0, match_dist = 0, avail = 0;
     while (pos < n) {
-        int32_t hh = pos + 2 < n ? insert_pos(d, pos) : -1;
+        int32_t hh = hashable(d, pos) ? insert_pos(d, pos) : -1;
         int prev_len = match_len, prev_dist = match_dist;
         match_len = 0;
-        if (hh >= 0 && prev_len < d->cfg.lazy) {
+        if (hh >= 0 && pos - (size_t)hh <= MAX_DIST && prev_len < d->cfg.lazy) {
             match_len = longest_match(d, pos, hh, prev_len, &match_dist);
             if (match_len == MIN_MATCH && match_dist > TOO_FAR)
                 match_len = 0;
         }
         if (prev_len >= MIN_MATCH && match_len <= prev_len) {
             emit_match(d, prev_len, prev_dist);
-            size_t end = pos - 1 + (size_t)prev_len;
-            for (size_t p = pos + 1; p < end && p + 2 < n; p++)
+            size_t end = pos - 1 + (size_t)prev_len, p = pos + 1;
+            if (d->cfg.insert_max && prev_len > d->cfg.insert_max)
+                p = end - 2;
+            for (; p < end && hashable(d, p); p++)
                 insert_pos(d, p);
             pos = end;
             avail = 0;
@@ -722,9 +841,10 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
     d->in = in ? in : no_input;
     d->n = n;
     d->cfg = level_cfgs[level];
+    pthread_once(&tab_once, tab_init);
     d->w = *w;
     if (level > 0) {
-        d->head = rt_malloc(HSIZE * sizeof *d->head);
+        d->head = rt_malloc(((size_t)1 << HBITS_MAX) * sizeof *d->head);
         d->prev = rt_malloc(WSIZE * sizeof *d->prev);
         d->sym_ll = rt_malloc(BLOCK_SYMS * sizeof *d->sym_ll);
         d->sym_d = rt_malloc(BLOCK_SYMS * sizeof *d->sym_d);
@@ -734,7 +854,7 @@ static rt_code deflate_to(const unsigned char *in, size_t n, int level, bitw *w,
             rt_free(d);
             return rt_fail(e, RT_ENOMEM, "out of memory for the deflate state");
         }
-        for (int i = 0; i < HSIZE; i++)
+        for (int i = 0; i < (1 << d->cfg.hbits); i++)
             d->head[i] = -1;
         for (int i = 0; i < WSIZE; i++)
             d->prev[i] = -1;

@@ -9,9 +9,12 @@
  * bytes and the level: the same input always gives the same bytes.
  *
  *   level 0      stored blocks only (no compression; fastest)
- *   level 1..3   greedy matching, short hash chains
- *   level 4..9   lazy matching, longer chains (6 is the usual default,
- *                the same parameters as zlib's level 6)
+ *   level 1      greedy matching, chains of 4, 4-byte hash
+ *   level 2..5   lazy matching, chains of 16..64, 4-byte hash (2 is PNG's
+ *                default: about zlib level 2's speed, zlib level 6's size
+ *                on image data)
+ *   level 6..9   lazy matching, longer chains, 3-byte hash: zlib's
+ *                parameters for these levels (6 is the usual default)
  *
  * deflate_zlib appends a complete zlib stream (2-byte header, deflate data,
  * Adler-32 of the input, big-endian) to out; deflate_raw appends bare deflate

@@ -60,64 +60,180 @@ static int paeth(int a, int b, int c) /* §9.4 */
     return pb <= pc ? b : c;
 }
 
-/* Sum of |v| over bytes read as signed (§12.8's heuristic): |v| is
- * min(v, 256 - v), a form compilers vectorise. */
-static uint64_t row_cost(const unsigned char *f, size_t rb)
+/* Adaptive filtering (§12.8's heuristic): for each row the filter type whose
+ * output bytes, read as signed, have the least sum of |v| (|v| of a byte is
+ * min(v, 256 - v)); ties go to the lower type. Filtering has no loop-carried
+ * dependency (it reads only the unfiltered rows), so one pass over the row
+ * computes the five costs at once, 8 bytes per step in 16-bit lanes with
+ * GCC/Clang vector extensions (SSE2 on x86-64, NEON on ARM), and a second
+ * pass writes only the chosen filter. The scalar code below is the
+ * reference and the fallback; both give the same bytes. */
+
+/* Paeth predictor on bytes, branch-free (§9.4: p - a = b - c, p - b =
+ * a - c, p - c = (b - c) + (a - c)). */
+static inline int paeth_pred(int a, int b, int c)
 {
-    uint64_t cost = 0;
-    for (size_t i = 0; i < rb;) {
-        size_t end = rb - i > 4096 ? i + 4096 : rb; /* uint32 partial sums cannot overflow */
-        uint32_t part = 0;
-        for (; i < end; i++) {
-            unsigned char v = f[i], nv = (unsigned char)(0u - v);
-            part += v < nv ? v : nv;
-        }
-        cost += part;
-    }
-    return cost;
+    int pa = b - c, pb = a - c, pc = pa + pb;
+    pa = pa < 0 ? -pa : pa;
+    pb = pb < 0 ? -pb : pb;
+    pc = pc < 0 ? -pc : pc;
+    return (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
 }
 
-/* Filter row cur (prev = the previous row, all zero for the first) with
- * type ft (§9.2) into dst. The first bpp bytes have no left neighbour
- * (a = c = 0); the loops after them are branch-free so they vectorise. */
-static void filter_row(int ft, const unsigned char *cur, const unsigned char *prev, size_t rb,
-                       size_t bpp, unsigned char *dst)
+static inline unsigned filt_byte(int ft, int x, int a, int b, int c)
 {
-    size_t i, k = bpp < rb ? bpp : rb;
     switch (ft) {
-    case 0:
-        memcpy(dst, cur, rb);
-        break;
-    case 1:
-        for (i = 0; i < k; i++)
-            dst[i] = cur[i];
-        for (; i < rb; i++)
-            dst[i] = (unsigned char)(cur[i] - cur[i - bpp]);
-        break;
-    case 2:
-        for (i = 0; i < rb; i++)
-            dst[i] = (unsigned char)(cur[i] - prev[i]);
-        break;
-    case 3:
-        for (i = 0; i < k; i++)
-            dst[i] = (unsigned char)(cur[i] - (prev[i] >> 1));
-        for (; i < rb; i++)
-            dst[i] = (unsigned char)(cur[i] - ((cur[i - bpp] + prev[i]) >> 1));
-        break;
-    default:
-        for (i = 0; i < k; i++) /* Paeth(0, b, 0) = b */
-            dst[i] = (unsigned char)(cur[i] - prev[i]);
-        for (; i < rb; i++) {
-            int a = cur[i - bpp], b = prev[i], c = prev[i - bpp];
-            int pa = b - c, pb = a - c, pc = pa + pb; /* p - a, p - b, p - c */
-            pa = pa < 0 ? -pa : pa;
-            pb = pb < 0 ? -pb : pb;
-            pc = pc < 0 ? -pc : pc;
-            int pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
-            dst[i] = (unsigned char)(cur[i] - pred);
-        }
-        break;
+    case 0: return (unsigned char)x;
+    case 1: return (unsigned char)(x - a);
+    case 2: return (unsigned char)(x - b);
+    case 3: return (unsigned char)(x - ((a + b) >> 1));
+    default: return (unsigned char)(x - paeth_pred(a, b, c));
     }
+}
+
+static inline unsigned byte_cost(unsigned v)
+{
+    return v < 256 - v ? v : 256 - v;
+}
+
+/* Costs of bytes [i0, i1) of the row, all five filters, scalar; the first
+ * bpp bytes have no left neighbour (a = c = 0). */
+static void row_costs_scalar(const unsigned char *cur, const unsigned char *prev, size_t i0,
+                             size_t i1, size_t bpp, uint64_t cost[5])
+{
+    for (size_t i = i0; i < i1; i++) {
+        int x = cur[i], b = prev[i];
+        int a = i >= bpp ? cur[i - bpp] : 0, c = i >= bpp ? prev[i - bpp] : 0;
+        for (int ft = 0; ft < 5; ft++)
+            cost[ft] += byte_cost(filt_byte(ft, x, a, b, c));
+    }
+}
+
+static void filter_scalar(int ft, const unsigned char *cur, const unsigned char *prev, size_t i0,
+                          size_t i1, size_t bpp, unsigned char *dst)
+{
+    for (size_t i = i0; i < i1; i++) {
+        int a = i >= bpp ? cur[i - bpp] : 0, c = i >= bpp ? prev[i - bpp] : 0;
+        dst[i] = (unsigned char)filt_byte(ft, cur[i], a, prev[i], c);
+    }
+}
+
+#if defined(__GNUC__) || defined(__clang__)
+#define PNG_VEC 1
+typedef uint8_t png_v8u8 __attribute__((vector_size(8)));
+typedef int16_t png_v8i16 __attribute__((vector_size(16)));
+
+static inline png_v8i16 vload8(const unsigned char *p)
+{
+    png_v8u8 v;
+    memcpy(&v, p, 8);
+    return __builtin_convertvector(v, png_v8i16);
+}
+
+static inline png_v8i16 vabs16(png_v8i16 v)
+{
+    png_v8i16 m = v >> 15;
+    return (v ^ m) - m;
+}
+
+/* lanes where m is all ones take x, the others y */
+static inline png_v8i16 vsel(png_v8i16 m, png_v8i16 x, png_v8i16 y)
+{
+    return (x & m) | (y & ~m);
+}
+
+static inline png_v8i16 vpaeth(png_v8i16 a, png_v8i16 b, png_v8i16 c)
+{
+    png_v8i16 pa = b - c, pb = a - c, pc = pa + pb;
+    pa = vabs16(pa), pb = vabs16(pb), pc = vabs16(pc);
+    png_v8i16 take_a = (pa <= pb) & (pa <= pc), take_b = pb <= pc;
+    return vsel(take_a, a, vsel(take_b, b, c));
+}
+
+/* |v| of the low byte read as signed: min(t, 256 - t), t = v & 255 */
+static inline png_v8i16 vcost(png_v8i16 v)
+{
+    png_v8i16 t = v & 255, u = 256 - t;
+    return vsel(t < u, t, u);
+}
+
+/* The five costs of bytes [i0, i1), i0 >= bpp. Lane sums stay below 2^15:
+ * each step adds at most 128 per lane, and they are flushed every 128
+ * steps. */
+static size_t row_costs_vec(const unsigned char *cur, const unsigned char *prev, size_t i0,
+                            size_t i1, size_t bpp, uint64_t cost[5])
+{
+    size_t i = i0;
+    while (i + 8 <= i1) {
+        png_v8i16 s0 = {0}, s1 = {0}, s2 = {0}, s3 = {0}, s4 = {0};
+        for (int k = 0; k < 128 && i + 8 <= i1; k++, i += 8) {
+            png_v8i16 x = vload8(cur + i), a = vload8(cur + i - bpp);
+            png_v8i16 b = vload8(prev + i), c = vload8(prev + i - bpp);
+            s0 += vcost(x);
+            s1 += vcost(x - a);
+            s2 += vcost(x - b);
+            s3 += vcost(x - ((a + b) >> 1));
+            s4 += vcost(x - vpaeth(a, b, c));
+        }
+        for (int l = 0; l < 8; l++) {
+            cost[0] += (uint64_t)s0[l];
+            cost[1] += (uint64_t)s1[l];
+            cost[2] += (uint64_t)s2[l];
+            cost[3] += (uint64_t)s3[l];
+            cost[4] += (uint64_t)s4[l];
+        }
+    }
+    return i;
+}
+
+static size_t filter_vec(int ft, const unsigned char *cur, const unsigned char *prev, size_t i0,
+                         size_t i1, size_t bpp, unsigned char *dst)
+{
+    size_t i = i0;
+    for (; i + 8 <= i1; i += 8) {
+        png_v8i16 x = vload8(cur + i), a = vload8(cur + i - bpp);
+        png_v8i16 b = vload8(prev + i), c = vload8(prev + i - bpp), r;
+        switch (ft) {
+        case 1: r = x - a; break;
+        case 2: r = x - b; break;
+        case 3: r = x - ((a + b) >> 1); break;
+        default: r = x - vpaeth(a, b, c); break;
+        }
+        png_v8u8 o = __builtin_convertvector(r & 255, png_v8u8);
+        memcpy(dst + i, &o, 8);
+    }
+    return i;
+}
+#endif
+
+/* Filter row cur (prev = the previous row, all zero for the first) with
+ * the adaptive choice into dst[0] (type) and dst[1..rb]. */
+static void filter_adaptive(const unsigned char *cur, const unsigned char *prev, size_t rb,
+                            size_t bpp, unsigned char *dst)
+{
+    uint64_t cost[5] = {0};
+    size_t k = bpp < rb ? bpp : rb, i = k;
+    row_costs_scalar(cur, prev, 0, k, bpp, cost);
+#ifdef PNG_VEC
+    i = row_costs_vec(cur, prev, k, rb, bpp, cost);
+#endif
+    row_costs_scalar(cur, prev, i, rb, bpp, cost);
+    int ft = 0;
+    for (int t = 1; t < 5; t++)
+        if (cost[t] < cost[ft])
+            ft = t;
+    dst[0] = (unsigned char)ft;
+    unsigned char *o = dst + 1;
+    if (ft == 0) {
+        memcpy(o, cur, rb);
+        return;
+    }
+    filter_scalar(ft, cur, prev, 0, k, bpp, o);
+    i = k;
+#ifdef PNG_VEC
+    i = filter_vec(ft, cur, prev, k, rb, bpp, o);
+#endif
+    filter_scalar(ft, cur, prev, i, rb, bpp, o);
 }
 
 /* The provenance chunks (provenance.h), between IHDR and IDAT: tEXt
@@ -180,31 +296,16 @@ rt_code png_encode_samples(const unsigned char *rows, int w, int h, int channels
     size_t total = rt_mul_size((size_t)h, rb + 1);
     if (rb == 0 || total == 0)
         return rt_fail(e, RT_EINVAL, "PNG image size %d×%d is too large", w, h);
-    unsigned char *f = rt_malloc(total), *tmp = rt_malloc(5 * rb), *zero = rt_calloc(1, rb);
-    if (!f || !tmp || !zero) {
-        rt_free(f), rt_free(tmp), rt_free(zero);
+    unsigned char *f = rt_malloc(total), *zero = rt_calloc(1, rb);
+    if (!f || !zero) {
+        rt_free(f), rt_free(zero);
         return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", w, h);
     }
-    /* adaptive filtering, §12.8: minimum sum of absolute differences */
     for (int y = 0; y < h; y++) {
         const unsigned char *cur = rows + (size_t)y * rb;
-        const unsigned char *prev = y ? cur - rb : zero;
-        unsigned char *dst = f + (size_t)y * (rb + 1);
-        uint64_t best = 0;
-        int bestft = 0;
-        for (int ft = 0; ft <= 4; ft++) {
-            filter_row(ft, cur, prev, rb, bpp, tmp + (size_t)ft * rb);
-            uint64_t cost = row_cost(tmp + (size_t)ft * rb, rb);
-            if (ft == 0 || cost < best) {
-                best = cost;
-                bestft = ft;
-            }
-        }
-        dst[0] = (unsigned char)bestft;
-        memcpy(dst + 1, tmp + (size_t)bestft * rb, rb);
+        filter_adaptive(cur, y ? cur - rb : zero, rb, bpp, f + (size_t)y * (rb + 1));
     }
     rt_free(zero);
-    rt_free(tmp);
     if (filtered)
         bytebuf_append(filtered, f, total);
 

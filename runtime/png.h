@@ -13,11 +13,11 @@
  * Each row gets the filter (None, Sub, Up, Average, Paeth) whose output has
  * the smallest sum of absolute values as signed bytes (the heuristic of the
  * PNG specification §12.8, as libpng uses it); ties go to the lower type.
- * The filtered rows are deflated at PNG_DEFAULT_LEVEL = 2 (zlib's level-2
- * parameters: greedy matching, chains of 8). On the 1024×1024 benchmark
- * texture it gives files 5% larger than zlib level 6 at ~45 MB/s, where
- * level 4 gives +1.4% at ~31 MB/s and level 6 matches zlib at ~12 MB/s
- * (bench/README_png.md); png_encode_samples takes any level.
+ * The filtered rows are deflated at PNG_DEFAULT_LEVEL = 2 (deflate.h: lazy
+ * matching over chains of 16 positions that share 4 bytes). On the
+ * benchmark images (bench/README_png.md) it runs at about the speed of
+ * zlib's level 2 and gives files within a few per cent of zlib's level 6,
+ * smaller on noisy and 16-bit images; png_encode_samples takes any level.
  *
  * png_encode_samples is the lower layer: rows of big-endian samples exactly
  * as PNG stores them (w * channels * bits / 8 bytes per row, top row first,

@@ -71,6 +71,30 @@ static void test_checksums(void)
     uint64_t a = (1 + 255ull * n) % 65521, b = (n + 255ull * n * (n + 1) / 2) % 65521;
     CHECK(deflate_adler32(1, ff, n) == (uint32_t)(b << 16 | a), "adler32 of 100000 x 0xFF");
     rt_free(ff);
+
+    /* every length 0..100 at every offset 0..7 (the 8-byte steps and their
+     * tails) against the CRC computed one bit at a time from the polynomial */
+    unsigned char buf[108];
+    for (int i = 0; i < 108; i++)
+        buf[i] = (unsigned char)(i * 167 + 13);
+    int bad = 0;
+    for (int off = 0; off < 8; off++)
+        for (int len = 0; len <= 100; len++) {
+            uint32_t r = 0xFFFFFFFFu;
+            for (int i = 0; i < len; i++) {
+                r ^= buf[off + i];
+                for (int k = 0; k < 8; k++)
+                    r = (r >> 1) ^ (0xEDB88320u & (0u - (r & 1)));
+            }
+            bad += deflate_crc32(0, buf + off, (size_t)len) != (r ^ 0xFFFFFFFFu);
+        }
+    CHECK(bad == 0, "crc32 differs from the bitwise CRC in %d of 808 cases", bad);
+    /* Adler-32 by its definition, sums reduced at the end (no overflow in 64 bits) */
+    uint64_t sa = 1, sb = 0;
+    for (int i = 0; i < 108; i++)
+        sa += buf[i], sb += sa;
+    CHECK(deflate_adler32(1, buf, 108) == (uint32_t)((sb % 65521) << 16 | (sa % 65521)),
+          "adler32 of 108 bytes");
 }
 
 static void test_roundtrips(void)
@@ -95,6 +119,12 @@ static void test_roundtrips(void)
     size_t zrun = roundtrip(run, n, 6, "run");
     CHECK(zrun < 400, "a run of %zu bytes compressed to %zu bytes", n, zrun);
     roundtrip(run, n, 1, "run");
+    /* levels 2..5 (4-byte hash; level 2 inserts only the ends of long matches) */
+    for (int level = 2; level <= 5; level++) {
+        size_t zl = roundtrip(run, n, level, "run");
+        CHECK(zl < 400, "level %d: a run of %zu bytes compressed to %zu bytes", level, n, zl);
+        roundtrip(r, n, level, "random");
+    }
 
     /* repetitive with distances up to 32768: a random block repeated at 32768 */
     unsigned char *far = rt_malloc(70000);
@@ -106,6 +136,10 @@ static void test_roundtrips(void)
     /* the second copy must be found at distance exactly 32768 (the window) */
     CHECK(zfar < 32768 + 2000, "period-32768 data compressed to %zu bytes", zfar);
     roundtrip(far, 70000, 6, "distance 32768");
+    for (int level = 2; level <= 5; level++) {
+        size_t zl = roundtrip(far, 70000, level, "distance 32768");
+        CHECK(zl < 32768 + 2000, "level %d: period-32768 data compressed to %zu bytes", level, zl);
+    }
     /* a period one beyond the window cannot be matched */
     unsigned char *far2 = rt_malloc(65538);
     memcpy(far2, blk, 32768);
@@ -119,6 +153,8 @@ static void test_roundtrips(void)
     bytebuf_init(&t);
     gen_text(&t);
     size_t zt = roundtrip(t.data, t.len, 6, "text");
+    for (int level = 2; level <= 5; level++)
+        roundtrip(t.data, t.len, level, "text");
     CHECK(zt <= 1544 * 115 / 100, "text: %zu bytes vs zlib level 6's 1544", zt);
     bytebuf_free(&t);
 
@@ -150,6 +186,7 @@ static void test_roundtrips(void)
     }
     roundtrip(fib.data, fib.len, 6, "fibonacci");
     roundtrip(fib.data, fib.len, 1, "fibonacci");
+    roundtrip(fib.data, fib.len, 2, "fibonacci");
     bytebuf_free(&fib);
     rt_free(r);
     rt_free(run);

@@ -579,6 +579,89 @@ static void test_paeth_ties(void)
     free(want);
 }
 
+/* The same rules for every pixel size (bpp 1..8 bytes, 8- and 16-bit) on
+ * rows longer than the encoder's vector blocks and of a length that is not
+ * a multiple of 8, so the block loops, their tails and the 128-step partial
+ * sums are all exercised. Rows are built to make each filter type win
+ * somewhere: noise (None), horizontal ramps (Sub), copies of the row above
+ * (Up), the mean of left and above (Average) and planes (Paeth), each with a
+ * little noise. The want rows come from the spec's formulas, written out
+ * per byte here. */
+static void test_filter_all_depths(void)
+{
+    static const int cfg[][2] = {{1, 8}, {2, 8}, {3, 8}, {4, 8}, {1, 16}, {2, 16}, {3, 16}, {4, 16}};
+    enum { W = 1031, H = 40 };
+    int wins[5] = {0};
+    uint32_t x = 777;
+    for (size_t k = 0; k < sizeof cfg / sizeof cfg[0]; k++) {
+        int channels = cfg[k][0], bits = cfg[k][1];
+        int bpp = channels * bits / 8, rb = W * bpp;
+        unsigned char *rows = malloc((size_t)rb * H), *want = malloc((size_t)(rb + 1) * H);
+        CHECK(rows && want, "memory");
+        for (int y = 0; y < H; y++)
+            for (int i = 0; i < rb; i++) {
+                x = x * 1103515245u + 12345u;
+                int noise = (int)((x >> 16) % 3), kind = (y / 2) % 5, v;
+                int a = i >= bpp ? rows[y * rb + i - bpp] : 0, b = y ? rows[(y - 1) * rb + i] : 0;
+                switch (kind) {
+                case 0: v = (int)(x >> 20); break;
+                case 1: v = a + 3 + noise; break;
+                case 2: v = b + noise; break;
+                case 3: v = (a + b) / 2 + noise; break;
+                default: v = i >= bpp && y ? a + b - rows[(y - 1) * rb + i - bpp] + noise : 7 * i;
+                }
+                rows[y * rb + i] = (unsigned char)v;
+            }
+        for (int y = 0; y < H; y++) {
+            const unsigned char *cur = rows + y * rb;
+            long cost[5] = {0};
+            for (int i = 0; i < rb; i++) {
+                int a = i >= bpp ? cur[i - bpp] : 0, b = y ? cur[i - rb] : 0;
+                int c = i >= bpp && y ? cur[i - rb - bpp] : 0;
+                int pred[5] = {0, a, b, (a + b) / 2, paeth_ref(a, b, c)};
+                for (int f = 0; f < 5; f++) {
+                    unsigned char r = (unsigned char)(cur[i] - pred[f]);
+                    cost[f] += r < 128 ? r : 256 - r;
+                }
+            }
+            int best = 0;
+            for (int f = 1; f < 5; f++)
+                if (cost[f] < cost[best])
+                    best = f;
+            wins[best]++;
+            unsigned char *o = want + y * (rb + 1);
+            o[0] = (unsigned char)best;
+            for (int i = 0; i < rb; i++) {
+                int a = i >= bpp ? cur[i - bpp] : 0, b = y ? cur[i - rb] : 0;
+                int c = i >= bpp && y ? cur[i - rb - bpp] : 0;
+                int pred[5] = {0, a, b, (a + b) / 2, paeth_ref(a, b, c)};
+                o[1 + i] = (unsigned char)(cur[i] - pred[best]);
+            }
+        }
+        bytebuf out, filt;
+        bytebuf_init(&out);
+        bytebuf_init(&filt);
+        rt_error e;
+        CHECK(png_encode_samples(rows, W, H, channels, bits, PNG_DEFAULT_LEVEL, &out, &filt, &e) ==
+                  RT_OK,
+              "encode: %s", e.msg);
+        int bad = -1;
+        if (filt.len == (size_t)(rb + 1) * H)
+            for (bad = 0; bad < H && !memcmp(filt.data + bad * (rb + 1), want + bad * (rb + 1),
+                                             (size_t)rb + 1);
+                 bad++)
+                ;
+        CHECK(bad == H, "%d channels, %d bits: filtered rows differ from the spec first at row %d",
+              channels, bits, bad);
+        bytebuf_free(&out);
+        bytebuf_free(&filt);
+        free(rows);
+        free(want);
+    }
+    for (int f = 0; f < 5; f++)
+        CHECK(wins[f] >= 8, "filter type %d wins only %d rows", f, wins[f]);
+}
+
 /* A small file that declares a huge image: refused by the pixel limit at
  * IHDR, before anything of that size is allocated; the memory check comes
  * before the rows are inflated. */
@@ -625,6 +708,7 @@ int main(void)
     test_corrupt_suite();
     test_handmade();
     test_paeth_ties();
+    test_filter_all_depths();
     test_declared_size();
     return check_done("test_png");
 }
