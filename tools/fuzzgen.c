@@ -200,6 +200,33 @@ static void numbers(const char *sub)
     }
 }
 
+/* The newer builtins with tiny work (fit: one map, one or two generations,
+ * tiny targets; meshes of a few faces; framing), and their edges. */
+static void newer(const char *sub)
+{
+    bytebuf b;
+    bytebuf_init(&b);
+    bytebuf_printf(&b, "let f = fit({\n1 1 0\n0 1 1\n}, maps: 1, iterations: 1)\nprint(f)\n"
+                       "let g = fit([[1, 0, 1], [1, 1, 1]], maps: \"1..2\", iterations: 2, rifs: true, seed: 3)\n"
+                       "print(g)\nprint(fit([[1, 1], [1, 0]], maps: 1, iterations: 1, start: f))\n"
+                       "let im = image([3, 2], 1)\nprint(fit(im, maps: 1, iterations: 1, foreground: \"dark\"))\n"
+                       "print(fit(im, maps: 1, iterations: 1, threshold: 1, time: 0.01))\n");
+    script(sub, "gen_fit_tiny", &b);
+    bytebuf_printf(&b, "let p = pyramid()\nlet c = cube([0, 0, 0], [1, 2, 3])\n"
+                       "let t = polyhedron([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], "
+                       "[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])\n"
+                       "let q = polyhedron([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1]], "
+                       "[[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])\n"
+                       "print(p, c, t, q)\nprint(c.lo, c.hi, t.vertices)\n"
+                       "print(iterate(ifs([[0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5, 0, 0, 0], "
+                       "[0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5, 0.5, 0, 0]]), start: p, steps: 1))\n"
+                       "let cam = framing([0, 0, 0], [1, 1, 1], [8, 8])\nprint(cam)\n"
+                       "print(framing(c.lo, c.hi, 4, azimuth: -720, elevation: -89.9))\n"
+                       "print(rasterize(c, camera: cam, size: [8, 8]))\n");
+    script(sub, "gen_meshes_framing", &b);
+    bytebuf_free(&b);
+}
+
 static void scripts(const char *dir, int over)
 {
     static const int depths[] = {8, 40, 60};
@@ -210,6 +237,7 @@ static void scripts(const char *dir, int over)
     chains(dir, lens, 2);
     wide(dir);
     numbers(dir);
+    newer(dir);
     if (over) {
         nests("over", deep, 3);
         chains("over", longc, 2);
