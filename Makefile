@@ -144,11 +144,11 @@ fuzz-seeds: $(BUILD)/fuzzgen $(BUILD)/frac
 	    cp "$$f" $(FUZZ_DIR)/corpus/script/$$(echo $$f | tr / _); done
 	$(BUILD)/fuzzgen $(FUZZ_DIR)/corpus
 	@mkdir -p $(FUZZ_DIR)/corpus/shard $(FUZZ_DIR)/corpus/recipe && rm -rf $(FUZZ_DIR)/shard-seeds && \
-	for f in tests/shard/small.frac tests/shard/solid.frac; do for n in 1 2 3; do \
+	for f in tests/fuzz/shard_seed.frac; do for n in 1 2 3; do \
 	    i=0; while [ $$i -lt $$n ]; do $(BUILD)/frac run -q --threads 1 --shard $$i/$$n -o $(FUZZ_DIR)/shard-seeds $$f \
 	        || exit 1; i=$$((i + 1)); done; done; done; \
 	cd $(FUZZ_DIR)/shard-seeds && for p in *.part; do cp $$p ../corpus/shard/seed_$$p; done; \
-	for b in small solid; do cat $$b.shard-*-of-2.part > ../corpus/shard/seed_$$b.all-of-2; \
+	for b in shard_seed; do cat $$b.shard-*-of-2.part > ../corpus/shard/seed_$$b.all-of-2; \
 	    cat $$b.shard-*-of-3.part > ../corpus/shard/seed_$$b.all-of-3; done
 	@rm -rf $(FUZZ_DIR)/recipe-seeds && $(BUILD)/frac -q --seed 7 -o $(FUZZ_DIR)/recipe-seeds \
 	    tests/cli/data/recipe_scene.frac -D size=8 arg1 > /dev/null && \

@@ -13,8 +13,9 @@
  *
  * Oracles: no crash, no sanitizer report, no leak; an accepted set of parts
  * has count == the number of parts, and an error is always recorded when
- * the check fails. FRAC_FUZZ_VERBOSE=1 prints each input's outcome. Seeds: `frac run --shard I/N` of scripts in tests/shard/ (the
- * fuzz-seeds rule). */
+ * the check fails. FRAC_FUZZ_VERBOSE=1 prints each input's outcome.
+ * Seeds: `frac run --shard I/N` of the tiny tests/fuzz/shard_seed.frac
+ * (the fuzz-seeds rule). */
 #define _GNU_SOURCE
 #include <stdint.h>
 #include <stdio.h>
@@ -99,9 +100,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     size_t at[MAXP + 1];
     int k = 0;
-    for (size_t i = 0; i + 8 <= size && k < MAXP; i++)
-        if (data[i] == 'F' && !memcmp(data + i, "FRACPART", 8))
-            at[k++] = i;
+    for (const uint8_t *p = data; k < MAXP && (p = memmem(p, size - (size_t)(p - data), "FRACPART", 8)); p++)
+        at[k++] = (size_t)(p - data);
     if (k == 0)
         at[k++] = 0; /* not a part at all: one file */
     at[0] = 0;
