@@ -100,12 +100,12 @@ bench: $(BUILD)/frac $(BENCH_BIN)
 # UBSan (UBSan errors abort) and coverage instrumentation; the harnesses
 # link them with -fsanitize=fuzzer.
 #   make fuzz              build everything, then run the script harness FUZZ_SECONDS
-#   make fuzz-NAME         run one harness (script png inflate pnm ifs nrrd vtk ply obj stl)
+#   make fuzz-NAME         run one harness (script shard png inflate pnm ifs nrrd vtk ply obj stl apng recipe)
 #   make fuzz-smoke        build, replay tests/fuzz/regressions, run each harness briefly
 #   make fuzz-seeds        (re)make the seed corpora in build-fuzz/corpus/
 FUZZ_SECONDS ?= 60
-FUZZ_LOADERS := png inflate pnm ifs nrrd vtk ply obj stl
-FUZZ_HARNESSES := script $(FUZZ_LOADERS)
+FUZZ_LOADERS := png inflate pnm ifs nrrd vtk ply obj stl apng recipe
+FUZZ_HARNESSES := script shard $(FUZZ_LOADERS)
 FUZZ_SAN = -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
            -fsanitize-coverage-ignorelist=tests/fuzz/engines.ignorelist
 FUZZ_FLAGS = -timeout=10 -rss_limit_mb=1536 -malloc_limit_mb=1024 -print_final_stats=1
@@ -118,9 +118,13 @@ $(BUILD)/fuzz/fuzz_script: tests/fuzz/fuzz_script.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/
 	$(CC) $(CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) \
 	    -Wl,--wrap=fileio_write_atomic,--wrap=fileio_read_all -o $@
 
-$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_loaders.c $(BUILD)/libfracrt.a
+$(BUILD)/fuzz/fuzz_shard: tests/fuzz/fuzz_shard.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -fsanitize=fuzzer -DFUZZ_LOADER=$* $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) -o $@
+
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_loaders.c $(BUILD)/libfracrt.a $(BUILD)/interp/recipe.o
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fsanitize=fuzzer -DFUZZ_LOADER=$* $< $(BUILD)/interp/recipe.o $(BUILD)/libfracrt.a $(LDLIBS) -o $@
 
 $(BUILD)/fuzzgen: tools/fuzzgen.c $(BUILD)/libfracrt.a
 	@mkdir -p $(dir $@)
@@ -134,11 +138,21 @@ fuzz-build:
 
 # Seeds: the examples and language tests for the script harness, plus the
 # deep and wide inputs and the small valid files tools/fuzzgen writes.
-fuzz-seeds: $(BUILD)/fuzzgen
+fuzz-seeds: $(BUILD)/fuzzgen $(BUILD)/frac
 	@mkdir -p $(FUZZ_DIR)/corpus/script
 	@for f in examples/*.frac tests/lang/*/*.frac tests/regression/*.frac; do \
 	    cp "$$f" $(FUZZ_DIR)/corpus/script/$$(echo $$f | tr / _); done
 	$(BUILD)/fuzzgen $(FUZZ_DIR)/corpus
+	@mkdir -p $(FUZZ_DIR)/corpus/shard $(FUZZ_DIR)/corpus/recipe && rm -rf $(FUZZ_DIR)/shard-seeds && \
+	for f in tests/fuzz/shard_seed.frac; do for n in 1 2 3; do \
+	    i=0; while [ $$i -lt $$n ]; do $(BUILD)/frac run -q --threads 1 --shard $$i/$$n -o $(FUZZ_DIR)/shard-seeds $$f \
+	        || exit 1; i=$$((i + 1)); done; done; done; \
+	cd $(FUZZ_DIR)/shard-seeds && for p in *.part; do cp $$p ../corpus/shard/seed_$$p; done; \
+	for b in shard_seed; do cat $$b.shard-*-of-2.part > ../corpus/shard/seed_$$b.all-of-2; \
+	    cat $$b.shard-*-of-3.part > ../corpus/shard/seed_$$b.all-of-3; done
+	@rm -rf $(FUZZ_DIR)/recipe-seeds && $(BUILD)/frac -q --seed 7 -o $(FUZZ_DIR)/recipe-seeds \
+	    tests/cli/data/recipe_scene.frac -D size=8 arg1 > /dev/null && \
+	for f in $(FUZZ_DIR)/recipe-seeds/*; do cp $$f $(FUZZ_DIR)/corpus/recipe/seed_$${f##*/}; done
 
 fuzz: fuzz-build fuzz-seeds
 	$(MAKE) fuzz-script

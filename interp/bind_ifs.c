@@ -359,6 +359,15 @@ static const rifs *as_rifs(value v)
     return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_rifs_class ? &((lang_rifs *)AS_OBJ(v)->payload)->r : NULL;
 }
 
+rt_code lang_chaos_fit(interp *I, const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
+                       rt_error *e)
+{
+    chaos_opts fo = *o;
+    double cap = floor(I->lim.max_points); /* >= 1 (main.c) */
+    fo.fit_points = cap < CHAOS_FIT_POINTS ? (uint64_t)(cap >= 1 ? cap : 1) : CHAOS_FIT_POINTS;
+    return chaos_fit(s, &fo, w, h, lo, hi, e);
+}
+
 int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what)
 {
     const lang_ifs *li = lang_as_ifs(v);
@@ -620,7 +629,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
         hi[1] = win[3];
         if (!(hi[0] > lo[0]) || !(hi[1] > lo[1]))
             return err_at(I, NULL, ERR_VALUE, "chaos: window is [xmin, xmax, ymin, ymax] with min < max");
-    } else if ((c = chaos_fit(&s, &o, w, h, lo, hi, &e))) {
+    } else if ((c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e))) {
         return lang_rt_error(I, c, &e, "chaos");
     }
     if ((double)w * h * ss * ss > I->lim.max_pixels)
@@ -696,7 +705,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
         for (int i = 0; i < dim; i++)
             if (!(hi[i] > lo[i]))
                 return err_at(I, NULL, ERR_VALUE, "measure: the box needs lo < hi on every axis");
-    } else if ((c = chaos_fit(&s, &o, (int)g[0], (int)g[1], lo, hi, &e))) {
+    } else if ((c = lang_chaos_fit(I, &s, &o, (int)g[0], (int)g[1], lo, hi, &e))) {
         return lang_rt_error(I, c, &e, "measure");
     }
     rt_run run = lang_run(I);
@@ -796,7 +805,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     rt_code c;
     if (a[1].k == V_NIL) { /* the default framing (camera.h) of the fitted box */
         double lo[3], hi[3];
-        if ((c = chaos_fit(&s, &o, w, h, lo, hi, &e)))
+        if ((c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e)))
             return lang_rt_error(I, c, &e, "view");
         if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
             return err_at(I, NULL, ERR_VALUE, "view: cannot frame the attractor (its box is not finite)");
@@ -844,7 +853,7 @@ static int sys_save(interp *I, chaos_sys *s, const char *path, value opts)
     memset(&co, 0, sizeof co);
     co.seed = I->seed;
     rt_error e;
-    rt_code c = chaos_fit(s, &co, fo.width, fo.height, fo.lo, fo.hi, &e);
+    rt_code c = lang_chaos_fit(I, s, &co, fo.width, fo.height, fo.lo, fo.hi, &e);
     if (!c)
         c = flam3_save(path, s, &fo, &e);
     if (c)
@@ -867,7 +876,7 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
     if (sys_dim(s) == 3) {
         camera cam;
         double lo[3], hi[3];
-        if ((c = chaos_fit(s, &o, 256, 256, lo, hi, &e)))
+        if ((c = lang_chaos_fit(I, s, &o, 256, 256, lo, hi, &e)))
             goto fail;
         camera_frame_box(&cam, lo, hi, 256, 256, 30, 20, 40);
         chaos_stats st;
@@ -877,7 +886,7 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
     } else {
         hist2 hs;
         double lo[2], hi[2];
-        if ((c = chaos_fit(s, &o, 256, 256, lo, hi, &e)) || (c = hist2_init(&hs, 256, 256, lo, hi, 0, &e)))
+        if ((c = lang_chaos_fit(I, s, &o, 256, 256, lo, hi, &e)) || (c = hist2_init(&hs, 256, 256, lo, hi, 0, &e)))
             goto fail;
         chaos_stats st;
         c = chaos_hist2(s, &o, &hs, &st, &run, &e);

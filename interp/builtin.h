@@ -4,7 +4,7 @@
  * the table is the contract: argument matching, every check of types,
  * ranges and finiteness, the messages ("chaos: argument 'points' must be a
  * number, got string"), `frac check` and `:help NAME` all come from it
- * (contract.c compiles it once, at builtin_register; call_builtin checks
+ * (contract.c compiles it once, at its first call; call_builtin checks
  * it before the builtin runs). A builtin only reads what was declared.
  *
  * Types: '|'-separated alternatives, each a base name with optional parts:

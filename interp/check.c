@@ -134,7 +134,9 @@ static int check_builtin(interp *I, const builtin *b, const node *call)
 {
     const bspec *spec = contract_spec(I, b);
     int na = call->nkids - 1;
-    if (!spec || na > MAX_ARGS || spec->n > MAX_ARGS)
+    if (!spec)
+        return I->err.active ? -1 : 0;
+    if (na > MAX_ARGS || spec->n > MAX_ARGS)
         return 0;
     const char *pnames[MAX_ARGS], *anames[MAX_ARGS];
     const node *anodes[MAX_ARGS];

@@ -469,7 +469,8 @@ static int literal_default(interp *I, const char *d, value *out)
     return 0;
 }
 
-int contract_register(interp *I, const builtin *b)
+/* Compile b's declaration into the cache (first use: contract_spec). */
+static int contract_compile(interp *I, const builtin *b)
 {
     bspec *s = mem_arena_alloc(I, sizeof *s);
     cparam *p = mem_arena_alloc(I, sizeof *p * (size_t)(b->nparams ? b->nparams : 1));
@@ -507,7 +508,21 @@ int contract_register(interp *I, const builtin *b)
 
 const bspec *contract_spec(interp *I, const builtin *b)
 {
-    return cache_get(I, b);
+    /* compiled on first use, not at registration: a session that calls five
+     * builtins compiles five declarations, not all ~300 (this was most of
+     * the setup of a short run; tests/fuzz/README.md has the measurements) */
+    const bspec *s = cache_get(I, b);
+    if (!s && !contract_compile(I, b))
+        s = cache_get(I, b);
+    return s;
+}
+
+int contract_compile_all(interp *I)
+{
+    for (int i = 0; i < I->nbuiltins; i++)
+        if (!contract_spec(I, I->builtins[i]))
+            return -1;
+    return 0;
 }
 
 int contract_default(interp *I, const bspec *s, int j, value *out)

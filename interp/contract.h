@@ -3,8 +3,8 @@
  * Every builtin declares, for each parameter, a type text (see builtin.h for
  * the mini-language: "num[0,1]", "int>=1", "vec3", "str{log,linear}",
  * "rec{bits: int{8,16}, channels: int[1,4]}", "num+inf" …). contract.c
- * compiles each text once per interpreter (at builtin_register, with the
- * parameter defaults) and checks values against it in one function,
+ * compiles each text once per interpreter (on the builtin's first call, with
+ * the parameter defaults) and checks values against it in one function,
  * contract_check_value, used by call_builtin at run time, by the static
  * call checks of resolve.c before anything runs, and by option readers
  * whose keys depend on the value (save).
@@ -52,10 +52,14 @@ typedef struct bcall {
     int n;
 } bcall;
 
-/* Compile every parameter of b (registration); an error in a declaration
- * is an internal error naming the builtin. */
-int contract_register(interp *I, const builtin *b);
+/* The compiled declaration of b: every parameter's type and default,
+ * compiled on the first call (once per interpreter, then cached). NULL after
+ * recording an error: out of memory, or an internal error naming the
+ * builtin when its declaration does not compile. */
 const bspec *contract_spec(interp *I, const builtin *b);
+/* Compile every registered builtin's declaration (`:help` does, so a bad
+ * declaration fails the REPL tests, not only the first script calling it). */
+int contract_compile_all(interp *I);
 /* The default of parameter j (a borrowed value). */
 int contract_default(interp *I, const bspec *s, int j, value *out);
 /* A type text compiled once per interpreter (cached by address). */

@@ -21,6 +21,10 @@ extern const obj_class lang_ifs_class, lang_rifs_class, lang_map_class;
 const lang_ifs *lang_as_ifs(value v);
 /* The system behind an ifs or rifs value. */
 int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what);
+/* chaos_fit with its pre-pass bounded by --max-points (every binding
+ * fitting a window calls this, not chaos_fit). */
+rt_code lang_chaos_fit(interp *I, const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
+                       rt_error *e);
 /* Maps (and probabilities) from a table of rows, a list of maps or an ifs:
  * malloc'd arrays; returns 1 if probabilities were given, 0 if not, -1 on
  * error. */

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "builtin.h"
+#include "contract.h"
 #include "eval.h"
 #include "fileio.h"
 #include "lexer.h"
@@ -301,6 +302,10 @@ static void cmd_help(repl *r, const char *arg)
         builtin_signature(b, &s);
         printf("%.*s\n  %s\n", (int)s.len, (char *)s.data, b->doc);
         bytebuf_free(&s);
+        return;
+    }
+    if (contract_compile_all(I)) { /* every declaration, so a bad one shows here */
+        report(r);
         return;
     }
     fputs(help_text, stdout);

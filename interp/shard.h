@@ -93,6 +93,11 @@ int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned 
  * Frees what the attempt allocated. Returns -1 if writing failed (error in I). */
 int shard_attempt_end(shard *s, int ok, const char *script);
 
+/* Merge's check of every part (set up by shard_init_merge) against a script
+ * whose FNV-1a hash is given, without a script: for tests/fuzz/fuzz_shard.c.
+ * 0, or -1 with the error in I; shard_attempt_end(s, 0, "") frees. */
+int shard_check_parts(shard *s, interp *I, uint64_t script_hash);
+
 /* The evaluator's hooks (eval.c), cheap when s has no partial values. */
 int shard_scan_args(interp *I, const char *builtin_name, const node *call, const value *pos, int npos,
                     const value *named, int nnamed);

@@ -658,14 +658,14 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
     sysdata *d = sys_make(s, o, 0, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
+    size_t np = o->fit_points && o->fit_points < CHAOS_FIT_POINTS ? (size_t)o->fit_points : CHAOS_FIT_POINTS;
     chaos_opts fo = *o;
-    fo.points = CHAOS_FIT_POINTS;
+    fo.points = np;
     fo.colour = CHAOS_COLOUR_NONE;
-    fo.chunk = CHAOS_FIT_POINTS;
+    fo.chunk = (uint32_t)np;
     fo.seed = rng_hash3(o->seed, 1ull << 63, 0, 0); /* independent of the chunks' streams */
     job j;
     job_init(&j, d, &fo);
-    size_t np = CHAOS_FIT_POINTS;
     j.pos = rt_malloc(sizeof *j.pos * 3 * np);
     double *ax = rt_malloc(sizeof *ax * np);
     if (!j.pos || !ax) {

@@ -40,7 +40,8 @@
  *   c_k = opts.map_c[k] (in [0, 1]) or k/(n-1) by default (0 for one map);
  *   the ramp is opts.ramp or grey.
  *
- * Window fitting (chaos_fit): a pre-pass of CHAOS_FIT_POINTS points (rng
+ * Window fitting (chaos_fit): a pre-pass of CHAOS_FIT_POINTS points, or
+ * opts.fit_points when that is smaller (the interpreter's --max-points), (rng
  * stream 2^63 of the seed, so independent of the chunks); per axis the
  * bounding interval of the points between the 0.1 % and 99.9 % quantiles
  * (a few far-out transients or rare excursions do not blow the window up),
@@ -98,6 +99,7 @@ typedef struct chaos_opts {
     chaos_colour colour;
     const double *map_c; /* n colour coordinates, or NULL */
     const ramp *ramp;    /* or NULL: grey */
+    uint64_t fit_points; /* chaos_fit: at most this many pre-pass points; 0 = CHAOS_FIT_POINTS */
     /* projection only */
     double near_b, far_b; /* depth shading brightness, both 0 = 1 and 0.25 */
     float bg[4];          /* background of empty pixels */

@@ -1,6 +1,6 @@
 /* fuzzgen.c — writes seed corpora for the fuzz harnesses (tests/fuzz/).
  *
- *   fuzzgen DIR        writes DIR/script/gen_* and DIR/{png,inflate,pnm,ifs,
+ *   fuzzgen DIR        writes DIR/script/gen_* and DIR/{png,apng,recipe,inflate,pnm,ifs,
  *                      nrrd,vtk,ply,obj,stl}/seed_*
  *   fuzzgen --over DIR also writes DIR/over/: inputs past the script
  *                      harness's nesting caps (the known deep-nesting
@@ -22,6 +22,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "apng.h"
 #include "deflate.h"
 #include "fileio.h"
 #include "image.h"
@@ -199,6 +200,33 @@ static void numbers(const char *sub)
     }
 }
 
+/* The newer builtins with tiny work (fit: one map, one or two generations,
+ * tiny targets; meshes of a few faces; framing), and their edges. */
+static void newer(const char *sub)
+{
+    bytebuf b;
+    bytebuf_init(&b);
+    bytebuf_printf(&b, "let f = fit({\n1 1 0\n0 1 1\n}, maps: 1, iterations: 1)\nprint(f)\n"
+                       "let g = fit([[1, 0, 1], [1, 1, 1]], maps: \"1..2\", iterations: 2, rifs: true, seed: 3)\n"
+                       "print(g)\nprint(fit([[1, 1], [1, 0]], maps: 1, iterations: 1, start: f))\n"
+                       "let im = image([3, 2], 1)\nprint(fit(im, maps: 1, iterations: 1, foreground: \"dark\"))\n"
+                       "print(fit(im, maps: 1, iterations: 1, threshold: 1, time: 0.01))\n");
+    script(sub, "gen_fit_tiny", &b);
+    bytebuf_printf(&b, "let p = pyramid()\nlet c = cube([0, 0, 0], [1, 2, 3])\n"
+                       "let t = polyhedron([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], "
+                       "[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])\n"
+                       "let q = polyhedron([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1]], "
+                       "[[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])\n"
+                       "print(p, c, t, q)\nprint(c.lo, c.hi, t.vertices)\n"
+                       "print(iterate(ifs([[0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5, 0, 0, 0], "
+                       "[0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5, 0.5, 0, 0]]), start: p, steps: 1))\n"
+                       "let cam = framing([0, 0, 0], [1, 1, 1], [8, 8])\nprint(cam)\n"
+                       "print(framing(c.lo, c.hi, 4, azimuth: -720, elevation: -89.9))\n"
+                       "print(rasterize(c, camera: cam, size: [8, 8]))\n");
+    script(sub, "gen_meshes_framing", &b);
+    bytebuf_free(&b);
+}
+
 static void scripts(const char *dir, int over)
 {
     static const int depths[] = {8, 40, 60};
@@ -209,6 +237,7 @@ static void scripts(const char *dir, int over)
     chains(dir, lens, 2);
     wide(dir);
     numbers(dir);
+    newer(dir);
     if (over) {
         nests("over", deep, 3);
         chains("over", longc, 2);
@@ -319,6 +348,83 @@ static void pngs(void)
                                 0, 40, 0, 41,   /* p6: x 1, y 0 and 2 */
                                 0, 50, 51, 52}; /* p7: y 1 */
     png_raw("seed_adam7.png", 3, 3, 8, 0, 1, NULL, 0, NULL, 0, a7, sizeof a7);
+}
+
+/* APNG harness inputs: 3 option bytes (delay, plays), then the frames as
+ * whole PNG files one after the other (tests/fuzz/fuzz_loaders.c). */
+static void apngs(void)
+{
+    bytebuf b, f;
+    bytebuf_init(&b);
+    bytebuf_init(&f);
+    rt_error e;
+    image a, c;
+    test_image(&a, 5, 4);
+    test_image(&c, 5, 4);
+    for (size_t i = 0; i < (size_t)5 * 4 * 4; i += 3)
+        c.px[i] = 1.0f - c.px[i]; /* a second frame that differs */
+    static const int bits[] = {8, 16};
+    char name[64];
+    for (int bi = 0; bi < 2; bi++)
+        for (int ch = 1; ch <= 4; ch += 3) {
+            for (int nf = 1; nf <= 3; nf++) {
+                bytebuf_append(&b, "\x00\x28\x02", 3);
+                for (int k = 0; k < nf; k++) {
+                    png_encode(k % 2 ? &c : &a, bits[bi], ch, &f, &e);
+                    bytebuf_append(&b, f.data, f.len);
+                    bytebuf_free(&f);
+                    bytebuf_init(&f);
+                }
+                snprintf(name, sizeof name, "seed_%d_%d_x%d", bits[bi], ch, nf);
+                put_buf("apng", name, &b);
+            }
+        }
+    /* frames of two sizes (refused), and an APNG as a frame */
+    image sm;
+    test_image(&sm, 3, 3);
+    bytebuf_append(&b, "\x01\x00\x00", 3);
+    png_encode(&a, 8, 3, &f, &e);
+    bytebuf_append(&b, f.data, f.len);
+    bytebuf_free(&f);
+    bytebuf_init(&f);
+    png_encode(&sm, 8, 3, &f, &e);
+    bytebuf_append(&b, f.data, f.len);
+    bytebuf_free(&f);
+    bytebuf_init(&f);
+    put_buf("apng", "seed_two_sizes", &b);
+    const image *ims[2] = {&a, &c};
+    apng_opts o = {APNG_DEFAULT_DELAY_MS, 0};
+    bytebuf_append(&b, "\x00\x10\x00", 3);
+    if (apng_encode(ims, 2, 8, 4, &o, &f, &e) == RT_OK)
+        bytebuf_append(&b, f.data, f.len);
+    bytebuf_free(&f);
+    put_buf("apng", "seed_apng_in", &b);
+    image_free(&a);
+    image_free(&c);
+    image_free(&sm);
+}
+
+/* Recipe texts (interp/recipe.h) for the recipe harness; files frac wrote
+ * are added by the fuzz-seeds rule. */
+static void recipes(void)
+{
+    static const char *const texts[] = {
+        "frac-recipe 1\nversion: 0.1.0\nscript-path: a.frac\nscript-sha256: "
+        "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef\nseed: 1\nframe: none\n"
+        "param n=3\nparam s=\"a\\tb\\\\c\\x01\"\narg x\narg \\n\nscript: 8\n\nprint(1)",
+        "frac-recipe 1\nversion: 0.1.0\nscript-path: b.frac\nseed: 9007199254740992\nframe: -2\n"
+        "frames: -2..10:4\nscript: omitted\n",
+        "frac-recipe 1\nversion: 0.1.0\nscript-path: c\\x7f.frac\nseed: 0\nframe: 7\nscript: 0\n",
+        "# frac-recipe 1\n# version: 0.1.0\n# script-path: d.frac\n# seed: 2\n# frame: none\n# script: 3\nP5\n",
+        "comment frac-recipe 1\ncomment version: 0.1.0\ncomment script-path: e.frac\ncomment seed: 3\n"
+        "comment frame: none\ncomment script: omitted\n",
+        "frac-recipe 2\nversion: 9\n",
+    };
+    char name[32];
+    for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+        snprintf(name, sizeof name, "seed_text_%zu", i);
+        put("recipe", name, texts[i], strlen(texts[i]));
+    }
 }
 
 static void inflates(void)
@@ -470,6 +576,8 @@ int main(int argc, char **argv)
     mkdir(root, 0777);
     scripts("script", over);
     pngs();
+    apngs();
+    recipes();
     inflates();
     pnms();
     ifss();

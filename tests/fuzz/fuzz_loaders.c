@@ -11,11 +11,20 @@
  *   ply      mio_ply_from_mem (binary and ASCII)
  *   obj      mio_obj_from_mem
  *   stl      mio_stl_from_mem
+ *   apng     apng_assemble: the input is split at each PNG signature into
+ *            frames (each repaired as for png), assembled, and the result
+ *            checked chunk by chunk (below)
+ *   recipe   recipe_find on the input as a file frac wrote (PNG text chunks,
+ *            comment lines, the one-line form), recipe_parse of what it
+ *            finds and of the raw input; a parsed recipe is written back
+ *            with recipe_text and must parse to the same fields
  * Oracles beyond "no crash, no sanitizer report, no leak": a decoded image,
  * volume or mesh is checked for consistency (sizes, triangle indices in
  * range), images are re-encoded to 16-bit PNG and decoded back within
  * 1/65535, volumes to float NRRD and back bit-exactly, meshes to binary PLY
  * and back with the same counts.
+ *
+ * FRAC_FUZZ_VERBOSE=1 prints what each apng and recipe input did.
  *
  * Known: a PNG may declare up to PNG_MAX_DIM² pixels and decode them from a
  * few KB (issue 11, memory work); the harness skips headers over 2^18
@@ -27,12 +36,14 @@
 #include <string.h>
 
 #include "rt_alloc.h"
+#include "apng.h"
 #include "deflate.h"
 #include "fractint.h"
 #include "mesh.h"
 #include "mesh_io.h"
 #include "png.h"
 #include "pnm.h"
+#include "recipe.h"
 #include "volume_io.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -40,6 +51,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 #define STR2(x) #x
 #define STR(x) STR2(x)
 static const char *const loader = STR(FUZZ_LOADER);
+
+static int verbose; /* FRAC_FUZZ_VERBOSE=1: what each replayed input did (apng, recipe) */
 
 static void fail(const char *what)
 {
@@ -314,12 +327,262 @@ static void fuzz_mesh(const unsigned char *d, size_t n, int fmt)
     mesh_free(&m);
 }
 
+/* ---- APNG: the assembler and what it writes ----------------------------- */
+
+static int same_image(const image *a, const image *b)
+{
+    if (a->w != b->w || a->h != b->h)
+        return 0;
+    size_t n = (size_t)a->w * a->h * 4;
+    for (size_t i = 0; i < n; i++)
+        if (a->px[i] != b->px[i] && !(isnan(a->px[i]) && isnan(b->px[i])))
+            return 0;
+    return 1;
+}
+
+/* Walk the assembled file: signature, every chunk's CRC, IHDR first and
+ * equal to the first frame's, acTL (frames, plays) before the first IDAT,
+ * fcTL/fdAT sequence numbers 0, 1, 2… in file order, one fcTL per frame
+ * (whole canvas, delay as asked), IEND last. Each frame's data (IDAT, or
+ * fdAT without its sequence number) is collected into frames[k]. */
+static void check_apng(const unsigned char *d, size_t n, int nframes, const apng_opts *o,
+                       const unsigned char *ihdr0, bytebuf *frames)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    if (n < 8 || memcmp(d, sig, 8) != 0)
+        fail("APNG: no PNG signature");
+    size_t pos = 8;
+    uint32_t seq = 0;
+    int fctl = 0, seen_actl = 0, seen_iend = 0, nchunk = 0;
+    while (pos < n) {
+        if (seen_iend)
+            fail("APNG: bytes after IEND");
+        if (n - pos < 12)
+            fail("APNG: a truncated chunk");
+        uint32_t l = be32(d + pos);
+        if (l > n - pos - 12)
+            fail("APNG: a chunk longer than the file");
+        const unsigned char *type = d + pos + 4, *body = d + pos + 8;
+        if (be32(body + l) != deflate_crc32(0, type, (size_t)l + 4))
+            fail("APNG: a chunk CRC is wrong");
+        if (nchunk++ == 0 && (memcmp(type, "IHDR", 4) != 0 || l != 13 || memcmp(body, ihdr0, 13) != 0))
+            fail("APNG: the first chunk is not the first frame's IHDR");
+        if (!memcmp(type, "acTL", 4)) {
+            if (seen_actl || fctl || l != 8 || be32(body) != (uint32_t)nframes || be32(body + 4) != (uint32_t)o->loop)
+                fail("APNG: acTL missing, repeated, late or wrong");
+            seen_actl = 1;
+        } else if (!memcmp(type, "fcTL", 4)) {
+            if (!seen_actl || l != 26 || be32(body) != seq++ || fctl >= nframes ||
+                memcmp(body + 4, ihdr0, 8) != 0 || be32(body + 12) != 0 || be32(body + 16) != 0 ||
+                (body[20] << 8 | body[21]) != o->delay_ms || (body[22] << 8 | body[23]) != 1000 || body[24] ||
+                body[25])
+                fail("APNG: an fcTL is out of sequence or wrong");
+            fctl++;
+        } else if (!memcmp(type, "IDAT", 4)) {
+            if (fctl != 1)
+                fail("APNG: IDAT outside the first frame");
+            bytebuf_append(&frames[0], body, l);
+        } else if (!memcmp(type, "fdAT", 4)) {
+            if (fctl < 2 || l < 4 || be32(body) != seq++)
+                fail("APNG: an fdAT is out of sequence");
+            bytebuf_append(&frames[fctl - 1], body + 4, l - 4);
+        } else if (!memcmp(type, "IEND", 4)) {
+            seen_iend = 1;
+        }
+        pos += 12 + (size_t)l;
+    }
+    if (!seen_iend || fctl != nframes)
+        fail("APNG: no IEND, or not one fcTL per frame");
+}
+
+/* A plain PNG of one frame: the IHDR (and PLTE / tRNS) of the assembled
+ * file with that frame's data as one IDAT. */
+static void frame_png(const unsigned char *d, size_t n, const bytebuf *data, bytebuf *out)
+{
+    bytebuf_append(out, d, 8);
+    for (size_t pos = 8; n - pos >= 12;) {
+        uint32_t l = be32(d + pos);
+        const unsigned char *type = d + pos + 4;
+        if (!memcmp(type, "IHDR", 4) || !memcmp(type, "PLTE", 4) || !memcmp(type, "tRNS", 4))
+            bytebuf_append(out, d + pos, 12 + (size_t)l);
+        pos += 12 + (size_t)l;
+    }
+    size_t at = out->len;
+    bytebuf_u32be(out, (uint32_t)data->len);
+    bytebuf_append(out, "IDAT", 4);
+    bytebuf_append(out, data->data, data->len);
+    if (!out->failed)
+        bytebuf_u32be(out, deflate_crc32(0, out->data + at + 4, data->len + 4));
+    bytebuf_u32be(out, 0);
+    bytebuf_append(out, "IEND", 4);
+    bytebuf_u32be(out, deflate_crc32(0, "IEND", 4));
+}
+
+#define APNG_FRAMES 4
+static void fuzz_apng(const unsigned char *d, size_t n)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    /* frames start at each signature; bytes before the first are the options */
+    size_t at[APNG_FRAMES + 1];
+    int k = 0;
+    for (size_t i = 0; i + 8 <= n && k < APNG_FRAMES; i++)
+        if (d[i] == 0x89 && memcmp(d + i, sig, 8) == 0)
+            at[k++] = i;
+    if (k == 0)
+        return;
+    at[k] = n;
+    apng_opts o = {at[0] >= 2 ? (d[0] << 8 | d[1]) % (APNG_MAX_DELAY_MS + 1) : APNG_DEFAULT_DELAY_MS,
+                   at[0] >= 3 ? d[2] : 0};
+    unsigned char *part[APNG_FRAMES] = {0};
+    const unsigned char *pngs[APNG_FRAMES];
+    size_t lens[APNG_FRAMES];
+    image im[APNG_FRAMES];
+    int ndec = 0, ok = 1;
+    for (int i = 0; i < k; i++) {
+        size_t rn = 0;
+        part[i] = png_repair(d + at[i], at[i + 1] - at[i], &rn);
+        pngs[i] = part[i] ? part[i] : d + at[i];
+        lens[i] = part[i] ? rn : at[i + 1] - at[i];
+        rt_error e;
+        png_info info;
+        /* the assembler decodes every frame: keep declared sizes small */
+        if (png_read_info(pngs[i], lens[i], &info, &e) != RT_OK || (double)info.w * info.h > 65536)
+            ok = 0;
+        else if (ok && png_decode(pngs[i], lens[i], &im[i], NULL, &e) == RT_OK)
+            ndec = i + 1;
+        else
+            ok = 0;
+    }
+    if (ok) {
+        bytebuf out;
+        bytebuf_init(&out);
+        rt_error e;
+        rt_code ac = apng_assemble(pngs, lens, k, NULL, &o, &out, &e);
+        if (verbose)
+            fprintf(stderr, "fuzz_apng: %d frame(s): %s\n", k, ac ? e.msg : "assembled and checked");
+        if (ac == RT_OK) {
+            /* a viewer without APNG shows the first frame */
+            image first;
+            if (png_decode(out.data, out.len, &first, NULL, &e) != RT_OK)
+                fail("APNG: the assembled file does not decode as a PNG");
+            if (!same_image(&first, &im[0]))
+                fail("APNG: the default image is not the first frame");
+            image_free(&first);
+            bytebuf frames[APNG_FRAMES];
+            for (int i = 0; i < k; i++)
+                bytebuf_init(&frames[i]);
+            const unsigned char *ihdr0 = NULL; /* the first frame's IHDR body */
+            for (size_t pos = 8; !ihdr0 && lens[0] - pos >= 12 + 13; pos += 12 + (size_t)be32(pngs[0] + pos))
+                if (!memcmp(pngs[0] + pos + 4, "IHDR", 4))
+                    ihdr0 = pngs[0] + pos + 8;
+            if (!ihdr0)
+                fail("APNG: a frame that decodes has no IHDR");
+            check_apng(out.data, out.len, k, &o, ihdr0, frames);
+            /* each frame's data, as a PNG of its own, decodes to that frame */
+            for (int i = 0; i < k; i++) {
+                bytebuf one;
+                bytebuf_init(&one);
+                frame_png(out.data, out.len, &frames[i], &one);
+                image back;
+                if (one.failed || png_decode(one.data, one.len, &back, NULL, &e) != RT_OK)
+                    fail("APNG: a frame's data does not decode");
+                if (!same_image(&back, &im[i]))
+                    fail("APNG: a frame's data decodes to another image");
+                image_free(&back);
+                bytebuf_free(&one);
+                bytebuf_free(&frames[i]);
+            }
+        } else if (k == 1) {
+            fail("APNG: one frame that decodes was refused");
+        }
+        bytebuf_free(&out);
+    }
+    for (int i = 0; i < ndec; i++)
+        image_free(&im[i]);
+    for (int i = 0; i < k; i++)
+        rt_free(part[i]);
+}
+
+/* ---- recipes -------------------------------------------------------------- */
+
+static int same_str(const char *a, const char *b) { return (!a && !b) || (a && b && strcmp(a, b) == 0); }
+
+static void recipe_round_trip(const char *text, size_t len)
+{
+    recipe r, b;
+    char err[256];
+    if (recipe_parse(text, len, &r, err, sizeof err)) {
+        if (verbose)
+            fprintf(stderr, "fuzz_recipe: %s\n", err);
+        return;
+    }
+    if (verbose)
+        fprintf(stderr, "fuzz_recipe: parsed (%d params, %d args, script %s)\n", r.nparams, r.nargs,
+                r.script ? "text" : r.has_script ? "length only" : "omitted");
+    bytebuf t;
+    bytebuf_init(&t);
+    size_t hl = 0;
+    char one[256];
+    recipe_text(&r, &t, &hl, one, sizeof one);
+    if (t.failed)
+        fail("recipe: out of memory writing it back");
+    if (hl > t.len || strlen(one) >= sizeof one)
+        fail("recipe: header length or one-line form out of range");
+    if (recipe_parse((const char *)t.data, t.len, &b, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        fail("recipe: what recipe_text wrote does not parse");
+    }
+    int same = same_str(r.version, b.version) && same_str(r.script_path, b.script_path) &&
+               !strcmp(r.sha256, b.sha256) && r.seed == b.seed && r.frame_given == b.frame_given &&
+               r.frame == b.frame && r.frames_range == b.frames_range && r.frames_a == b.frames_a &&
+               r.frames_b == b.frames_b && r.frames_step == b.frames_step && r.nparams == b.nparams &&
+               r.nargs == b.nargs && r.has_script == b.has_script && r.script_len == b.script_len &&
+               (r.script != NULL) == (b.script != NULL) &&
+               (!r.script || memcmp(r.script, b.script, r.script_len) == 0);
+    for (int i = 0; same && i < r.nparams; i++)
+        same = !strcmp(r.params[i], b.params[i]);
+    for (int i = 0; same && i < r.nargs; i++)
+        same = !strcmp(r.args[i], b.args[i]);
+    if (!same)
+        fail("recipe: written back, it parses to other fields");
+    /* the header alone (what the comment-line formats carry) parses too */
+    recipe h;
+    if (recipe_parse((const char *)t.data, hl, &h, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        fail("recipe: the header alone does not parse");
+    }
+    recipe_free(&h);
+    recipe_free(&b);
+    recipe_free(&r);
+    bytebuf_free(&t);
+}
+
+static void fuzz_recipe(const unsigned char *d, size_t n)
+{
+    size_t rn = 0;
+    unsigned char *r = n >= 8 && !memcmp(d, "\x89PNG", 4) ? png_repair(d, n, &rn) : NULL;
+    char *text = NULL, one[256], err[256];
+    size_t len = 0;
+    int found = recipe_find(r ? r : d, r ? rn : n, &text, &len, one, sizeof one, err, sizeof err);
+    if (found == 0) {
+        if (!text && len)
+            fail("recipe_find: found, but no text");
+        recipe_round_trip(text, len);
+    } else if (found == 1 && strlen(one) >= sizeof one) {
+        fail("recipe_find: the one-line form overflows");
+    }
+    rt_free(text);
+    rt_free(r);
+    recipe_round_trip((const char *)d, n);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size > (1u << 20))
         return 0;
     /* a private heap copy of exactly size bytes: ASan sees any read past
      * the end, and no decoder can depend on a NUL after the data */
+    verbose = getenv("FRAC_FUZZ_VERBOSE") != NULL;
     unsigned char *d = malloc(size ? size : 1);
     if (!d)
         return 0;
@@ -342,6 +605,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fuzz_mesh(d, size, 1);
     else if (!strcmp(loader, "stl"))
         fuzz_mesh(d, size, 2);
+    else if (!strcmp(loader, "apng"))
+        fuzz_apng(d, size);
+    else if (!strcmp(loader, "recipe"))
+        fuzz_recipe(d, size);
     else
         fail("unknown FUZZ_LOADER");
     free(d);
