@@ -151,35 +151,34 @@ static int c_if(interp *I, env *e, const cnode *c, value *out)
 }
 
 /* if a CMP b then … with a and b numbers or names: compared in place when
- * both are numbers (c->slot is the operator), else as c_if. */
-static int c_if_cmp(interp *I, env *e, const cnode *c, value *out)
-{
-    const value *pa = cnode_peek(e, c->a->a), *pb = cnode_peek(e, c->a->b);
-    int t;
-    if (pa && pb && pa->k == V_NUM && pb->k == V_NUM) {
-        double x = pa->u.n, y = pb->u.n;
-        switch (c->slot) {
-        case T_LT: t = x < y; break;
-        case T_LE: t = x <= y; break;
-        case T_GT: t = x > y; break;
-        case T_GE: t = x >= y; break;
-        case T_EQ: t = x == y; break;
-        default: t = x != y; break;
-        }
-    } else {
-        value v;
-        if (cnode_eval(I, e, c->a, &v))
-            return -1;
-        t = truthy(v);
-        val_unref(I, v);
+ * both are numbers, else as c_if. */
+#define IF_CMP_FN(NAME, CMP)                                                   \
+    static int NAME(interp *I, env *e, const cnode *c, value *out)             \
+    {                                                                          \
+        const value *pa = cnode_peek(e, c->a->a), *pb = cnode_peek(e, c->a->b); \
+        int t;                                                                 \
+        if (pa && pb && pa->k == V_NUM && pb->k == V_NUM) {                    \
+            t = pa->u.n CMP pb->u.n;                                           \
+        } else {                                                               \
+            value v;                                                           \
+            if (cnode_eval(I, e, c->a, &v))                                    \
+                return -1;                                                     \
+            t = truthy(v);                                                     \
+            val_unref(I, v);                                                   \
+        }                                                                      \
+        if (t)                                                                 \
+            return cnode_eval(I, e, c->b, out);                                \
+        if (c->c)                                                              \
+            return cnode_eval(I, e, c->c, out);                                \
+        *out = val_nil();                                                      \
+        return 0;                                                              \
     }
-    if (t)
-        return cnode_eval(I, e, c->b, out);
-    if (c->c)
-        return cnode_eval(I, e, c->c, out);
-    *out = val_nil();
-    return 0;
-}
+IF_CMP_FN(c_if_lt, <)
+IF_CMP_FN(c_if_le, <=)
+IF_CMP_FN(c_if_gt, >)
+IF_CMP_FN(c_if_ge, >=)
+IF_CMP_FN(c_if_eq, ==)
+IF_CMP_FN(c_if_ne, !=)
 
 static int c_index(interp *I, env *e, const cnode *c, value *out)
 {
@@ -294,7 +293,7 @@ static int c_call(interp *I, env *e, const cnode *c, value *out)
 done:
     while (i-- > 0)
         val_unref(I, args[i]);
-    val_unref(I, fn);
+    cnode_unref(I, fn);
     return rc;
 }
 
@@ -319,7 +318,7 @@ static int c_call1(interp *I, env *e, const cnode *c, value *out)
         rc = eval_call_positional(I, e, fn, &arg, 1, c->n, c->assign, out);
     }
     val_unref(I, arg);
-    val_unref(I, fn);
+    cnode_unref(I, fn);
     return rc;
 }
 
@@ -518,8 +517,8 @@ static const cnode *comp_expr(interp *I, const node *n, int depth)
             if (k->kind == N_BINARY && c->a->a && c->a->a->tag != CT_OTHER && c->a->b->tag != CT_OTHER &&
                 (k->op == T_LT || k->op == T_LE || k->op == T_GT || k->op == T_GE || k->op == T_EQ ||
                  k->op == T_NE)) {
-                c->fn = c_if_cmp;
-                c->slot = k->op;
+                c->fn = k->op == T_LT ? c_if_lt : k->op == T_LE ? c_if_le : k->op == T_GT ? c_if_gt
+                        : k->op == T_GE ? c_if_ge : k->op == T_EQ ? c_if_eq : c_if_ne;
             }
         }
         return c;

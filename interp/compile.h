@@ -133,6 +133,17 @@ __attribute__((always_inline)) static inline const value *cnode_peek(env *e, con
     return NULL;
 }
 
+/* val_unref, with a reference that is not the last dropped inline */
+__attribute__((always_inline)) static inline void cnode_unref(interp *I, value v)
+{
+    if (v.k >= V_STR && v.k != V_BUILTIN) {
+        if (v.u.h->rc > 1)
+            v.u.h->rc--;
+        else
+            val_heap_unref(I, v.u.h);
+    }
+}
+
 /* eval.c's pieces the compiled form calls (not for other modules). */
 int eval_binary_node(interp *I, const node *n, value a, value b, value *out); /* takes a, b */
 int eval_unary_node(interp *I, const node *n, value a, value *out);           /* borrows a */

@@ -980,6 +980,12 @@ __attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
         val_unref(I, it);
         return -1;
     }
+    /* The body's statements run here, not through eval_block: the C stack
+     * it checks is as deep at every iteration, so it is checked once. */
+    if (count > 0 && cstack_exhausted()) {
+        val_unref(I, it);
+        return stack_overflow(I, n->kids[1]);
+    }
     env *s = NULL;
     for (size_t i = 0; i < count && rc == 0; i++) {
         if (check_interrupt(I, n)) {
@@ -997,8 +1003,8 @@ __attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
         } else {
             rc = val_env_define(I, s, n->str, iter_item(it, &rs, i));
         }
-        if (rc == 0)
-            rc = body->fn(I, s, body, NULL);
+        for (int k = 0; k < body->nkids && rc == 0; k++)
+            rc = body->kids[k]->fn(I, s, body->kids[k], NULL);
         if (rc == 0)
             s = iter_scope_next(I, s);
     }
