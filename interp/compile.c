@@ -238,9 +238,6 @@ static int c_doblock(interp *I, env *e, const cnode *c, value *out)
 static int call_user_exact(interp *I, vfunc *f, const value *args, int nargs, const node *call, value *out)
 {
     const node *l = f->lambda;
-    const cnode *body = compile_lambda(I, l);
-    if (!body)
-        return -1;
     env *ne = val_env_new(I, f->closure);
     if (!ne)
         return -1;
@@ -264,7 +261,8 @@ static int call_user_exact(interp *I, vfunc *f, const value *args, int nargs, co
     } else if (eval_push_frame(I, f->name ? f->name : "<lambda>", call)) {
         goto done;
     }
-    rc = body->fn(I, ne, body, out);
+    const cnode *body = compile_lambda(I, l); /* after the frame, as in call_user */
+    rc = body ? body->fn(I, ne, body, out) : -1;
     I->depth--;
 done:
     val_heap_unref(I, &ne->h);
