@@ -68,8 +68,11 @@ ops() {
 
 load=$(cut -d' ' -f1-3 /proc/loadavg)
 printf '%-8s %12s %12s %8s   (load average %s)\n' program 'frac ns/op' 'Lua ns/op' ratio "$load"
-# name, two frac sizes, two Lua sizes (Lua needs larger ones to take measurable time)
-for spec in "fib 22 27 27 30" "range 1000000 3000000 3000000 30000000" "closure 300000 1000000 1000000 3000000" \
+# name, two frac sizes, two Lua sizes (Lua needs larger ones to take measurable time).
+# /usr/bin/time counts CPU time in 10 ms steps: the difference between the two
+# sizes must take a few hundred ms, or the slope is mostly rounding (fib 22..27
+# was ~580 K calls, ~20 ms: a 17 ns/call step).
+for spec in "fib 27 32 27 32" "range 3000000 30000000 3000000 30000000" "closure 300000 1000000 1000000 3000000" \
     "concat 300000 1000000 1000000 5000000" "string 20000 80000 20000 80000"; do
     set -- $spec
     name=$1 n1=$2 n2=$3 m1=$4 m2=$5

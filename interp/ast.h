@@ -59,6 +59,9 @@ typedef struct node {
      * N_FNDEF: the slot it defines in its own scope. The evaluator checks
      * the slot still holds that name before using it (see eval.c). */
     int slot, hops;
+    /* Set by compile.c: the compiled form of a lambda's body or of a block's
+     * statements, made the first time it runs (NULL until then). */
+    const struct cnode *code;
 } node;
 
 #endif

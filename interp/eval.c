@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "builtin.h"
+#include "compile.h"
 #include "contract.h"
 #include "cstack.h"
 #include "fileio.h"
@@ -16,44 +17,15 @@
 #include "shard.h"
 #include "stdlib_embed.h"
 
-/* A name by its slot (resolve.c), checked: the slot must hold the name
- * (it may not be defined yet, or a REPL input may have stopped half-way),
- * else the search by name decides, as it always did. */
-static inline value *lookup(env *e, const node *n)
-{
-    if (n->slot) {
-        env *t = e;
-        for (int h = n->hops; h > 0 && t; h--)
-            t = t->parent;
-        /* t is NULL only if the scopes are not the ones resolve.c saw */
-        size_t k = (size_t)n->slot - 1;
-        if (t && k < t->n && t->names[k] == n->str)
-            return &t->vals[k];
-    }
-    return val_env_lookup(e, n->str);
-}
-
 /* A name's value (a new reference), or the error for an unknown one. */
 static inline int eval_name(interp *I, env *e, const node *n, value *out)
 {
-    value *v = lookup(e, n);
+    value *v = scope_lookup(e, n);
     if (!v)
         return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
     *out = *v;
     val_ref(*out);
     return 0;
-}
-
-/* Define n->str in e (takes v), in place when the slot already holds it. */
-static inline int define(interp *I, env *e, const node *n, value v)
-{
-    size_t k = (size_t)n->slot - 1;
-    if (n->slot && k < e->n && e->names[k] == n->str) {
-        val_unref(I, e->vals[k]);
-        e->vals[k] = v;
-        return 0;
-    }
-    return val_env_define(I, e, n->str, v);
 }
 
 static int check_interrupt(interp *I, const node *at)
@@ -304,10 +276,8 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
     }
     if (push_frame(I, fname, call))
         goto done;
-    if (l->body->kind == N_BLOCK)
-        rc = eval_block(I, e, l->body, out);
-    else
-        rc = eval_expr(I, e, l->body, out);
+    const cnode *body = compile_lambda(I, l); /* compile.c: the first call compiles it */
+    rc = body ? body->fn(I, e, body, out) : -1;
     I->depth--;
 done:
     val_heap_unref(I, &e->h);
@@ -451,7 +421,7 @@ __attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node 
         I->lazy_range = NULL;
     } else if (assign && npos > 0 && pos[0].k == V_LIST && fn.k == V_BUILTIN &&
                strcmp(fn.u.bi->name, "concat") == 0) {
-        value *x = lookup(e, assign); /* the arguments may have reassigned it */
+        value *x = scope_lookup(e, assign); /* the arguments may have reassigned it */
         I->append_target = x && x->k == V_LIST && x->u.h == pos[0].u.h ? pos[0].u.h : NULL;
         rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
         I->append_target = NULL;
@@ -834,7 +804,7 @@ static inline int eval_leaf(interp *I, env *e, const node *n, value *out)
         return 0;
     }
     if (n->kind == N_NAME) {
-        value *v = lookup(e, n);
+        value *v = scope_lookup(e, n);
         if (v) {
             *out = *v;
             val_ref(*out);
@@ -1003,7 +973,19 @@ __attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
     size_t count;
     if (eval_iterable(I, e, n->kids[0], &it, &rs, &count))
         return -1;
+    /* the body's compiled form (compile.c), made on the loop's first run */
+    const cnode *body = compile_block(I, n->kids[1]); /* kids[1] is an N_BLOCK (parser.c) */
     int rc = 0;
+    if (!body) {
+        val_unref(I, it);
+        return -1;
+    }
+    /* The body's statements run here, not through eval_block: the C stack
+     * it checks is as deep at every iteration, so it is checked once. */
+    if (count > 0 && cstack_exhausted()) {
+        val_unref(I, it);
+        return stack_overflow(I, n->kids[1]);
+    }
     env *s = NULL;
     for (size_t i = 0; i < count && rc == 0; i++) {
         if (check_interrupt(I, n)) {
@@ -1021,8 +1003,8 @@ __attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
         } else {
             rc = val_env_define(I, s, n->str, iter_item(it, &rs, i));
         }
-        if (rc == 0)
-            rc = eval_block(I, s, n->kids[1], NULL);
+        for (int k = 0; k < body->nkids && rc == 0; k++)
+            rc = body->kids[k]->fn(I, s, body->kids[k], NULL);
         if (rc == 0)
             s = iter_scope_next(I, s);
     }
@@ -1049,7 +1031,7 @@ __attribute__((noinline)) static int exec_param(interp *I, env *e, const node *n
         val_unref(I, def);
         def = ov;
     }
-    return define(I, e, n, def);
+    return scope_define(I, e, n, def);
 }
 
 __attribute__((noinline)) static int exec_import(interp *I, env *e, const node *n)
@@ -1085,10 +1067,10 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         value v;
         if (eval_expr(I, e, n->kids[0], &v))
             return -1;
-        return define(I, e, n, v);
+        return scope_define(I, e, n, v);
     }
     case N_ASSIGN: {
-        value *slot = lookup(e, n);
+        value *slot = scope_lookup(e, n);
         if (!slot)
             return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                           n->str, n->str);
@@ -1096,7 +1078,7 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         const node *rhs = n->kids[0];
         if (rhs->kind == N_CALL ? eval_call_in(I, e, rhs, &v, NULL, n) : eval_expr(I, e, rhs, &v))
             return -1;
-        slot = lookup(e, n); /* the evaluation may have grown the scope */
+        slot = scope_lookup(e, n); /* the evaluation may have grown the scope */
         val_unref(I, *slot);
         *slot = v;
         return 0;
@@ -1107,7 +1089,7 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         value f = val_func(I, n->kids[0], e, n->str);
         if (f.k == V_NIL)
             return -1;
-        return define(I, e, n, f);
+        return scope_define(I, e, n, f);
     }
     case N_IMPORT:
         return exec_import(I, e, n);
@@ -1272,4 +1254,56 @@ int eval_text(interp *I, const char *srcname, const char *text, value *out)
     while (root->parent)
         root = root->parent;
     return eval_expr(I, I->globals ? I->globals : root, prog->kids[0]->kids[0], out);
+}
+
+/* ---- for compile.c (compile.h) ------------------------------------------------- */
+
+int eval_binary_node(interp *I, const node *n, value a, value b, value *out)
+{
+    return binary_values(I, n, a, b, out);
+}
+
+int eval_unary_node(interp *I, const node *n, value a, value *out)
+{
+    return eval_unary(I, n->op, a, out, n);
+}
+
+int eval_index_node(interp *I, const node *n, value a, value ix, value *out)
+{
+    return eval_index(I, a, ix, out, n);
+}
+
+int eval_field_node(interp *I, const node *n, value a, value *out)
+{
+    return eval_field(I, a, n->str, out, n);
+}
+
+/* eval_call_in after its arguments, all positional, are evaluated */
+int eval_call_positional(interp *I, env *e, value fn, const value *args, int nargs, const node *call,
+                         const node *assign, value *out)
+{
+    const node *const *anodes = (const node *const *)call->kids + 1;
+    if (assign && nargs > 0 && args[0].k == V_LIST && fn.k == V_BUILTIN && strcmp(fn.u.bi->name, "concat") == 0) {
+        value *x = scope_lookup(e, assign); /* the arguments may have reassigned it */
+        I->append_target = x && x->k == V_LIST && x->u.h == args[0].u.h ? args[0].u.h : NULL;
+        int rc = call_any(I, fn, args, nargs, NULL, NULL, 0, anodes, call, out);
+        I->append_target = NULL;
+        return rc;
+    }
+    return call_any(I, fn, args, nargs, NULL, NULL, 0, anodes, call, out);
+}
+
+int eval_stmt(interp *I, env *e, const node *n, value *last)
+{
+    return exec_stmt(I, e, n, last);
+}
+
+int eval_push_frame(interp *I, const char *name, const node *call)
+{
+    return push_frame(I, name, call);
+}
+
+int eval_stack_overflow(interp *I, const node *n)
+{
+    return stack_overflow(I, n);
 }
