@@ -180,12 +180,15 @@ int bind_fit_init(interp *I) { return BUILTIN_REGISTER(I, fit_builtins); }
 
 /* ---- frac fit ---------------------------------------------------------------------------- */
 
+#define FIT_USAGE                                                                                          \
+    "usage: frac fit TARGET.png --maps N|A..B [--seed S] [--iterations K] [--time SECONDS] [--rifs]\n"   \
+    "        [--foreground auto|dark|light|alpha] [--threshold T] [--threads N] [-q] [-o FIT.frac]"
+
 static int fit_usage(const char *fmt, const char *a)
 {
     fprintf(stderr, "frac: fit: ");
     fprintf(stderr, fmt, a);
-    fprintf(stderr, "\n(usage: frac fit TARGET.png --maps N|A..B [--seed S] [--iterations K] [--time SECONDS]\n"
-                    "        [--foreground auto|dark|light|alpha] [--threshold T] [--threads N] [-q] [-o FIT.frac])\n");
+    fprintf(stderr, "\n(" FIT_USAGE ")\n");
     return 64;
 }
 
@@ -201,8 +204,44 @@ static int whole(const char *s, double lo, double hi, double *out)
     return 0;
 }
 
-/* The script: the maps as a table in Fractint order, and a render of the
- * attractor in the target's frame at the target's size, white on black. */
+/* fit's options that take a value (the next word, or --NAME=VALUE) */
+static const char *const fit_valued[] = {"--maps", "--seed", "--iterations", "--time",
+                                         "-o", "--threads", "--foreground", "--threshold"};
+#define FIT_NVALUED (sizeof fit_valued / sizeof *fit_valued)
+/* the other commands' options that take a value: skipped when looking for the word fit,
+ * refused by fit */
+static const char *const main_valued[] = {"--out-dir", "-e", "-D", "--frames", "--shard", "--delay", "--loop",
+                                          "--max-memory", "--max-depth", "--max-pixels", "--max-points",
+                                          "--max-voxels", "--max-list", "--fail-alloc"};
+#define MAIN_NVALUED (sizeof main_valued / sizeof *main_valued)
+/* and the ones that take none */
+static const char *const main_flags[] = {"--params", "--no-recipe", "--stats", "--show", "--version"};
+#define MAIN_NFLAGS (sizeof main_flags / sizeof *main_flags)
+
+static int in_list(const char *a, const char *const *list, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!strcmp(a, list[i]))
+            return 1;
+    return 0;
+}
+
+int fit_command_index(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--"))
+            return 0;
+        if (a[0] != '-' || !a[1])
+            return strcmp(a, "fit") == 0 ? i : 0;
+        if (!strchr(a, '=') && (in_list(a, fit_valued, FIT_NVALUED) || in_list(a, main_valued, MAIN_NVALUED)))
+            i++; /* its value */
+    }
+    return 0;
+}
+/* The script: the maps as a table in Fractint order (f: the IFS built from them; NULL for a
+ * RIFS: the maps and the transition matrix as tables), and a render of the attractor in the
+ * target's frame at the target's size, white on black. */
 static size_t write_script(char *buf, size_t cap, const char *target, int w, int h, const fit_opts *o,
                            const fit_result *r, const ifs *f, const char *fg)
 {
@@ -216,29 +255,50 @@ static size_t write_script(char *buf, size_t cap, const char *target, int w, int
     OUT("# An IFS fitted by `frac fit` to %s (%d×%d pixels, foreground %s).\n", name, w, h, fg);
     OUT("# maps %d, seed %llu, iterations %ld; final loss %.4g cells (docs/fit.md).\n", r->n,
         (unsigned long long)o->seed, o->iterations, r->loss);
-    OUT("# Coordinates: the target's pixels normalised to [0, 1]², y up. Rows: a b c d e f p.\n");
-    OUT("let fitted = ifs({\n");
-    for (int i = 0; i < f->n; i++) {
-        const affine *a = &f->maps[i];
-        OUT("  %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", a->m[0][0], a->m[0][1], a->m[1][0], a->m[1][1], a->t[0],
-            a->t[1], f->p[i]);
+    if (f) {
+        OUT("# Coordinates: the target's pixels normalised to [0, 1]², y up. Rows: a b c d e f p.\n");
+        OUT("let fitted = ifs({\n");
+        for (int i = 0; i < f->n; i++) {
+            const affine *a = &f->maps[i];
+            OUT("  %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", a->m[0][0], a->m[0][1], a->m[1][0], a->m[1][1], a->t[0],
+                a->t[1], f->p[i]);
+        }
+        OUT("}, normalize: true)\n");
+    } else {
+        OUT("# A Recurrent IFS: map rows a b c d e f, then the transition matrix (row i: the\n");
+        OUT("# probabilities of the next map after map i; 0 = forbidden). Coordinates: the\n");
+        OUT("# target's pixels normalised to [0, 1]², y up.\n");
+        OUT("let fitted = rifs({\n");
+        for (int i = 0; i < r->n; i++) {
+            const affine *a = &r->maps[i];
+            OUT("  %.9g %.9g %.9g %.9g %.9g %.9g\n", a->m[0][0], a->m[0][1], a->m[1][0], a->m[1][1], a->t[0], a->t[1]);
+        }
+        OUT("}, {\n");
+        for (int i = 0; i < r->n; i++) {
+            OUT(" ");
+            for (int j = 0; j < r->n; j++)
+                OUT(" %.9g", r->P[i * r->n + j]);
+            OUT("\n");
+        }
+        OUT("}, normalize: true)\n");
     }
     double pts = 40.0 * w * h;
     pts = pts < 1e5 ? 1e5 : pts > 5e7 ? 5e7 : pts;
-    OUT("}, normalize: true)\n");
     OUT("save(chaos(fitted, points: %.0f, size: [%d, %d], window: [0, 1, 0, 1], curve: \"linear\",\n", pts, w, h);
     OUT("           brightness: 1e9), \"fit.png\")\n");
 #undef OUT
     return n;
 }
 
-int fit_command(interp *I, int argc, char **argv, volatile sig_atomic_t *cancel)
+int fit_command(interp *I, int argc, char **argv, int at, volatile sig_atomic_t *cancel)
 {
     const char *target = NULL, *outp = "fit.frac", *maps = NULL, *fgname = "auto";
     fit_opts o = {.iterations = 1000, .seed = I->seed};
     double thresh = 0.5;
-    int quiet = 0;
+    int quiet = 0, given[FIT_NVALUED] = {0};
     for (int i = 1; i < argc; i++) {
+        if (i == at)
+            continue;
         const char *a = argv[i];
         if (a[0] != '-' || !a[1]) {
             if (target)
@@ -246,20 +306,42 @@ int fit_command(interp *I, int argc, char **argv, volatile sig_atomic_t *cancel)
             target = a;
             continue;
         }
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(FIT_USAGE "\n(docs/fit.md)\n", stdout);
+            return 0;
+        }
         if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
             continue;
         }
-        static const char *valued[] = {"--maps", "--seed", "--iterations", "--time", "-o", "--threads",
-                                       "--foreground", "--threshold"};
+        if (!strcmp(a, "--rifs")) {
+            if (o.rifs)
+                return fit_usage("%s is given twice", a);
+            o.rifs = 1;
+            continue;
+        }
+        /* --NAME=VALUE or --NAME VALUE */
+        char name[32];
+        const char *eq = a[1] == '-' ? strchr(a, '=') : NULL, *v = NULL;
+        snprintf(name, sizeof name, "%.*s", eq ? (int)(eq - a) : (int)strlen(a), a);
         size_t f = 0;
-        while (f < sizeof valued / sizeof *valued && strcmp(a, valued[f]) != 0)
+        while (f < FIT_NVALUED && strcmp(name, fit_valued[f]) != 0)
             f++;
-        if (f == sizeof valued / sizeof *valued)
+        if (f == FIT_NVALUED) {
+            if (in_list(name, main_valued, MAIN_NVALUED) || in_list(name, main_flags, MAIN_NFLAGS) ||
+                !strncmp(name, "-D", 2))
+                return fit_usage("%s does not go with `frac fit`", !strncmp(name, "-D", 2) ? "-D" : name);
             return fit_usage("unknown option '%s'", a);
-        if (i + 1 >= argc)
-            return fit_usage("%s needs a value", a);
-        const char *v = argv[++i];
+        }
+        if (eq) {
+            v = eq + 1;
+        } else {
+            if (i + 1 >= argc || i + 1 == at)
+                return fit_usage("%s needs a value", a);
+            v = argv[++i];
+        }
+        if (given[f]++)
+            return fit_usage("%s is given twice", name);
         double d;
         switch (f) {
         case 0: maps = v; break;
@@ -281,7 +363,11 @@ int fit_command(interp *I, int argc, char **argv, volatile sig_atomic_t *cancel)
             o.time_s = d;
             break;
         }
-        case 4: outp = v; break;
+        case 4:
+            if (!*v)
+                return fit_usage("%s", "-o needs a file name (the script to write)");
+            outp = v;
+            break;
         case 5:
             if (whole(v, 1, 256, &d))
                 return fit_usage("--threads takes a whole number from 1 to 256, got '%s'", v);
@@ -331,22 +417,23 @@ int fit_command(interp *I, int argc, char **argv, volatile sig_atomic_t *cancel)
     image_free(&im);
     c = fit_run(&(fit_mask){w, h, m}, &o, &run, &r, &e);
     rt_free(m);
-    ifs f;
-    if (!c && !build_ifs(&r, &f, &e))
+    ifs f = {0};
+    if (!c && !r.rifs && !build_ifs(&r, &f, &e))
         c = e.code;
     if (c) {
         err_pos(I, -1, 0, 0, lang_rt_kind(c), "fit: %s: %s", target, e.msg);
         return session_report(I);
     }
     char buf[8192];
-    size_t len = write_script(buf, sizeof buf, target, w, h, &o, &r, &f, fgnames[mode]);
-    ifs_free(&f);
+    size_t len = write_script(buf, sizeof buf, target, w, h, &o, &r, r.rifs ? NULL : &f, fgnames[mode]);
+    if (!r.rifs)
+        ifs_free(&f);
     c = len < sizeof buf ? fileio_write_atomic(outp, buf, len, &e) : rt_fail(&e, RT_ENOMEM, "script too long");
     if (c) {
         err_pos(I, -1, 0, 0, lang_rt_kind(c), "fit: %s", e.msg);
         return session_report(I);
     }
     if (!quiet)
-        fprintf(stderr, "wrote %s (%d maps, loss %.4g)\n", outp, r.n, r.loss);
+        fprintf(stderr, "wrote %s (%d maps%s, loss %.4g)\n", outp, r.n, r.rifs ? ", recurrent" : "", r.loss);
     return 0;
 }

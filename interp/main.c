@@ -58,7 +58,8 @@ static const char usage_text[] =
     "                                          N plays (default 0: forever)\n"
     "       frac -e 'EXPR'                     evaluate one expression and print it\n"
     "       frac fit TARGET.png --maps N|A..B [--seed S] [--iterations K] [--time SECONDS]\n"
-    "                [--foreground auto|dark|light|alpha] [--threshold T] [-o FIT.frac]\n"
+    "                [--rifs] [--foreground auto|dark|light|alpha] [--threshold T]\n"
+    "                [--threads N] [-q] [-o FIT.frac]\n"
     "                                          fit an IFS to a picture; writes a script\n"
     "                                          (default fit.frac) that saves fit.png\n"
     "                                          (docs/fit.md)\n"
@@ -496,12 +497,13 @@ static int finish_output(int rc)
 
 static int frac_main(int argc, char **argv)
 {
-    if (argc > 1 && strcmp(argv[1], "fit") == 0) { /* its own options (interp/bind_fit.c) */
+    int fit_at = fit_command_index(argc, argv);
+    if (fit_at) { /* its own options, before or after the word fit (interp/bind_fit.c) */
         interp st, *I = &st;
         interp_init(I);
         I->threads = par_cores();
         I->progress = 1;
-        int frc = fit_command(I, argc - 1, argv + 1, &cli_interrupted);
+        int frc = fit_command(I, argc, argv, fit_at, &cli_interrupted);
         interp_free(I);
         return finish_output(frc);
     }

@@ -452,8 +452,10 @@ static void offspring(void *ctx, size_t k, int worker)
     } else {
         double u = rng_uniform(&r);
         int j = (int)(rng_uniform(&r) * n);
-        if (u < 0.75) {
-            for (int i = 0; i < NPAR; i++)
+        if (u < 0.75) { /* one map: all its parameters, or its translation, or its linear part */
+            double v = rng_uniform(&r);
+            int lo = v < 0.75 ? 0 : 4, hi = v < 0.5 || v >= 0.75 ? NPAR : 4;
+            for (int i = lo; i < hi; i++)
                 c[j * NPAR + i] += F->sigma * step_scale[i] * rng_normal(&r);
         } else if (u < 0.95) {
             for (int m = 0; m < n; m++)
@@ -683,14 +685,15 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
     rt_run prun = run ? *run : (rt_run){.threads = 1};
     prun.progress = 0; /* the fit draws its own bar */
     F->n = n;
-    /* the coarse levels from FIT_STARTS starts (the collage and perturbed copies of it); the
-     * best on the last coarse level goes on to the fine levels */
+    /* the coarse levels from FIT_STARTS starts (the two collages, as they are and moved, each
+     * with its own offspring streams); the best on the last coarse level goes on to the fine
+     * levels */
     int hi = coarse_levels(F), starts = o->start ? 1 : FIT_STARTS, np = nparams(F, n);
     double bestx[XLEN], best = HUGE_VAL, bsigma = 0.15;
     for (int st = 0; st < starts && !*timed_out; st++) {
         double xs[XLEN];
         memcpy(xs, st % 2 ? x2 : x, sizeof(double) * (size_t)np);
-        if (st > 1) {
+        if (st % 4 >= 2) {
             rng r;
             rng_init(&r, o->seed, rng_hash3(0x7374617274ull, (uint64_t)st, (uint64_t)n, 0));
             for (int m = 0; m < n; m++)

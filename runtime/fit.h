@@ -53,19 +53,26 @@
  *     of a level uses the same random stream (common random numbers), so
  *     the loss is a fixed function of the parameters. The optimiser is a
  *     (1+4)-evolution strategy: each generation makes 4 offspring from the
- *     current parameters (mostly one map's 6 parameters moved by Gaussian
- *     steps, sometimes all maps by smaller steps), evaluates them (in
+ *     current parameters (mostly one map moved by Gaussian steps: half the
+ *     time all its 6 parameters, a quarter of the time only its linear part
+ *     θ, φ, u1, u2, a quarter only its translation — near the optimum a
+ *     step in all six rarely improves all of them; sometimes all maps by
+ *     smaller steps), evaluates them (in
  *     parallel, each its own buffers) and keeps the best if it is no worse;
  *     the step size grows by 1.2 on success and shrinks by 0.97 otherwise.
  *     The generations are split among the levels 40/30/20/10 % (coarse to
  *     fine); the step size restarts at each level at 0.6 of the last one.
  *     Multi-start: the coarse levels (the 32- and 64-cell grids when there
- *     are three or more levels, else the first) are run FIT_STARTS = 4 times,
- *     from collage (a), collage (b), and a copy of each with every parameter
- *     moved by a Gaussian step (0.1 of the step scales); the start with the
- *     smallest loss on the last coarse level goes on to the finer levels.
- *     (Without this, a fit often settles on a covering by misplaced copies.)
- *     With `start`, one start only.
+ *     are three or more levels, else the first) are run FIT_STARTS = 8 times:
+ *     start k begins from collage (a) (k even) or (b) (k odd), moved by a
+ *     Gaussian step of every parameter (0.1 of the step scales) when
+ *     k mod 4 >= 2, and each start has its own offspring streams; the start
+ *     with the smallest loss on the last coarse level goes on to the finer
+ *     levels. (Without this, a fit often settles on a covering by misplaced
+ *     copies; and two runs of the strategy from the same collage end at
+ *     different precisions, so several streams per collage make the best of
+ *     them a safer pick: on the Sierpinski triangle, four starts missed the
+ *     goal on one seed in five.) With `start`, one start only.
  *  4. Probabilities: on the finest level, a few generations perturb the
  *     log-weights only (the support of the attractor does not depend on
  *     them, but with a finite number of points, coverage does).
@@ -101,7 +108,7 @@
 #define FIT_MAX_MAPS 16
 #define FIT_PENALTY 0.5
 #define FIT_LAMBDA 4
-#define FIT_STARTS 4
+#define FIT_STARTS 8
 
 typedef struct fit_mask {
     int w, h;                /* >= 2 each */
