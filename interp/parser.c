@@ -159,8 +159,9 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
 }
 
 /* Enter one nesting level; past PARSE_MAX_NESTING, fail at the token that
- * went too deep. Every recursive production passes here (parse_binary, the
- * operand of a unary operator or '^', the body of 'for' and of a named 'fn'),
+ * went too deep. Every recursive production passes here (parse_subexpr,
+ * that is every operand of an operator, and the body of 'for' and of a
+ * named 'fn'),
  * so the recursion of every walk over the tree is bounded. At the end of
  * the input the usual "expected …, found end of input" follows instead (the
  * REPL asks for more). Callers that succeed must leave with p->depth--. */
