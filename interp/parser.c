@@ -1,5 +1,6 @@
-/* parser.c — recursive descent for statements, precedence climbing (a table
- * with one row per binary operator) for expressions.
+/* parser.c — recursive descent, one function per production (each starts
+ * with its grammar rule, as in Lua's lparser.c); expressions by precedence
+ * climbing over one operator table, ops[] (docs/language.md shows it).
  *
  * Newlines end statements and separate table rows; they are skipped inside
  * (), [] and record braces. In a table row, entries are separated by white
@@ -158,8 +159,9 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
 }
 
 /* Enter one nesting level; past PARSE_MAX_NESTING, fail at the token that
- * went too deep. Every recursive production passes here (parse_binary, the
- * operand of a unary operator or '^', the body of 'for' and of a named 'fn'),
+ * went too deep. Every recursive production passes here (parse_subexpr,
+ * that is every operand of an operator, and the body of 'for' and of a
+ * named 'fn'),
  * so the recursion of every walk over the tree is bounded. At the end of
  * the input the usual "expected …, found end of input" follows instead (the
  * REPL asks for more). Callers that succeed must leave with p->depth--. */
@@ -324,39 +326,101 @@ static node *string_node(parser *p, const token *t)
     return n;
 }
 
+/* ---- operators: one Pratt table ----------------------------------------------
+ *
+ * Every operator has one row: the token, whether it is written before its
+ * operand (PREFIX) or between two (INFIX), its binding level (higher binds
+ * tighter) and its associativity, which says at which level its right
+ * operand is parsed:
+ *   LEFT   at level+1           `a - b - c` is `(a - b) - c`
+ *   RIGHT  at level itself      `2^3^2` is `2^(3^2)`; a prefix operator nests
+ *                               in itself (`not not x`, `- -x`)
+ *   NONE   at level+1, and the same level may not follow (`a < b < c`)
+ * A prefix operator may start an operand only where its level is allowed, so
+ * `a * not b` is an error while `2^-1` is not (unary minus shares `^`'s
+ * level, so `-2^2` is `-(2^2)`). `kind` is the node an operator builds;
+ * N_CALL marks the pipe, `x |> f(a)` built as the call `f(x, a)`. An operator
+ * marked `leads` may begin the next line (a pipe chain written one step per
+ * line). After an infix operator the operand may continue on the next line.
+ * docs/language.md shows this table. */
+enum { PREFIX, INFIX };
+enum { LEFT, RIGHT, NONE };
+
+typedef struct oprow {
+    tok_type tok;
+    unsigned char fix, prec, assoc, leads;
+    node_kind kind;
+    int op; /* the node's op: the token type, or '-', '+', 'n' for N_UNARY */
+} oprow;
+
+static const oprow ops[] = {
+    {T_PIPE, INFIX, 1, LEFT, 1, N_CALL, T_PIPE},
+    {T_OR, INFIX, 2, LEFT, 0, N_OR, T_OR},
+    {T_AND, INFIX, 3, LEFT, 0, N_AND, T_AND},
+    {T_NOT, PREFIX, 4, RIGHT, 0, N_UNARY, 'n'},
+    {T_EQ, INFIX, 5, NONE, 0, N_BINARY, T_EQ},
+    {T_NE, INFIX, 5, NONE, 0, N_BINARY, T_NE},
+    {T_LT, INFIX, 5, NONE, 0, N_BINARY, T_LT},
+    {T_LE, INFIX, 5, NONE, 0, N_BINARY, T_LE},
+    {T_GT, INFIX, 5, NONE, 0, N_BINARY, T_GT},
+    {T_GE, INFIX, 5, NONE, 0, N_BINARY, T_GE},
+    {T_PLUS, INFIX, 6, LEFT, 0, N_BINARY, T_PLUS},
+    {T_MINUS, INFIX, 6, LEFT, 0, N_BINARY, T_MINUS},
+    {T_STAR, INFIX, 7, LEFT, 0, N_BINARY, T_STAR},
+    {T_SLASH, INFIX, 7, LEFT, 0, N_BINARY, T_SLASH},
+    {T_PERCENT, INFIX, 7, LEFT, 0, N_BINARY, T_PERCENT},
+    {T_MINUS, PREFIX, 8, RIGHT, 0, N_UNARY, '-'},
+    {T_PLUS, PREFIX, 8, RIGHT, 0, N_UNARY, '+'},
+    {T_CARET, INFIX, 8, RIGHT, 0, N_BINARY, T_CARET},
+};
+
+/* the only non-associative operators are the comparisons */
+#define CHAIN_ERROR "comparisons cannot be chained; use 'and'"
+
+static const oprow *op_row(tok_type t, int fix)
+{
+    for (size_t i = 0; i < sizeof ops / sizeof ops[0]; i++)
+        if (ops[i].tok == t && ops[i].fix == fix)
+            return &ops[i];
+    return NULL;
+}
+
+/* The level of the right operand of row r. */
+static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : r->prec + 1; }
+
+/* The infix operator at t, or NULL. In a table row a '+' or '-' with space
+ * before it and none after starts a new entry instead (`1 -2`). */
+static const oprow *infix_at(parser *p, const token *t)
+{
+    const oprow *r = op_row(t->type, INFIX);
+    if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
+        const token *after = t + 1;
+        if (!after->space_before && after->type != T_NEWLINE)
+            return NULL;
+    }
+    return r;
+}
+
+/* Outside a table row, newlines before an operator that may lead a line are
+ * skipped (`x\n|> f`). */
+static void skip_to_leading_op(parser *p)
+{
+    if (p->table_mode || peek_raw(p)->type != T_NEWLINE)
+        return;
+    size_t i = p->pos;
+    while (p->tl.toks[i].type == T_NEWLINE)
+        i++;
+    const oprow *r = op_row(p->tl.toks[i].type, INFIX);
+    if (r && r->leads)
+        p->pos = i;
+}
+
+
 /* ---- expressions ----------------------------------------------------------- */
 
 static node *parse_expr(parser *p);
-static node *parse_block_until(parser *p, const token *open, int allow_else);
+static node *parse_block_until(parser *p, const token *open);
 static node *parse_lambda_rest(parser *p, const token *at, const char *name);
-
-/* Binary operators, one row each: precedence (higher binds tighter) and
- * right-associativity. */
-static const struct {
-    tok_type tok;
-    int prec, right;
-} binops[] = {
-    {T_PIPE, 1, 0},  {T_OR, 2, 0},    {T_AND, 3, 0},    {T_EQ, 5, 0},   {T_NE, 5, 0},
-    {T_LT, 5, 0},    {T_LE, 5, 0},    {T_GT, 5, 0},     {T_GE, 5, 0},   {T_PLUS, 6, 0},
-    {T_MINUS, 6, 0}, {T_STAR, 7, 0},  {T_SLASH, 7, 0},  {T_PERCENT, 7, 0}, {T_CARET, 9, 1},
-};
-enum { PREC_NOT = 4, PREC_UNARY = 8 };
-
-static int binop_prec(parser *p, const token *t, int *right)
-{
-    for (size_t i = 0; i < sizeof binops / sizeof binops[0]; i++) {
-        if (binops[i].tok == t->type) {
-            *right = binops[i].right;
-            if (p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
-                const token *after = t + 1;
-                if (!after->space_before && after->type != T_NEWLINE)
-                    return -1; /* `1 -2`: a new entry starts */
-            }
-            return binops[i].prec;
-        }
-    }
-    return -1;
-}
 
 /* One comma-separated list, the shape every bracketed construct shares:
  *   list -> [item {',' item} [',']] CLOSE
@@ -548,7 +612,7 @@ static node *make_lambda(parser *p, const token *at, nodevec *params, node *body
     return l;
 }
 
-/* lambda body -> '=' expr | 'do' block 'end' | '=>' expr */
+/* lambda_body -> '=' expr | 'do' block 'end' | '=>' expr */
 static node *parse_lambda_rest(parser *p, const token *at, const char *name)
 {
     const token *save_c = p->construct;
@@ -564,7 +628,7 @@ static node *parse_lambda_rest(parser *p, const token *at, const char *name)
         body = parse_expr(p);
     } else if (t->type == T_DO) {
         next(p);
-        body = parse_block_until(p, t, 0);
+        body = parse_block_until(p, t);
         if (body && expect_close(p, T_END, t))
             return NULL;
     } else {
@@ -751,10 +815,9 @@ static node *parse_list(parser *p)
 /* if -> 'if' expr 'then' expr {'elif' expr 'then' expr} ['else' expr]
  * An elif chain is built by a loop (each elif is the else branch of the
  * one before), so a long chain is not nesting. */
-static node *parse_if(parser *p, token *at)
+static node *parse_if(parser *p)
 {
-    /* an elif chain is built by this loop, not by recursion, so a long
-     * chain needs no nesting depth */
+    token *at = next(p);
     int save_tm = p->table_mode;
     const token *save_c = p->construct;
     p->table_mode = 0;
@@ -801,243 +864,208 @@ static node *parse_if(parser *p, token *at)
     return first;
 }
 
+/* literal -> NUMBER | STRING | 'true' | 'false' | 'nil' */
+static node *parse_literal(parser *p)
+{
+    token *t = next(p);
+    node *n;
+    switch (t->type) {
+    case T_NUMBER:
+        if ((n = mk(p, N_NUM, t)))
+            n->num = t->num;
+        return n;
+    case T_STRING:
+        return string_node(p, t);
+    case T_NIL:
+        return mk(p, N_NIL, t);
+    default: /* 'true' | 'false' */
+        if ((n = mk(p, N_BOOL, t)))
+            n->num = t->type == T_TRUE;
+        return n;
+    }
+}
+
+/* name -> NAME | NAME '=>' expr   (a one-parameter lambda; not in a table row) */
+static node *parse_name(parser *p)
+{
+    token *t = peek(p);
+    if (peek2(p)->type == T_ARROW && !p->table_mode) {
+        next(p);
+        next(p);
+        nodevec params = {0};
+        if (nv_push(p, &params, NULL, tok_name(p, t)))
+            return NULL;
+        node *body = parse_expr(p);
+        return body ? make_lambda(p, t, &params, body, NULL) : NULL;
+    }
+    next(p);
+    node *n = mk(p, N_NAME, t);
+    if (n)
+        n->str = tok_name(p, t);
+    return n;
+}
+
+/* paren -> params '=>' expr | '(' expr ')'   (newlines are white space inside) */
+static node *parse_paren(parser *p)
+{
+    token *t = peek(p);
+    if (is_paren_lambda(p)) {
+        nodevec params = {0};
+        if (parse_params(p, &params) || expect(p, T_ARROW, "after the parameter list"))
+            return NULL;
+        node *body = parse_expr(p);
+        return body ? make_lambda(p, t, &params, body, NULL) : NULL;
+    }
+    next(p);
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 1;
+    p->table_mode = 0;
+    node *e = parse_expr(p);
+    if (e)
+        expect_close(p, T_RPAREN, t);
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return p->failed ? NULL : e;
+}
+
+/* doblock -> 'do' block 'end' */
+static node *parse_do(parser *p)
+{
+    token *t = next(p);
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 0;
+    p->table_mode = 0;
+    node *b = parse_block_until(p, t);
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    if (b && expect_close(p, T_END, t))
+        return NULL;
+    return b;
+}
+
+/* fnexpr -> 'fn' params lambda_body   (an anonymous function) */
+static node *parse_fn_expr(parser *p)
+{
+    token *t = next(p);
+    int save_nl = p->skip_nl, save_tm = p->table_mode;
+    p->skip_nl = 0;
+    p->table_mode = 0;
+    node *l = parse_lambda_rest(p, t, NULL);
+    p->skip_nl = save_nl;
+    p->table_mode = save_tm;
+    return l;
+}
+
+/* primary -> literal | name | paren | list | brace | if | doblock | fnexpr */
 static node *parse_primary(parser *p)
 {
     token *t = peek(p);
     char buf[64];
     switch (t->type) {
-    case T_NUMBER: {
-        next(p);
-        node *n = mk(p, N_NUM, t);
-        if (n)
-            n->num = t->num;
-        return n;
-    }
+    case T_NUMBER:
     case T_STRING:
-        next(p);
-        return string_node(p, t);
     case T_TRUE:
-    case T_FALSE: {
-        next(p);
-        node *n = mk(p, N_BOOL, t);
-        if (n)
-            n->num = t->type == T_TRUE;
-        return n;
-    }
+    case T_FALSE:
     case T_NIL:
-        next(p);
-        return mk(p, N_NIL, t);
-    case T_IDENT: {
-        if (peek2(p)->type == T_ARROW && !p->table_mode) {
-            /* x => expr */
-            next(p);
-            next(p);
-            nodevec params = {0};
-            if (nv_push(p, &params, NULL, tok_name(p, t)))
-                return NULL;
-            node *body = parse_expr(p);
-            return body ? make_lambda(p, t, &params, body, NULL) : NULL;
-        }
-        next(p);
-        node *n = mk(p, N_NAME, t);
-        if (n)
-            n->str = tok_name(p, t);
-        return n;
-    }
-    case T_LPAREN: {
-        if (is_paren_lambda(p)) {
-            node *l = NULL;
-            nodevec params = {0};
-            if (parse_params(p, &params))
-                return NULL;
-            if (expect(p, T_ARROW, "after the parameter list"))
-                return NULL;
-            node *body = parse_expr(p);
-            if (body)
-                l = make_lambda(p, t, &params, body, NULL);
-            return l;
-        }
-        next(p);
-        int save_nl = p->skip_nl, save_tm = p->table_mode;
-        p->skip_nl = 1;
-        p->table_mode = 0;
-        node *e = parse_expr(p);
-        if (e)
-            expect_close(p, T_RPAREN, t);
-        p->skip_nl = save_nl;
-        p->table_mode = save_tm;
-        return p->failed ? NULL : e;
-    }
+        return parse_literal(p);
+    case T_IDENT:
+        return parse_name(p);
+    case T_LPAREN:
+        return parse_paren(p);
     case T_LBRACKET:
         return parse_list(p);
     case T_LBRACE:
         return parse_brace(p);
     case T_IF:
-        next(p);
-        return parse_if(p, t);
-    case T_DO: {
-        next(p);
-        int save_nl = p->skip_nl, save_tm = p->table_mode;
-        p->skip_nl = 0;
-        p->table_mode = 0;
-        node *b = parse_block_until(p, t, 0);
-        p->skip_nl = save_nl;
-        p->table_mode = save_tm;
-        if (b && expect_close(p, T_END, t))
-            return NULL;
-        return b;
-    }
-    case T_FN: {
-        next(p);
-        int save_nl = p->skip_nl, save_tm = p->table_mode;
-        p->skip_nl = 0;
-        p->table_mode = 0;
-        node *l = parse_lambda_rest(p, t, NULL);
-        p->skip_nl = save_nl;
-        p->table_mode = save_tm;
-        return l;
-    }
-    case T_EOF:
-        syntax_error(p, t, "expected an expression, found %s", "end of input");
-        return NULL;
+        return parse_if(p);
+    case T_DO:
+        return parse_do(p);
+    case T_FN:
+        return parse_fn_expr(p);
     default:
         syntax_error(p, t, "expected an expression, found %s", tok_desc(t, buf, sizeof buf));
         return NULL;
     }
 }
 
-static node *parse_unary(parser *p);
+static node *parse_subexpr(parser *p, int level);
 
-static node *parse_binary_level(parser *p, int min_prec);
-
-static node *parse_binary(parser *p, int min_prec)
+/* pipe -> left '|>' (NAME | call | operand): the call gets left as its first
+ * argument, `x |> f(a)` is `f(x, a)` and `x |> f` is `f(x)` */
+static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 {
-    if (enter_level(p))
+    nodevec args = {0};
+    if (nv_push(p, &args, left, NULL))
         return NULL;
-    node *n = parse_binary_level(p, min_prec);
-    p->depth--;
+    if (rhs->kind != N_CALL)
+        return make_call(p, rhs, &args, op);
+    for (int i = 1; i < rhs->nkids; i++)
+        if (nv_push(p, &args, rhs->kids[i], rhs->names[i]))
+            return NULL;
+    return make_call(p, rhs->kids[0], &args, op);
+}
+
+/* prefixexp -> PREFIXOP subexpr(level of the operator) | primary postfix */
+static node *parse_operand(parser *p, int level)
+{
+    token *t = peek(p);
+    const oprow *r = op_row(t->type, PREFIX);
+    if (!r || r->prec < level) /* `a * not b`: the primary reports 'not' */
+        {
+        node *e = parse_primary(p);
+        return e ? parse_postfix(p, e) : NULL;
+    }
+    next(p);
+    node *a = parse_subexpr(p, operand_level(r));
+    node *n = a ? mk1(p, r->kind, t, a) : NULL;
+    if (n)
+        n->op = r->op;
     return n;
 }
 
-static node *parse_binary_level(parser *p, int min_prec)
+/* subexpr(level) -> prefixexp { INFIXOP subexpr(operand level) }
+ * taking only operators of at least `level` (precedence climbing). Each
+ * operand is one nesting level (enter_level), so deep nesting of brackets,
+ * prefix operators or '^' is refused while a long flat chain is a loop. */
+static node *parse_subexpr(parser *p, int level)
 {
-    node *left;
-    token *t = peek(p);
-    if (t->type == T_NOT && min_prec <= PREC_NOT) {
-        next(p);
-        node *a = parse_binary(p, PREC_NOT);
-        if (!a)
-            return NULL;
-        left = mk1(p, N_UNARY, t, a);
-        if (!left)
-            return NULL;
-        left->op = 'n';
-    } else {
-        left = parse_unary(p);
-    }
+    if (enter_level(p))
+        return NULL;
+    node *left = parse_operand(p, level);
     while (left) {
-        /* a pipe may start the next line */
-        token *op = peek_raw(p);
-        if (op->type == T_NEWLINE && !p->table_mode) {
-            size_t i = p->pos;
-            while (p->tl.toks[i].type == T_NEWLINE)
-                i++;
-            if (p->tl.toks[i].type == T_PIPE)
-                p->pos = i;
-        }
-        op = peek(p);
-        int right;
-        int prec = binop_prec(p, op, &right);
-        if (prec < 0 || prec < min_prec)
+        skip_to_leading_op(p);
+        token *op = peek(p);
+        const oprow *r = infix_at(p, op);
+        if (!r || r->prec < level)
             break;
         next(p);
-        /* operands may continue on the next line after an operator */
-        while (peek_raw(p)->type == T_NEWLINE)
+        while (peek_raw(p)->type == T_NEWLINE) /* the operand may start the next line */
             p->pos++;
-        if (op->type == T_PIPE) {
-            /* x |> f(a) means f(x, a); x |> f means f(x) */
-            node *rhs = parse_binary(p, prec + 1);
-            if (!rhs)
-                return NULL;
-            nodevec args = {0};
-            if (nv_push(p, &args, left, NULL))
-                return NULL;
-            if (rhs->kind == N_CALL) {
-                for (int i = 1; i < rhs->nkids; i++)
-                    if (nv_push(p, &args, rhs->kids[i], rhs->names[i]))
-                        return NULL;
-                left = make_call(p, rhs->kids[0], &args, op);
-            } else {
-                left = make_call(p, rhs, &args, op);
-            }
+        node *rhs = parse_subexpr(p, operand_level(r));
+        if (!rhs) {
+            left = NULL;
+            break;
+        }
+        if (r->kind == N_CALL) {
+            left = make_pipe(p, op, left, rhs);
             continue;
         }
-        node *r = parse_binary(p, right ? prec : prec + 1);
-        if (!r)
-            return NULL;
-        node *b = mk2(p, op->type == T_AND ? N_AND : op->type == T_OR ? N_OR : N_BINARY, op, left, r);
-        if (!b)
-            return NULL;
-        b->op = op->type;
-        if (prec == 5) {
-            /* comparisons do not chain: a < b < c is an error */
-            int r2;
-            token *again = peek(p);
-            if (binop_prec(p, again, &r2) == 5) {
-                syntax_error(p, again, "%s", "comparisons cannot be chained; use 'and'");
-                return NULL;
-            }
+        left = mk2(p, r->kind, op, left, rhs);
+        if (!left)
+            break;
+        left->op = r->op;
+        const oprow *again = r->assoc == NONE ? infix_at(p, peek(p)) : NULL;
+        if (again && again->prec == r->prec) {
+            syntax_error(p, peek(p), "%s", CHAIN_ERROR);
+            left = NULL;
         }
-        left = b;
     }
+    p->depth--;
     return left;
 }
 
-/* an operand of a unary operator or '^': one more nesting level */
-static node *parse_unary_nested(parser *p)
-{
-    if (enter_level(p))
-        return NULL;
-    node *n = parse_unary(p);
-    p->depth--;
-    return n;
-}
-
-/* unary -> ('-' | '+') unary | power ; power -> postfix ['^' unary] */
-static node *parse_unary(parser *p)
-{
-    token *t = peek(p);
-    if (t->type == T_MINUS || t->type == T_PLUS) {
-        next(p);
-        node *a = parse_unary_nested(p);
-        if (!a)
-            return NULL;
-        node *n = mk1(p, N_UNARY, t, a);
-        if (n)
-            n->op = t->type == T_MINUS ? '-' : '+';
-        return n;
-    }
-    node *base = parse_primary(p);
-    if (!base)
-        return NULL;
-    base = parse_postfix(p, base);
-    if (!base)
-        return NULL;
-    token *op = peek(p);
-    if (op->type == T_CARET) {
-        next(p);
-        node *e = parse_unary_nested(p);
-        if (!e)
-            return NULL;
-        node *b = mk2(p, N_BINARY, op, base, e);
-        if (b)
-            b->op = T_CARET;
-        return b;
-    }
-    return base;
-}
-
-static node *parse_expr(parser *p) { return parse_binary(p, 1); }
+/* expr -> subexpr(1) */
+static node *parse_expr(parser *p) { return parse_subexpr(p, 1); }
 
 /* ---- statements ------------------------------------------------------------ */
 
@@ -1082,113 +1110,145 @@ static const char *trailing_comment(parser *p, const token *t)
     return d;
 }
 
-static node *parse_statement(parser *p)
+/* letstat -> 'let' NAME '=' expr   (a lambda takes the name) */
+static node *parse_let(parser *p)
+{
+    token *t = next(p);
+    const char *name = expect_name(p, "a name after 'let'");
+    if (!name || expect(p, T_ASSIGN, "after the name in 'let'"))
+        return NULL;
+    node *v = parse_expr(p);
+    if (v && v->kind == N_LAMBDA && !v->str)
+        v->str = name;
+    return v ? one_kid(p, N_LET, t, v, name) : NULL;
+}
+
+/* paramstat -> 'param' NAME '=' expr ['#' doc]   (the default is required) */
+static node *parse_param_decl(parser *p)
+{
+    token *t = next(p);
+    const char *name = expect_name(p, "a name after 'param'");
+    if (!name || expect(p, T_ASSIGN, "after the name in 'param' (a default value is required)"))
+        return NULL;
+    node *v = parse_expr(p);
+    node *n = v ? one_kid(p, N_PARAM, t, v, name) : NULL;
+    if (n)
+        n->doc = trailing_comment(p, t);
+    return n;
+}
+
+/* fnstat -> 'fn' NAME params lambda_body   (one nesting level) */
+static node *parse_fndef(parser *p)
+{
+    token *t = next(p);
+    const char *name = expect_name(p, "a function name");
+    if (!name || enter_level(p))
+        return NULL;
+    node *l = parse_lambda_rest(p, t, name);
+    p->depth--;
+    return l ? one_kid(p, N_FNDEF, t, l, name) : NULL;
+}
+
+/* importstat -> 'import' STRING ['as' NAME] */
+static node *parse_import(parser *p)
+{
+    token *t = next(p);
+    token *s = peek(p);
+    if (s->type != T_STRING) {
+        char buf[64];
+        syntax_error(p, s, "expected a module name in quotes after 'import', found %s",
+                     tok_desc(s, buf, sizeof buf));
+        return NULL;
+    }
+    next(p);
+    node *sn = string_node(p, s);
+    if (!sn)
+        return NULL;
+    node *n = mk(p, N_IMPORT, t);
+    if (!n)
+        return NULL;
+    n->str = sn->str;
+    n->slen = sn->slen;
+    n->names = mem_arena_alloc(p->I, sizeof(char *));
+    if (!n->names)
+        return NULL;
+    if (match(p, T_AS)) {
+        n->names[0] = expect_name(p, "a name after 'as'");
+        if (!n->names[0])
+            return NULL;
+    }
+    return n;
+}
+
+/* forstat -> 'for' NAME 'in' expr 'do' block 'end'   (the body is one nesting level) */
+static node *parse_for(parser *p)
+{
+    token *t = next(p);
+    const token *save_c = p->construct;
+    p->construct = t;
+    const char *var = expect_name(p, "a variable name after 'for'");
+    if (!var || expect(p, T_IN, "after the loop variable"))
+        return NULL;
+    node *it = parse_expr(p);
+    if (!it)
+        return NULL;
+    token *d = peek(p);
+    if (expect(p, T_DO, "to start the body of 'for'") || enter_level(p))
+        return NULL;
+    node *body = parse_block_until(p, d);
+    p->depth--;
+    if (!body || expect_close(p, T_END, d))
+        return NULL;
+    p->construct = save_c;
+    node *n = mk2(p, N_FOR, t, it, body);
+    if (n)
+        n->str = var;
+    return n;
+}
+
+/* assignstat -> NAME '=' expr */
+static node *parse_assign(parser *p)
+{
+    token *t = next(p);
+    next(p); /* '=' */
+    node *v = parse_expr(p);
+    return v ? one_kid(p, N_ASSIGN, t, v, tok_name(p, t)) : NULL;
+}
+
+/* exprstat -> expr */
+static node *parse_expr_statement(parser *p)
 {
     token *t = peek(p);
-    switch (t->type) {
-    case T_LET: {
-        next(p);
-        const char *name = expect_name(p, "a name after 'let'");
-        if (!name || expect(p, T_ASSIGN, "after the name in 'let'"))
-            return NULL;
-        node *v = parse_expr(p);
-        if (v && v->kind == N_LAMBDA && !v->str)
-            v->str = name;
-        return v ? one_kid(p, N_LET, t, v, name) : NULL;
-    }
-    case T_PARAM: {
-        next(p);
-        const char *name = expect_name(p, "a name after 'param'");
-        if (!name || expect(p, T_ASSIGN, "after the name in 'param' (a default value is required)"))
-            return NULL;
-        node *v = parse_expr(p);
-        node *n = v ? one_kid(p, N_PARAM, t, v, name) : NULL;
-        if (n)
-            n->doc = trailing_comment(p, t);
-        return n;
-    }
-    case T_FN: {
-        if (peek2(p)->type != T_IDENT)
-            break; /* an anonymous fn expression */
-        next(p);
-        const char *name = expect_name(p, "a function name");
-        if (!name || enter_level(p))
-            return NULL;
-        node *l = parse_lambda_rest(p, t, name);
-        p->depth--;
-        return l ? one_kid(p, N_FNDEF, t, l, name) : NULL;
-    }
-    case T_IMPORT: {
-        next(p);
-        token *s = peek(p);
-        if (s->type != T_STRING) {
-            char buf[64];
-            syntax_error(p, s, "expected a module name in quotes after 'import', found %s",
-                         tok_desc(s, buf, sizeof buf));
-            return NULL;
-        }
-        next(p);
-        node *sn = string_node(p, s);
-        if (!sn)
-            return NULL;
-        node *n = mk(p, N_IMPORT, t);
-        if (!n)
-            return NULL;
-        n->str = sn->str;
-        n->slen = sn->slen;
-        n->names = mem_arena_alloc(p->I, sizeof(char *));
-        if (!n->names)
-            return NULL;
-        if (match(p, T_AS)) {
-            n->names[0] = expect_name(p, "a name after 'as'");
-            if (!n->names[0])
-                return NULL;
-        }
-        return n;
-    }
-    case T_FOR: {
-        next(p);
-        const token *save_c = p->construct;
-        p->construct = t;
-        const char *var = expect_name(p, "a variable name after 'for'");
-        if (!var || expect(p, T_IN, "after the loop variable"))
-            return NULL;
-        node *it = parse_expr(p);
-        if (!it)
-            return NULL;
-        token *d = peek(p);
-        if (expect(p, T_DO, "to start the body of 'for'") || enter_level(p))
-            return NULL;
-        node *body = parse_block_until(p, d, 0);
-        p->depth--;
-        if (!body || expect_close(p, T_END, d))
-            return NULL;
-        p->construct = save_c;
-        node *n = mk2(p, N_FOR, t, it, body);
-        if (n)
-            n->str = var;
-        return n;
-    }
-    case T_IDENT:
-        if (peek2(p)->type == T_ASSIGN) {
-            next(p);
-            next(p);
-            node *v = parse_expr(p);
-            return v ? one_kid(p, N_ASSIGN, t, v, tok_name(p, t)) : NULL;
-        }
-        break;
-    default:
-        break;
-    }
     node *e = parse_expr(p);
     return e ? one_kid(p, N_EXPR, t, e, NULL) : NULL;
 }
 
-/* block -> { statement (NEWLINE | ';') } up to 'end' (or 'else' if allowed)
- * or end of input. */
-static node *parse_block_until(parser *p, const token *open, int allow_else)
+/* statement -> letstat | paramstat | fnstat | importstat | forstat | assignstat | exprstat
+ * ('fn' without a name starts an expression, as does a NAME not followed by '=') */
+static node *parse_statement(parser *p)
 {
-    (void)allow_else;
+    switch (peek(p)->type) {
+    case T_LET:
+        return parse_let(p);
+    case T_PARAM:
+        return parse_param_decl(p);
+    case T_FN:
+        return peek2(p)->type == T_IDENT ? parse_fndef(p) : parse_expr_statement(p);
+    case T_IMPORT:
+        return parse_import(p);
+    case T_FOR:
+        return parse_for(p);
+    case T_IDENT:
+        return peek2(p)->type == T_ASSIGN ? parse_assign(p) : parse_expr_statement(p);
+    default:
+        return parse_expr_statement(p);
+    }
+}
+
+/* block -> { statement (NEWLINE | ';') } up to 'end' (inside 'do')
+ * or end of input. */
+static node *parse_block_until(parser *p, const token *open)
+{
     int save_nl = p->skip_nl, save_tm = p->table_mode;
     p->skip_nl = 0;
     p->table_mode = 0;
@@ -1238,7 +1298,7 @@ int parse_source(interp *I, int src, node **out)
         I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
         return -1;
     }
-    node *b = parse_block_until(&p, NULL, 0);
+    node *b = parse_block_until(&p, NULL);
     lex_free(&p.tl);
     if (!b || p.failed) {
         if (!I->err.active)
