@@ -43,17 +43,6 @@ static void item_box(value v, double lo[3], double hi[3])
     }
 }
 
-/* Append src to dst (with fallback colour for meshes without colours). */
-static void mesh_append(mesh *dst, const mesh *src, const float colour[4])
-{
-    uint32_t base = (uint32_t)dst->nv;
-    static const float up[3] = {0, 1, 0};
-    for (size_t i = 0; i < src->nv; i++)
-        mesh_add_vertex(dst, src->pos + 3 * i, src->nrm ? src->nrm + 3 * i : up, src->col ? src->col + 4 * i : colour);
-    for (size_t t = 0; t < src->nt; t++)
-        mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
-}
-
 /* rasterize(scene, camera, size, background, light, ambient, diffuse, flat, unlit, colour, pixel, kmax) */
 static int b_rasterize(interp *I, value *a, int n, value *out)
 {
