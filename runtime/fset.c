@@ -378,32 +378,50 @@ static void chaos_orbit(void *p, size_t chunk, int worker)
     }
 }
 
+/* The end points of one chunk's walks (dim doubles each, *n of them; rt_free
+ * them): every walk starts at opts->start and takes opts->depth steps, step k
+ * a map of W_σ(k) drawn from the stream of (seed, k) at the chunk's index.
+ * NULL when out of memory. */
+static double *walk_chunk(const fset *fs, const fset_order *o, const double *cum, const fset_chaos_opts *op,
+                          size_t chunk, int dim, size_t *n)
+{
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
+    *n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
+    double *pt = rt_malloc(*n * (size_t)dim * sizeof *pt);
+    if (!pt)
+        return NULL;
+    for (size_t i = 0; i < *n; i++)
+        memcpy(pt + (size_t)dim * i, op->start, (size_t)dim * sizeof(double));
+    for (uint64_t k = 0; k < op->depth; k++) {
+        int s = fset_order_at(o, fs->n, k);
+        const fset_ifs *w = &fs->sets[s];
+        const double *cw = cum + (size_t)s * FSET_MAX_MAPS;
+        rng r;
+        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
+        for (size_t i = 0; i < *n; i++) {
+            int m = fset_pick(cw, w->n, rng_uniform(&r));
+            double *p = pt + (size_t)dim * i;
+            if (dim == 2) {
+                fset_apply2(&w->maps[m], &p[0], &p[1]);
+            } else {
+                double q[3];
+                affine_apply(&w->maps[m], p, q);
+                memcpy(p, q, sizeof q);
+            }
+        }
+    }
+    return pt;
+}
+
 static void chaos_walk(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
-    const fset_chaos_opts *op = c->opts;
     uint64_t *cnt = c->count[worker];
-    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
-    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
-    double *pt = rt_malloc(n * 2 * sizeof *pt);
+    size_t n;
+    double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 2, &n);
     if (!pt) {
         c->failed = 1;
         return;
-    }
-    for (size_t i = 0; i < n; i++) {
-        pt[2 * i] = op->start[0];
-        pt[2 * i + 1] = op->start[1];
-    }
-    for (uint64_t k = 0; k < op->depth; k++) {
-        int s = fset_order_at(c->o, c->fs->n, k);
-        const fset_ifs *w = &c->fs->sets[s];
-        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
-        rng r;
-        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
-        for (size_t i = 0; i < n; i++) {
-            int m = fset_pick(cum, w->n, rng_uniform(&r));
-            fset_apply2(&w->maps[m], &pt[2 * i], &pt[2 * i + 1]);
-        }
     }
     for (size_t i = 0; i < n; i++) {
         long b = fset_hist_bin(c->hs, pt[2 * i], pt[2 * i + 1]);
@@ -642,29 +660,13 @@ static void view_orbit(void *pp, size_t chunk, int worker)
 static void view_walk(void *pp, size_t chunk, int worker)
 {
     view_ctx *c = pp;
-    const fset_chaos_opts *op = c->opts;
-    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
-    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
-    double *pt = rt_malloc(n * 3 * sizeof *pt);
+    size_t n;
+    double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 3, &n);
     if (!pt) {
         c->failed = 1;
         return;
     }
-    for (size_t i = 0; i < n; i++)
-        memcpy(pt + 3 * i, op->start, 3 * sizeof(double));
-    for (uint64_t k = 0; k < op->depth; k++) {
-        int s = fset_order_at(c->o, c->fs->n, k);
-        const fset_ifs *w = &c->fs->sets[s];
-        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
-        rng r;
-        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
-        for (size_t i = 0; i < n; i++) {
-            int m = fset_pick(cum, w->n, rng_uniform(&r));
-            double q[3];
-            affine_apply(&w->maps[m], pt + 3 * i, q);
-            memcpy(pt + 3 * i, q, sizeof q);
-        }
-    }
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
     for (size_t i = 0; i < n; i++)
         view_plot(c, worker, first + i, pt + 3 * i);
     rt_free(pt);
