@@ -460,12 +460,8 @@ static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, c
             return err_at(I, NULL, ERR_VALUE, "chaos_fset: cannot frame the set (its box is not finite)");
     }
     image *im;
-    if (lang_image_new(I, w, h, &im))
+    if (lang_depth_image(I, w, h, 8, "chaos_fset", &im))
         return -1;
-    if (mem_precheck(I, (double)w * h * 8 * (I->threads + 1), "chaos_fset: the depth buffers")) {
-        lang_image_discard(im);
-        return -1;
-    }
     rt_run run = lang_run(I);
     c = fset_chaos_view(&f->fs, o, co, &cam, bg, im, &run, &e);
     return lang_image_finish(I, im, c, &e, "chaos_fset", out);
