@@ -22,11 +22,7 @@ static void item_box(value v, double lo[3], double hi[3])
     mesh *m = lang_as_mesh(v);
     surf_obj *s = lang_as_surf(v);
     if (m) {
-        for (size_t i = 0; i < m->nv; i++)
-            for (int d = 0; d < 3; d++) {
-                lo[d] = fmin(lo[d], m->pos[3 * i + d]);
-                hi[d] = fmax(hi[d], m->pos[3 * i + d]);
-            }
+        mesh_grow_box(m, lo, hi);
     } else if (s) {
         double hm = 0;
         for (size_t i = 0; i < (size_t)s->nu * (size_t)s->nv; i++) {

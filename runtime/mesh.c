@@ -217,3 +217,12 @@ void mesh_append(mesh *dst, const mesh *src, const float colour[4])
     for (size_t t = 0; t < src->nt; t++)
         mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
 }
+
+void mesh_grow_box(const mesh *m, double lo[3], double hi[3])
+{
+    for (size_t i = 0; i < m->nv; i++)
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fmin(lo[d], m->pos[3 * i + d]);
+            hi[d] = fmax(hi[d], m->pos[3 * i + d]);
+        }
+}

@@ -35,6 +35,9 @@ void mesh_add_tri(mesh *m, uint32_t a, uint32_t b, uint32_t c);
  * has no colours `colour`; attributes dst lacks are dropped. The caller keeps
  * dst->nv + src->nv below 2^32 - 1; an allocation failure sets dst->failed. */
 void mesh_append(mesh *dst, const mesh *src, const float colour[4]);
+/* Grow the box lo..hi to hold every vertex (start from lo = +inf, hi = -inf
+ * for the bounding box; NaN coordinates are passed over, as fmin does). */
+void mesh_grow_box(const mesh *m, double lo[3], double hi[3]);
 
 /* Topology statistics: edges shared by 1 triangle (boundary), by > 2
  * (non-manifold), Euler characteristic V - E + F (counting only vertices

@@ -94,6 +94,15 @@ int main(void)
           "vertex 9 = (2.5, 0, 0), normal up, fallback colour");
     CHECK(mesh_compute_stats(&all, &st, &e) == RT_OK && st.euler == 4 && st.boundary_edges == 0, "two closed cubes");
     CHECK_NEAR(st.volume, 2, 1e-9, "two cubes' volume");
+    /* The box of the two cubes is [0, 2.5] × [0, 1] × [0, 1]; a box that
+     * already holds more (down to z = -3) keeps it. */
+    double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    mesh_grow_box(&all, blo, bhi);
+    CHECK(blo[0] == 0 && blo[1] == 0 && blo[2] == 0 && bhi[0] == 2.5 && bhi[1] == 1 && bhi[2] == 1,
+          "box [%g, %g] × [%g, %g] × [%g, %g]", blo[0], bhi[0], blo[1], bhi[1], blo[2], bhi[2]);
+    blo[2] = -3;
+    mesh_grow_box(&one, blo, bhi);
+    CHECK(blo[2] == -3 && bhi[0] == 2.5, "a box only grows");
     mesh tri;
     mesh_init(&tri, 0, 1);
     const float red[4] = {1, 0, 0, 1};
