@@ -241,22 +241,6 @@ static int fv_arith(interp *I, int op, value a, value b, value *out)
 /* A DMF works on numbers (computed now) or fields (a node). */
 typedef double (*dmf_num)(double p, double t);
 
-static int get_bounds(interp *I, value lo, value hi, double l[3], double h[3], const char *what)
-{
-    char w[128];
-    snprintf(w, sizeof w, "%s: lo", what);
-    if (builtin_get_vec(I, lo, l, 3, w))
-        return -1;
-    snprintf(w, sizeof w, "%s: hi", what);
-    if (builtin_get_vec(I, hi, h, 3, w))
-        return -1;
-    for (int i = 0; i < 3; i++)
-        if (!(h[i] > l[i]))
-            return err_at(I, NULL, ERR_VALUE, "%s: the box needs lo < hi on every axis (axis %d: %g, %g)", what, i,
-                          l[i], h[i]);
-    return 0;
-}
-
 static int get_grid(interp *I, value v, int n[3], const char *what)
 {
     double g[3];
@@ -290,54 +274,23 @@ static int shape(interp *I, density_shape *s, value *out)
     return lang_field_value(I, field_density(s), out);
 }
 
-static int b_sphere(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    density_shape s = {0};
-    s.kind = DENSITY_SPHERE;
-    if (builtin_get_vec(I, a[0], s.c, 3, "sphere: center"))
-        return -1;
-    s.r = a[1].u.n;
-    s.s = a[2].u.n;
-    return shape(I, &s, out);
-}
-
-static int b_box(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    density_shape s = {0};
-    s.kind = DENSITY_BOX;
-    if (builtin_get_vec(I, a[0], s.c, 3, "box: center") || builtin_get_vec(I, a[1], s.h, 3, "box: half"))
-        return -1;
-    s.s = a[2].u.n;
-    return shape(I, &s, out);
-}
-
-static int b_torus(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    density_shape s = {0};
-    s.kind = DENSITY_TORUS;
-    if (builtin_get_vec(I, a[0], s.c, 3, "torus: center"))
-        return -1;
-    s.R = a[1].u.n;
-    s.r = a[2].u.n;
-    s.s = a[3].u.n;
-    return shape(I, &s, out);
-}
-
-static int b_cylinder(interp *I, value *a, int n, value *out)
-{
-    (void)n;
-    density_shape s = {0};
-    s.kind = DENSITY_CYLINDER;
-    if (builtin_get_vec(I, a[0], s.c, 3, "cylinder: center"))
-        return -1;
-    s.r = a[1].u.n;
-    s.h[2] = a[2].u.n;
-    s.s = a[3].u.n;
-    return shape(I, &s, out);
-}
+/* Density shapes: the centre first, then the kind's own parameters (their
+ * ranges declared in the table). */
+#define SHAPE_BUILTIN(name, KIND, set)                                              \
+    static int b_##name(interp *I, value *a, int n, value *out)                    \
+    {                                                                               \
+        (void)n;                                                                    \
+        density_shape s = {0};                                                      \
+        s.kind = KIND;                                                              \
+        if (builtin_get_vec(I, a[0], s.c, 3, #name ": center"))                     \
+            return -1;                                                              \
+        set;                                                                        \
+        return shape(I, &s, out);                                                   \
+    }
+SHAPE_BUILTIN(sphere, DENSITY_SPHERE, (s.r = a[1].u.n, s.s = a[2].u.n))
+SHAPE_BUILTIN(box, DENSITY_BOX, if (builtin_get_vec(I, a[1], s.h, 3, "box: half")) return -1; s.s = a[2].u.n)
+SHAPE_BUILTIN(torus, DENSITY_TORUS, (s.R = a[1].u.n, s.r = a[2].u.n, s.s = a[3].u.n))
+SHAPE_BUILTIN(cylinder, DENSITY_CYLINDER, (s.r = a[1].u.n, s.h[2] = a[2].u.n, s.s = a[3].u.n))
 
 static int noise_common(interp *I, field *f, double freq, value *out)
 {
@@ -559,7 +512,7 @@ static int b_sample(interp *I, value *a, int n, value *out)
     (void)n;
     int g[3];
     double lo[3], hi[3];
-    if (get_grid(I, a[1], g, "sample: grid") || get_bounds(I, a[2], a[3], lo, hi, "sample"))
+    if (get_grid(I, a[1], g, "sample: grid") || lang_get_box(I, a[2], a[3], lo, hi, "sample"))
         return -1;
     field *tmp;
     field_prog *own;
@@ -629,7 +582,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         field *tmp;
         field_prog *own;
         const field_prog *prog;
-        if (get_grid(I, a[2], g, "isosurface: grid") || get_bounds(I, a[3], a[4], lo, hi, "isosurface") ||
+        if (get_grid(I, a[2], g, "isosurface: grid") || lang_get_box(I, a[3], a[4], lo, hi, "isosurface") ||
             lang_field_fn(I, a[0], &tmp, &own, &prog, "isosurface")) {
             mem_free(I, m);
             lang_field_fn_done(ctmp, cown);
@@ -668,7 +621,7 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
         return -1;
     w = (int)sz[0];
     h = (int)sz[1];
-    if (lang_get_camera(I, a[1], &cam, "raymarch") || get_bounds(I, a[3], a[4], o.lo, o.hi, "raymarch"))
+    if (lang_get_camera(I, a[1], &cam, "raymarch") || lang_get_box(I, a[3], a[4], o.lo, o.hi, "raymarch"))
         return -1;
     /* declared: mode str{emission,solid}, sigma num>0, step num>0 */
     o.mode = strcmp(AS_STR(a[5])->s, "solid") == 0 ? RM_SOLID : RM_EMISSION;

@@ -437,90 +437,6 @@ int lang_tone_args(interp *I, value palette, value curve, value gamma, value bri
     return lang_get_colour(I, bg, t->bg, w);
 }
 
-/* Widen lo..hi by a margin and to the aspect w:h about its centre. */
-void lang_fit_aspect(double lo[2], double hi[2], int w, int h, double margin)
-{
-    double ext[2];
-    for (int k = 0; k < 2; k++) {
-        ext[k] = hi[k] - lo[k];
-        if (!(ext[k] > 1e-12))
-            ext[k] = fmax(1e-3, fmax(fabs(lo[k]), fabs(hi[k])) * 0.1);
-        ext[k] *= 1 + 2 * margin;
-    }
-    double aspect = (double)w / h;
-    if (ext[0] / ext[1] < aspect)
-        ext[0] = ext[1] * aspect;
-    else
-        ext[1] = ext[0] / aspect;
-    for (int k = 0; k < 2; k++) {
-        double c = (lo[k] + hi[k]) / 2;
-        lo[k] = c - ext[k] / 2;
-        hi[k] = c + ext[k] / 2;
-    }
-}
-
-/* The window of a function-set chaos game: a bound from the maps'
- * contractions, narrowed by three coarse histogram passes. */
-static rt_code fset_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
-                        double hi[2], const rt_run *run, rt_error *e)
-{
-    double R = 0;
-    int contractive = 1;
-    for (int s = 0; s < fs->n; s++)
-        for (int m = 0; m < fs->sets[s].n; m++) {
-            const affine *a = &fs->sets[s].maps[m];
-            double c = affine_contraction(a);
-            if (!(c < 0.999))
-                contractive = 0;
-            else
-                R = fmax(R, hypot(a->t[0], a->t[1]) / (1 - c));
-        }
-    R = contractive ? R + hypot(opts->start[0], opts->start[1]) + 1e-9 : 1e6;
-    lo[0] = lo[1] = -R;
-    hi[0] = hi[1] = R;
-    fset_chaos_opts fo = *opts;
-    fo.points = opts->points < 50000 ? opts->points : 50000;
-    for (int pass = 0; pass < 4; pass++) {
-        hist2 hs;
-        const int G = 256;
-        rt_code c = hist2_init(&hs, G, G, lo, hi, 0, e);
-        if (c)
-            return c;
-        rt_sharder *sv = par_set_sharder(NULL); /* a pre-pass: in full in every shard (par.h) */
-        c = fset_chaos(fs, o, &fo, &hs, run, e);
-        par_set_sharder(sv);
-        if (c) {
-            hist2_free(&hs);
-            return c;
-        }
-        int x0 = G, x1 = -1, y0 = G, y1 = -1;
-        for (int j = 0; j < G; j++)
-            for (int i = 0; i < G; i++)
-                if (hs.count[(size_t)j * G + i]) {
-                    if (i < x0)
-                        x0 = i;
-                    if (i > x1)
-                        x1 = i;
-                    if (j < y0)
-                        y0 = j;
-                    if (j > y1)
-                        y1 = j;
-                }
-        hist2_free(&hs);
-        if (x1 < 0)
-            return rt_fail(e, RT_EINVAL, "no point of the chaos game fell near the origin; give window: [xmin, xmax, ymin, ymax]");
-        double bx = (hi[0] - lo[0]) / G, by = (hi[1] - lo[1]) / G;
-        double nlo0 = lo[0] + (x0 - 1) * bx, nhi0 = lo[0] + (x1 + 2) * bx;
-        double nhi1 = hi[1] - (y0 - 1) * by, nlo1 = hi[1] - (y1 + 2) * by;
-        lo[0] = nlo0;
-        hi[0] = nhi0;
-        lo[1] = nlo1;
-        hi[1] = nhi1;
-    }
-    lang_fit_aspect(lo, hi, w, h, 0.03);
-    return RT_OK;
-}
-
 /* chaos_fset of a 3-D set: the nearest point per pixel through a camera
  * (default: framing(…) of the game's fitted box) */
 static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, const fset_chaos_opts *co, value camv,
@@ -544,12 +460,8 @@ static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, c
             return err_at(I, NULL, ERR_VALUE, "chaos_fset: cannot frame the set (its box is not finite)");
     }
     image *im;
-    if (lang_image_new(I, w, h, &im))
+    if (lang_depth_image(I, w, h, 8, "chaos_fset", &im))
         return -1;
-    if (mem_precheck(I, (double)w * h * 8 * (I->threads + 1), "chaos_fset: the depth buffers")) {
-        lang_image_discard(im);
-        return -1;
-    }
     rt_run run = lang_run(I);
     c = fset_chaos_view(&f->fs, o, co, &cam, bg, im, &run, &e);
     return lang_image_finish(I, im, c, &e, "chaos_fset", out);
@@ -626,7 +538,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     if (a[4].k != V_NIL) {
         if (lang_window_arg(I, a[4], lo, hi, "chaos_fset: window"))
             goto done;
-    } else if ((c = fset_order_validate(&o, f->n, &e)) || (c = fset_fit(&f->fs, &o, &co, w, h, lo, hi, &run, &e))) {
+    } else if ((c = fset_order_validate(&o, f->n, &e)) || (c = fset_chaos_fit(&f->fs, &o, &co, w, h, lo, hi, &run, &e))) {
         lang_rt_error(I, c, &e, "chaos_fset");
         goto done;
     }

@@ -811,13 +811,8 @@ static int b_view(interp *I, value *a, int n, value *out)
             return err_at(I, NULL, ERR_VALUE, "view: cannot frame the attractor (its box is not finite)");
     }
     image *im;
-    if (lang_image_new(I, w, h, &im))
+    if (lang_depth_image(I, w, h, 16, "view", &im))
         return -1;
-    double bytes = (double)w * h * 16 * (I->threads + 1);
-    if (mem_precheck(I, bytes, "view: the depth buffers")) {
-        lang_image_discard(im);
-        return -1;
-    }
     rt_run run = lang_run(I);
     chaos_stats st;
     double t0 = report_clock();

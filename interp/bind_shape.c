@@ -30,20 +30,6 @@ static void shape_destroy(void *pp)
     rt_free(s);
 }
 
-static void shape_bounds(const detiter_shape *s, double lo[2], double hi[2])
-{
-    lo[0] = lo[1] = INFINITY;
-    hi[0] = hi[1] = -INFINITY;
-    for (size_t i = 0; i < s->nverts; i++)
-        for (int k = 0; k < 2; k++) {
-            double x = s->v[i * (size_t)s->dim + (size_t)k];
-            if (x < lo[k])
-                lo[k] = x;
-            if (x > hi[k])
-                hi[k] = x;
-        }
-}
-
 static void shape_summary(const void *pp, bytebuf *out)
 {
     const detiter_shape *s = pp;
@@ -67,7 +53,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
         *out = val_num(s->dim);
     else if (strcmp(name, "bounds") == 0) {
         double lo[2], hi[2], b[4];
-        shape_bounds(s, lo, hi);
+        detiter_bounds(s, lo, hi);
         b[0] = lo[0];
         b[1] = hi[0];
         b[2] = lo[1];
@@ -125,93 +111,51 @@ static int shape_value(interp *I, detiter_shape *s, value *out)
     return out->k == V_NIL ? -1 : 0;
 }
 
-/* An empty shape with room for nv vertices and np polylines. */
-static int shape_alloc(interp *I, detiter_shape *s, int dim, size_t nv, size_t np)
-{
-    memset(s, 0, sizeof *s);
-    s->dim = dim;
-    s->v = mem_alloc(I, sizeof(double) * (nv ? nv : 1) * (size_t)dim);
-    s->start = mem_alloc(I, sizeof(size_t) * (np + 1));
-    s->closed = mem_alloc(I, np ? np : 1);
-    if (!s->v || !s->start || !s->closed) {
-        detiter_shape_free(s);
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
-    }
-    s->nverts = nv;
-    s->npoly = np;
-    return 0;
-}
-
 /* shape + [dx, dy], shape - [dx, dy], shape * k, map * shape, shape + shape (union) */
 static int shape_arith(interp *I, int op, value a, value b, value *out)
 {
     const detiter_shape *x = as_shape(a), *y = as_shape(b);
+    detiter_shape s;
+    rt_error e;
+    rt_code c;
+    const char *what;
     if (x && y && op == T_PLUS) {
         if (x->dim != y->dim)
             return err_at(I, NULL, ERR_VALUE, "shape + shape: a %d-D and a %d-D shape cannot be joined", x->dim, y->dim);
-        detiter_shape s;
-        if (shape_alloc(I, &s, x->dim, x->nverts + y->nverts, x->npoly + y->npoly))
-            return -1;
-        memcpy(s.v, x->v, sizeof(double) * x->nverts * (size_t)x->dim);
-        memcpy(s.v + x->nverts * (size_t)x->dim, y->v, sizeof(double) * y->nverts * (size_t)y->dim);
-        for (size_t i = 0; i < x->npoly; i++) {
-            s.start[i] = x->start[i];
-            s.closed[i] = x->closed[i];
-        }
-        for (size_t i = 0; i < y->npoly; i++) {
-            s.start[x->npoly + i] = x->nverts + y->start[i];
-            s.closed[x->npoly + i] = y->closed[i];
-        }
-        s.start[s.npoly] = s.nverts;
-        return shape_value(I, &s, out) ? -1 : 1;
-    }
-    const detiter_shape *src = x ? x : y;
-    value other = x ? b : a;
-    const affine *m = NULL;
-    double t[3] = {0, 0, 0}, k = 1;
-    int kind;
-    if (other.k == V_OBJ && AS_OBJ(other)->cls == &lang_map_class && y && op == T_STAR) {
-        m = AS_OBJ(other)->payload;
-        kind = 0;
-    } else if (other.k == V_LIST && (op == T_PLUS || (op == T_MINUS && x))) {
-        size_t nn = AS_LIST(other)->n;
-        if ((int)nn != src->dim)
-            return err_at(I, NULL, ERR_VALUE, "shape %s: a %d-D shape moves by a list of %d numbers, got %zu",
-                          op == T_PLUS ? "+" : "-", src->dim, src->dim, nn);
-        if (builtin_get_vec(I, other, t, nn, "shape offset"))
-            return -1;
-        if (op == T_MINUS)
-            for (int i = 0; i < 3; i++)
-                t[i] = -t[i];
-        kind = 1;
-    } else if (other.k == V_NUM && (op == T_STAR || (op == T_SLASH && x))) {
-        k = op == T_STAR ? other.u.n : 1 / other.u.n;
-        kind = 2;
+        what = "shape + shape";
+        c = detiter_shape_join(x, y, &s, &e);
     } else {
-        return 0;
-    }
-    if (m && m->dim > src->dim)
-        return err_at(I, NULL, ERR_VALUE, "map * shape: a %d-D map cannot apply to a %d-D shape", m->dim, src->dim);
-    detiter_shape s;
-    if (shape_alloc(I, &s, src->dim, src->nverts, src->npoly))
-        return -1;
-    memcpy(s.start, src->start, sizeof(size_t) * (src->npoly + 1));
-    memcpy(s.closed, src->closed, src->npoly);
-    for (size_t i = 0; i < src->nverts; i++) {
-        const double *p = src->v + i * (size_t)src->dim;
-        double *q = s.v + i * (size_t)src->dim;
-        if (kind == 0) {
-            double in[3] = {p[0], p[1], src->dim == 3 ? p[2] : 0}, o3[3];
-            affine_apply(m, in, o3);
-            for (int d = 0; d < m->dim; d++)
-                q[d] = o3[d];
-            if (m->dim < src->dim)
-                q[2] = p[2];
+        const detiter_shape *src = x ? x : y;
+        value other = x ? b : a;
+        if (other.k == V_OBJ && AS_OBJ(other)->cls == &lang_map_class && y && op == T_STAR) {
+            const affine *m = AS_OBJ(other)->payload;
+            if (m->dim > src->dim)
+                return err_at(I, NULL, ERR_VALUE, "map * shape: a %d-D map cannot apply to a %d-D shape", m->dim,
+                              src->dim);
+            what = "map * shape";
+            c = detiter_shape_map(src, m, &s, &e);
+        } else if (other.k == V_LIST && (op == T_PLUS || (op == T_MINUS && x))) {
+            size_t nn = AS_LIST(other)->n;
+            double t[3] = {0, 0, 0};
+            if ((int)nn != src->dim)
+                return err_at(I, NULL, ERR_VALUE, "shape %s: a %d-D shape moves by a list of %d numbers, got %zu",
+                              op == T_PLUS ? "+" : "-", src->dim, src->dim, nn);
+            if (builtin_get_vec(I, other, t, nn, "shape offset"))
+                return -1;
+            if (op == T_MINUS)
+                for (int i = 0; i < 3; i++)
+                    t[i] = -t[i];
+            what = op == T_PLUS ? "shape +" : "shape -";
+            c = detiter_shape_shift(src, t, &s, &e);
+        } else if (other.k == V_NUM && (op == T_STAR || (op == T_SLASH && x))) {
+            what = op == T_STAR ? "shape *" : "shape /";
+            c = detiter_shape_scale(src, op == T_STAR ? other.u.n : 1 / other.u.n, &s, &e);
         } else {
-            for (int d = 0; d < src->dim; d++)
-                q[d] = kind == 1 ? p[d] + t[d] : p[d] * k;
+            return 0;
         }
     }
+    if (c)
+        return lang_rt_error(I, c, &e, what);
     return shape_value(I, &s, out) ? -1 : 1;
 }
 
@@ -536,7 +480,7 @@ static int shape_view(interp *I, const detiter_shape *s, value window, int w, in
         if (lang_window_arg(I, window, lo, hi, wn))
             return -1;
     } else {
-        shape_bounds(s, lo, hi);
+        detiter_bounds(s, lo, hi);
         for (int k = 0; k < 2; k++) {
             double ext = hi[k] - lo[k];
             if (!(ext > 0))

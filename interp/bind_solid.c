@@ -51,22 +51,6 @@ static int get_axis(interp *I, value v, double a[3], const char *what)
     return 0;
 }
 
-static int get_box(interp *I, value lo, value hi, double l[3], double h[3], const char *what)
-{
-    char w[96];
-    snprintf(w, sizeof w, "%s: lo", what);
-    if (get_vec3(I, lo, l, w))
-        return -1;
-    snprintf(w, sizeof w, "%s: hi", what);
-    if (get_vec3(I, hi, h, w))
-        return -1;
-    for (int i = 0; i < 3; i++)
-        if (!(h[i] > l[i]))
-            return err_at(I, NULL, ERR_VALUE, "%s: the box needs lo < hi on every axis (axis %d: %g, %g)", what, i,
-                          l[i], h[i]);
-    return 0;
-}
-
 /* Graph shorthands (constructors consume their arguments; NULL propagates). */
 static field *fadd(field *a, field *b) { return field_binary(FIELD_ADD, a, b); }
 static field *fsub(field *a, field *b) { return field_binary(FIELD_SUB, a, b); }
@@ -283,7 +267,7 @@ static int b_fractal(interp *I, value *a, int n, value *out)
         type = MPD_TYPE4;
     }
     double lo[3], hi[3];
-    if (get_box(I, a[6], a[7], lo, hi, W))
+    if (lang_get_box(I, a[6], a[7], lo, hi, W))
         return -1;
 
     /* The automatic strategy: Type I when its array fits the budget, else

@@ -196,7 +196,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
             }
         if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1]))
             return err_at(I, NULL, ERR_VALUE, "superifs_image: the buffers hold no finite points; give window:");
-        lang_fit_aspect(lo, hi, w, h, 0.03);
+        fset_fit_aspect(lo, hi, w, h, 0.03);
     }
     if ((double)w * h > I->lim.max_pixels)
         return err_at(I, NULL, ERR_LIMIT, "superifs_image: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);

@@ -288,15 +288,12 @@ static int mesh_get(interp *I, const void *p, const char *name, value *out)
         *out = val_num((double)m->nt);
     else if (strcmp(name, "lo") == 0 || strcmp(name, "hi") == 0) {
         /* the bounding box corners (nil for an empty mesh) */
-        int hi = name[0] == 'h';
-        double b[3] = {hi ? -INFINITY : INFINITY, hi ? -INFINITY : INFINITY, hi ? -INFINITY : INFINITY};
-        for (size_t i = 0; i < m->nv; i++)
-            for (int d = 0; d < 3; d++)
-                b[d] = hi ? fmax(b[d], m->pos[3 * i + d]) : fmin(b[d], m->pos[3 * i + d]);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        mesh_grow_box(m, lo, hi);
         if (m->nv == 0)
             *out = val_nil();
         else
-            return lang_num_list_value(I, b, 3, out);
+            return lang_num_list_value(I, name[0] == 'h' ? hi : lo, 3, out);
     } else
         return 1;
     return 0;

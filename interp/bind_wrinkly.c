@@ -404,66 +404,6 @@ static int get_view(interp *I, const curve_obj *c, value bounds, int w, int h, d
     return 0;
 }
 
-/* Stroke a polyline whose segments have their own colours: per pixel the
- * segment with the largest coverage wins (coverage as in draw.h), then one
- * composite over the image. */
-static int stroke_coloured(interp *I, image *im, const draw_view *v, const wrinkly_polyline *pl, double width)
-{
-    size_t np = (size_t)im->w * (size_t)im->h;
-    float *cov = mem_calloc(I, np, sizeof *cov);
-    float *col = mem_calloc(I, np * 4, sizeof *col);
-    if (!cov || !col) {
-        mem_free(I, cov);
-        mem_free(I, col);
-        return err_at(I, NULL, ERR_MEMORY, "out of memory drawing a curve");
-    }
-    size_t nseg = pl->n < 2 ? 0 : pl->closed ? pl->n : pl->n - 1;
-    double r = width / 2 + 0.5;
-    for (size_t s = 0; s < nseg; s++) {
-        size_t i = s, j = (s + 1) % pl->n;
-        double ax, ay, bx, by;
-        draw_to_px(v, pl->xy[2 * i], pl->xy[2 * i + 1], &ax, &ay);
-        draw_to_px(v, pl->xy[2 * j], pl->xy[2 * j + 1], &bx, &by);
-        float c[4];
-        for (int q = 0; q < 4; q++)
-            c[q] = 0.5f * (pl->rgba[4 * i + q] + pl->rgba[4 * j + q]);
-        int x0 = (int)floor(fmin(ax, bx) - r), x1 = (int)ceil(fmax(ax, bx) + r);
-        int y0 = (int)floor(fmin(ay, by) - r), y1 = (int)ceil(fmax(ay, by) + r);
-        x0 = x0 < 0 ? 0 : x0;
-        y0 = y0 < 0 ? 0 : y0;
-        x1 = x1 > im->w - 1 ? im->w - 1 : x1;
-        y1 = y1 > im->h - 1 ? im->h - 1 : y1;
-        double dx = bx - ax, dy = by - ay, ll = dx * dx + dy * dy;
-        for (int y = y0; y <= y1; y++)
-            for (int x = x0; x <= x1; x++) {
-                double px = x + 0.5 - ax, py = y + 0.5 - ay;
-                double t = ll > 0 ? (px * dx + py * dy) / ll : 0;
-                t = t < 0 ? 0 : t > 1 ? 1 : t;
-                double ex = px - t * dx, ey = py - t * dy;
-                double k = r - sqrt(ex * ex + ey * ey);
-                k = k < 0 ? 0 : k > 1 ? 1 : k;
-                size_t id = (size_t)y * (size_t)im->w + (size_t)x;
-                if (k > cov[id]) {
-                    cov[id] = (float)k;
-                    memcpy(col + 4 * id, c, sizeof c);
-                }
-            }
-    }
-    for (size_t id = 0; id < np; id++) {
-        if (cov[id] <= 0)
-            continue;
-        float *p = im->px + 4 * id, *c = col + 4 * id;
-        float al = c[3] < 0 ? 0 : c[3] > 1 ? 1 : c[3];
-        float k = al * cov[id];
-        for (int q = 0; q < 3; q++)
-            p[q] = p[q] * (1 - k) + c[q] * k;
-        p[3] = p[3] + (1 - p[3]) * k;
-    }
-    mem_free(I, cov);
-    mem_free(I, col);
-    return 0;
-}
-
 static int polyline_shape(interp *I, const wrinkly_polyline *pl, int closed, detiter_shape *s)
 {
     rt_error e;
@@ -524,7 +464,8 @@ static int b_wrinkly_draw(interp *I, value *a, int n, value *out)
     }
     if (!rc && a[3].u.n > 0) {
         if (a[4].k == V_NIL) {
-            rc = stroke_coloured(I, im, &v, &pl, a[3].u.n);
+            if (draw_polyline_rgba(im, &v, pl.n, pl.xy, pl.rgba, pl.closed, a[3].u.n, &e))
+                rc = lang_rt_error(I, e.code, &e, W);
         } else {
             draw_style st = {{stroke[0], stroke[1], stroke[2], stroke[3]}, a[3].u.n, a[3].u.n / 2, 0};
             if (draw_shape(im, &v, &s, &st, &e))

@@ -32,7 +32,5 @@ int lang_window_arg(interp *I, value v, double lo[2], double hi[2], const char *
 /* Tone-mapping arguments shared by chaos_fset and superifs_image. */
 int lang_tone_args(interp *I, value palette, value curve, value gamma, value bright, value bg, tonemap_opts *t,
                    ramp *r, const char *what);
-/* Widen lo..hi by a margin and to the aspect w:h about its centre. */
-void lang_fit_aspect(double lo[2], double hi[2], int w, int h, double margin);
 
 #endif

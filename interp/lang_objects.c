@@ -2,6 +2,7 @@
  * ramps, option numbers, cameras, how engines run for this session and the
  * one map from runtime codes to script errors. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "builtin.h"
@@ -132,5 +133,35 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what)
     if (camera_setup(cam))
         return err_item(I, v, SIZE_MAX, ERR_VALUE, "%s: camera eye equals target, or up is parallel to the view",
                         what);
+    return 0;
+}
+
+int lang_depth_image(interp *I, int w, int h, double bytes_per_px, const char *what, image **out)
+{
+    char m[96];
+    snprintf(m, sizeof m, "%s: the depth buffers", what);
+    if (lang_image_new(I, w, h, out))
+        return -1;
+    if (mem_precheck(I, (double)w * h * bytes_per_px * (I->threads + 1), m)) {
+        lang_image_discard(*out);
+        *out = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+int lang_get_box(interp *I, value lo, value hi, double l[3], double h[3], const char *what)
+{
+    char w[128];
+    snprintf(w, sizeof w, "%s: lo", what);
+    if (builtin_get_vec(I, lo, l, 3, w))
+        return -1;
+    snprintf(w, sizeof w, "%s: hi", what);
+    if (builtin_get_vec(I, hi, h, 3, w))
+        return -1;
+    for (int i = 0; i < 3; i++)
+        if (!(h[i] > l[i]))
+            return err_at(I, NULL, ERR_VALUE, "%s: the box needs lo < hi on every axis (axis %d: %g, %g)", what, i,
+                          l[i], h[i]);
     return 0;
 }

@@ -50,6 +50,16 @@ int lang_opt_num(interp *I, value rec, const char *key, double *out);
  * TY_CAMERA (so its keys are already checked). */
 int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
+/* A box lo..hi from two vec3 arguments (messages "WHAT: lo", "WHAT: hi"),
+ * lo < hi on every axis. */
+int lang_get_box(interp *I, value lo, value hi, double l[3], double h[3], const char *what);
+
+/* A w×h image (lang_image_new) for an engine that also keeps a depth buffer
+ * of bytes_per_px per pixel for each worker and one more: the buffers'
+ * memory is checked too ("WHAT: the depth buffers needs …"). */
+struct image;
+int lang_depth_image(interp *I, int w, int h, double bytes_per_px, const char *what, struct image **out);
+
 /* How engines run for this session: threads, Ctrl-C flag, progress bar. */
 rt_run lang_run(interp *I);
 /* The one map from runtime codes to error kinds (lang_objects.c): RT_ENOMEM ->

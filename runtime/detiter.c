@@ -195,3 +195,104 @@ double detiter_length(const detiter_shape *s)
     }
     return total;
 }
+
+/* ---- shape arithmetic ---------------------------------------------------- */
+
+void detiter_bounds(const detiter_shape *s, double lo[2], double hi[2])
+{
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    for (size_t i = 0; i < s->nverts; i++)
+        for (int k = 0; k < 2; k++) {
+            double x = s->v[i * (size_t)s->dim + (size_t)k];
+            if (x < lo[k])
+                lo[k] = x;
+            if (x > hi[k])
+                hi[k] = x;
+        }
+}
+
+/* An empty shape with room for nv vertices and np polylines. */
+static rt_code shape_alloc(detiter_shape *s, int dim, size_t nv, size_t np, rt_error *e)
+{
+    memset(s, 0, sizeof *s);
+    s->dim = dim;
+    size_t vb = rt_mul_size(nv ? nv : 1, (size_t)dim * sizeof(double)), sb = rt_mul_size(np + 1, sizeof(size_t));
+    s->v = vb ? rt_malloc(vb) : NULL; /* 0: the size overflowed */
+    s->start = sb ? rt_malloc(sb) : NULL;
+    s->closed = rt_malloc(np ? np : 1);
+    if (!s->v || !s->start || !s->closed) {
+        detiter_shape_free(s);
+        return rt_fail(e, RT_ENOMEM, "out of memory for a shape of %zu vertices", nv);
+    }
+    s->nverts = nv;
+    s->npoly = np;
+    return RT_OK;
+}
+
+rt_code detiter_shape_join(const detiter_shape *x, const detiter_shape *y, detiter_shape *out, rt_error *e)
+{
+    if (x->dim != y->dim)
+        return rt_fail(e, RT_EINVAL, "a %d-D and a %d-D shape cannot be joined", x->dim, y->dim);
+    rt_code c = shape_alloc(out, x->dim, x->nverts + y->nverts, x->npoly + y->npoly, e);
+    if (c)
+        return c;
+    memcpy(out->v, x->v, sizeof(double) * x->nverts * (size_t)x->dim);
+    memcpy(out->v + x->nverts * (size_t)x->dim, y->v, sizeof(double) * y->nverts * (size_t)y->dim);
+    for (size_t i = 0; i < x->npoly; i++) {
+        out->start[i] = x->start[i];
+        out->closed[i] = x->closed[i];
+    }
+    for (size_t i = 0; i < y->npoly; i++) {
+        out->start[x->npoly + i] = x->nverts + y->start[i];
+        out->closed[x->npoly + i] = y->closed[i];
+    }
+    out->start[out->npoly] = out->nverts;
+    return RT_OK;
+}
+
+typedef enum { MOVE_MAP, MOVE_SHIFT, MOVE_SCALE } move_kind;
+
+/* out = src with every vertex mapped, shifted by t or scaled by k. */
+static rt_code shape_move(const detiter_shape *src, move_kind kind, const affine *m, const double *t, double k,
+                          detiter_shape *out, rt_error *e)
+{
+    rt_code c = shape_alloc(out, src->dim, src->nverts, src->npoly, e);
+    if (c)
+        return c;
+    memcpy(out->start, src->start, sizeof(size_t) * (src->npoly + 1));
+    memcpy(out->closed, src->closed, src->npoly);
+    for (size_t i = 0; i < src->nverts; i++) {
+        const double *p = src->v + i * (size_t)src->dim;
+        double *q = out->v + i * (size_t)src->dim;
+        if (kind == MOVE_MAP) {
+            double in[3] = {p[0], p[1], src->dim == 3 ? p[2] : 0}, o3[3];
+            affine_apply(m, in, o3);
+            for (int d = 0; d < m->dim; d++)
+                q[d] = o3[d];
+            if (m->dim < src->dim)
+                q[2] = p[2];
+        } else {
+            for (int d = 0; d < src->dim; d++)
+                q[d] = kind == MOVE_SHIFT ? p[d] + t[d] : p[d] * k;
+        }
+    }
+    return RT_OK;
+}
+
+rt_code detiter_shape_map(const detiter_shape *s, const affine *m, detiter_shape *out, rt_error *e)
+{
+    if (m->dim > s->dim)
+        return rt_fail(e, RT_EINVAL, "a %d-D map cannot apply to a %d-D shape", m->dim, s->dim);
+    return shape_move(s, MOVE_MAP, m, NULL, 1, out, e);
+}
+
+rt_code detiter_shape_shift(const detiter_shape *s, const double *t, detiter_shape *out, rt_error *e)
+{
+    return shape_move(s, MOVE_SHIFT, NULL, t, 1, out, e);
+}
+
+rt_code detiter_shape_scale(const detiter_shape *s, double k, detiter_shape *out, rt_error *e)
+{
+    return shape_move(s, MOVE_SCALE, NULL, NULL, k, out, e);
+}

@@ -58,4 +58,16 @@ rt_code detiter_run(const fset *fs, const fset_order *o, size_t steps, const det
 /* Total length of all segments (closing segments of polygons included). */
 double detiter_length(const detiter_shape *s);
 
+/* ---- shape arithmetic (new shapes; the arguments are not changed) ----
+ * Bounds of the x, y of every vertex (lo > hi on an axis when s is empty). */
+void detiter_bounds(const detiter_shape *s, double lo[2], double hi[2]);
+/* out = x ∪ y: x's polylines, then y's (same dimension, else RT_EINVAL). */
+rt_code detiter_shape_join(const detiter_shape *x, const detiter_shape *y, detiter_shape *out, rt_error *e);
+/* out = m(s), polylines as in s; a 2-D map on a 3-D shape keeps z; a 3-D
+ * map on a 2-D shape is RT_EINVAL. */
+rt_code detiter_shape_map(const detiter_shape *s, const affine *m, detiter_shape *out, rt_error *e);
+/* out = s + t (t has s->dim numbers) and out = k·s, vertex by vertex. */
+rt_code detiter_shape_shift(const detiter_shape *s, const double *t, detiter_shape *out, rt_error *e);
+rt_code detiter_shape_scale(const detiter_shape *s, double k, detiter_shape *out, rt_error *e);
+
 #endif

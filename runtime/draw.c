@@ -50,8 +50,10 @@ static void cov_max(float *cov, int w, int x, int y, double c)
         *p = f;
 }
 
-static void stroke_segment(float *cov, int w, int h, double ax, double ay, double bx, double by,
-                           double hw)
+/* Coverage of one segment into cov (max). With col, a pixel whose coverage
+ * the segment raises also takes the segment's colour c (draw_polyline_rgba). */
+static void stroke_segment(float *cov, float *col, const float c[4], int w, int h, double ax, double ay, double bx,
+                           double by, double hw)
 {
     double r = hw + 0.5;
     int x0 = (int)floor(fmin(ax, bx) - r), x1 = (int)ceil(fmax(ax, bx) + r);
@@ -68,9 +70,15 @@ static void stroke_segment(float *cov, int w, int h, double ax, double ay, doubl
             double cx = x + 0.5 - ax, cy = y + 0.5 - ay;
             double t = ll > 0 ? clamp01((cx * dx + cy * dy) / ll) : 0;
             double ex = cx - t * dx, ey = cy - t * dy;
-            double c = clamp01(r - sqrt(ex * ex + ey * ey));
-            if (c > 0)
-                cov_max(cov, w, x, y, c);
+            double k = clamp01(r - sqrt(ex * ex + ey * ey));
+            size_t id = (size_t)y * (size_t)w + (size_t)x;
+            if (!col) {
+                if (k > 0)
+                    cov_max(cov, w, x, y, k);
+            } else if (k > cov[id]) { /* compared in double: the winner as it always was */
+                cov[id] = (float)k;
+                memcpy(col + 4 * id, c, 4 * sizeof *c);
+            }
         }
 }
 
@@ -180,7 +188,7 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
                        &poly[2 * i + 1]);
         if (n == 1) {
             if (st->radius > 0)
-                stroke_segment(cov, w, h, poly[0], poly[1], poly[0], poly[1], st->radius - 0.5);
+                stroke_segment(cov, NULL, NULL, w, h, poly[0], poly[1], poly[0], poly[1], st->radius - 0.5);
             continue;
         }
         if (st->fill && s->closed[p] && n >= 3 && fill_polygon(cov, w, h, poly, n, &xs) < 0) {
@@ -191,7 +199,7 @@ rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const 
             size_t last = s->closed[p] ? n : n - 1;
             for (size_t i = 0; i < last; i++) {
                 size_t j = i + 1 < n ? i + 1 : 0;
-                stroke_segment(cov, w, h, poly[2 * i], poly[2 * i + 1], poly[2 * j],
+                stroke_segment(cov, NULL, NULL, w, h, poly[2 * i], poly[2 * i + 1], poly[2 * j],
                                poly[2 * j + 1], 0.5 * st->width);
             }
         }
@@ -210,6 +218,46 @@ done:
     rt_free(xs.x);
     rt_free(poly);
     return code;
+}
+
+rt_code draw_polyline_rgba(image *im, const draw_view *v, size_t n, const double *xy, const float *rgba, int closed,
+                           double width, rt_error *e)
+{
+    if (v->w != im->w || v->h != im->h)
+        return rt_fail(e, RT_EINVAL, "view is %d×%d but the image is %d×%d", v->w, v->h, im->w, im->h);
+    if (!(width >= 0))
+        return rt_fail(e, RT_EINVAL, "line width %g must be >= 0", width);
+    size_t np = (size_t)im->w * (size_t)im->h;
+    float *cov = rt_calloc(np, sizeof *cov);
+    float *col = rt_calloc(np, 4 * sizeof *col);
+    if (!cov || !col) {
+        rt_free(cov);
+        rt_free(col);
+        return rt_fail(e, RT_ENOMEM, "out of memory drawing a curve");
+    }
+    size_t nseg = n < 2 ? 0 : closed ? n : n - 1;
+    for (size_t s = 0; s < nseg; s++) {
+        size_t i = s, j = (s + 1) % n;
+        double ax, ay, bx, by;
+        draw_to_px(v, xy[2 * i], xy[2 * i + 1], &ax, &ay);
+        draw_to_px(v, xy[2 * j], xy[2 * j + 1], &bx, &by);
+        float c[4];
+        for (int q = 0; q < 4; q++)
+            c[q] = 0.5f * (rgba[4 * i + q] + rgba[4 * j + q]);
+        stroke_segment(cov, col, c, im->w, im->h, ax, ay, bx, by, width / 2);
+    }
+    for (size_t id = 0; id < np; id++) {
+        if (cov[id] <= 0)
+            continue;
+        float *p = im->px + 4 * id, *c = col + 4 * id;
+        float k = (float)clamp01(c[3]) * cov[id];
+        for (int q = 0; q < 3; q++)
+            p[q] = p[q] * (1 - k) + c[q] * k;
+        p[3] = p[3] + (1 - p[3]) * k;
+    }
+    rt_free(cov);
+    rt_free(col);
+    return RT_OK;
 }
 
 /* ---- SVG ------------------------------------------------------------- */

@@ -61,6 +61,15 @@ typedef struct draw_style {
 rt_code draw_shape(image *im, const draw_view *v, const detiter_shape *s, const draw_style *st,
                    rt_error *e);
 
+/* Stroke one polyline of n vertices xy[2n] (closed: the last joins the
+ * first) whose vertices carry colours rgba[4n]: segment i has the mean of
+ * its two end colours, each pixel takes the colour of the segment that
+ * covers it most (coverage as for draw_shape; of equal ones the first) and
+ * that coverage, then one composite over the image as above with
+ * α = clamp(alpha, 0, 1). */
+rt_code draw_polyline_rgba(image *im, const draw_view *v, size_t n, const double *xy, const float *rgba, int closed,
+                           double width, rt_error *e);
+
 /* Append an SVG document to b: an optional background rectangle (bg may be
  * NULL), then the shape with the style (fill only if st->fill). precision:
  * decimals for coordinates, 0 .. 9. */

@@ -378,32 +378,50 @@ static void chaos_orbit(void *p, size_t chunk, int worker)
     }
 }
 
+/* The end points of one chunk's walks (dim doubles each, *n of them; rt_free
+ * them): every walk starts at opts->start and takes opts->depth steps, step k
+ * a map of W_σ(k) drawn from the stream of (seed, k) at the chunk's index.
+ * NULL when out of memory. */
+static double *walk_chunk(const fset *fs, const fset_order *o, const double *cum, const fset_chaos_opts *op,
+                          size_t chunk, int dim, size_t *n)
+{
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
+    *n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
+    double *pt = rt_malloc(*n * (size_t)dim * sizeof *pt);
+    if (!pt)
+        return NULL;
+    for (size_t i = 0; i < *n; i++)
+        memcpy(pt + (size_t)dim * i, op->start, (size_t)dim * sizeof(double));
+    for (uint64_t k = 0; k < op->depth; k++) {
+        int s = fset_order_at(o, fs->n, k);
+        const fset_ifs *w = &fs->sets[s];
+        const double *cw = cum + (size_t)s * FSET_MAX_MAPS;
+        rng r;
+        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
+        for (size_t i = 0; i < *n; i++) {
+            int m = fset_pick(cw, w->n, rng_uniform(&r));
+            double *p = pt + (size_t)dim * i;
+            if (dim == 2) {
+                fset_apply2(&w->maps[m], &p[0], &p[1]);
+            } else {
+                double q[3];
+                affine_apply(&w->maps[m], p, q);
+                memcpy(p, q, sizeof q);
+            }
+        }
+    }
+    return pt;
+}
+
 static void chaos_walk(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
-    const fset_chaos_opts *op = c->opts;
     uint64_t *cnt = c->count[worker];
-    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
-    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
-    double *pt = rt_malloc(n * 2 * sizeof *pt);
+    size_t n;
+    double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 2, &n);
     if (!pt) {
         c->failed = 1;
         return;
-    }
-    for (size_t i = 0; i < n; i++) {
-        pt[2 * i] = op->start[0];
-        pt[2 * i + 1] = op->start[1];
-    }
-    for (uint64_t k = 0; k < op->depth; k++) {
-        int s = fset_order_at(c->o, c->fs->n, k);
-        const fset_ifs *w = &c->fs->sets[s];
-        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
-        rng r;
-        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
-        for (size_t i = 0; i < n; i++) {
-            int m = fset_pick(cum, w->n, rng_uniform(&r));
-            fset_apply2(&w->maps[m], &pt[2 * i], &pt[2 * i + 1]);
-        }
     }
     for (size_t i = 0; i < n; i++) {
         long b = fset_hist_bin(c->hs, pt[2 * i], pt[2 * i + 1]);
@@ -642,29 +660,13 @@ static void view_orbit(void *pp, size_t chunk, int worker)
 static void view_walk(void *pp, size_t chunk, int worker)
 {
     view_ctx *c = pp;
-    const fset_chaos_opts *op = c->opts;
-    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
-    size_t n = (size_t)(op->points - first < FSET_WALK_CHUNK ? op->points - first : FSET_WALK_CHUNK);
-    double *pt = rt_malloc(n * 3 * sizeof *pt);
+    size_t n;
+    double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 3, &n);
     if (!pt) {
         c->failed = 1;
         return;
     }
-    for (size_t i = 0; i < n; i++)
-        memcpy(pt + 3 * i, op->start, 3 * sizeof(double));
-    for (uint64_t k = 0; k < op->depth; k++) {
-        int s = fset_order_at(c->o, c->fs->n, k);
-        const fset_ifs *w = &c->fs->sets[s];
-        const double *cum = c->cum + (size_t)s * FSET_MAX_MAPS;
-        rng r;
-        rng_init(&r, rng_hash3(op->seed, k, 0, FSET_WALK_TAG), chunk);
-        for (size_t i = 0; i < n; i++) {
-            int m = fset_pick(cum, w->n, rng_uniform(&r));
-            double q[3];
-            affine_apply(&w->maps[m], pt + 3 * i, q);
-            memcpy(pt + 3 * i, q, sizeof q);
-        }
-    }
+    uint64_t first = (uint64_t)chunk * FSET_WALK_CHUNK;
     for (size_t i = 0; i < n; i++)
         view_plot(c, worker, first + i, pt + 3 * i);
     rt_free(pt);
@@ -688,6 +690,90 @@ static int cmp_dbl(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return x < y ? -1 : x > y;
+}
+
+/* Widen lo..hi by a margin and to the aspect w:h about its centre. */
+void fset_fit_aspect(double lo[2], double hi[2], int w, int h, double margin)
+{
+    double ext[2];
+    for (int k = 0; k < 2; k++) {
+        ext[k] = hi[k] - lo[k];
+        if (!(ext[k] > 1e-12))
+            ext[k] = fmax(1e-3, fmax(fabs(lo[k]), fabs(hi[k])) * 0.1);
+        ext[k] *= 1 + 2 * margin;
+    }
+    double aspect = (double)w / h;
+    if (ext[0] / ext[1] < aspect)
+        ext[0] = ext[1] * aspect;
+    else
+        ext[1] = ext[0] / aspect;
+    for (int k = 0; k < 2; k++) {
+        double c = (lo[k] + hi[k]) / 2;
+        lo[k] = c - ext[k] / 2;
+        hi[k] = c + ext[k] / 2;
+    }
+}
+
+/* The window of a function-set chaos game: a bound from the maps'
+ * contractions, narrowed by three coarse histogram passes. */
+rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
+                       double hi[2], const rt_run *run, rt_error *e)
+{
+    double R = 0;
+    int contractive = 1;
+    for (int s = 0; s < fs->n; s++)
+        for (int m = 0; m < fs->sets[s].n; m++) {
+            const affine *a = &fs->sets[s].maps[m];
+            double c = affine_contraction(a);
+            if (!(c < 0.999))
+                contractive = 0;
+            else
+                R = fmax(R, hypot(a->t[0], a->t[1]) / (1 - c));
+        }
+    R = contractive ? R + hypot(opts->start[0], opts->start[1]) + 1e-9 : 1e6;
+    lo[0] = lo[1] = -R;
+    hi[0] = hi[1] = R;
+    fset_chaos_opts fo = *opts;
+    fo.points = opts->points < 50000 ? opts->points : 50000;
+    for (int pass = 0; pass < 4; pass++) {
+        hist2 hs;
+        const int G = 256;
+        rt_code c = hist2_init(&hs, G, G, lo, hi, 0, e);
+        if (c)
+            return c;
+        rt_sharder *sv = par_set_sharder(NULL); /* a pre-pass: in full in every shard (par.h) */
+        c = fset_chaos(fs, o, &fo, &hs, run, e);
+        par_set_sharder(sv);
+        if (c) {
+            hist2_free(&hs);
+            return c;
+        }
+        int x0 = G, x1 = -1, y0 = G, y1 = -1;
+        for (int j = 0; j < G; j++)
+            for (int i = 0; i < G; i++)
+                if (hs.count[(size_t)j * G + i]) {
+                    if (i < x0)
+                        x0 = i;
+                    if (i > x1)
+                        x1 = i;
+                    if (j < y0)
+                        y0 = j;
+                    if (j > y1)
+                        y1 = j;
+                }
+        hist2_free(&hs);
+        if (x1 < 0)
+            return rt_fail(e, RT_EINVAL, "no point of the chaos game fell near the origin; give window: [xmin, xmax, ymin, ymax]");
+        double bx = (hi[0] - lo[0]) / G, by = (hi[1] - lo[1]) / G;
+        double nlo0 = lo[0] + (x0 - 1) * bx, nhi0 = lo[0] + (x1 + 2) * bx;
+        double nhi1 = hi[1] - (y0 - 1) * by, nlo1 = hi[1] - (y1 + 2) * by;
+        lo[0] = nlo0;
+        hi[0] = nhi0;
+        lo[1] = nlo1;
+        hi[1] = nhi1;
+    }
+    fset_fit_aspect(lo, hi, w, h, 0.03);
+    return RT_OK;
 }
 
 rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],

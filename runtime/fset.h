@@ -165,6 +165,22 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
 rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
                        rt_error *e);
 
+/* Widen the window lo..hi about its centre: each extent (a degenerate one,
+ * <= 1e-12, first becomes max(1e-3, 10 % of the larger |bound|)) grows by
+ * `margin` of itself on each side, then the shorter side grows until the
+ * window has the aspect w:h of the image. */
+void fset_fit_aspect(double lo[2], double hi[2], int w, int h, double margin);
+/* The window of a 2-D function set's chaos game for a w×h image. Start from
+ * the square ±R, R = max over the maps of |t|/(1 - c) (c the contraction
+ * factor, affine_contraction) plus |start|, or ±1e6 when a map has c >= 0.999;
+ * then four passes of the same game (at most 50,000 points, run in full in
+ * every shard) into a 256×256 histogram of the window each narrow it to the
+ * occupied cells plus one cell on each side, and
+ * fset_fit_aspect with a 3 % margin ends it. RT_EINVAL when no point falls
+ * in the first window. */
+rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
+                       double hi[2], const rt_run *run, rt_error *e);
+
 /* Bin of a plane point in a histogram (hist.h conventions), or -1 if it
  * falls outside (or is NaN). */
 long fset_hist_bin(const hist2 *hs, double x, double y);

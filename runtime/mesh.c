@@ -207,3 +207,22 @@ rt_code mesh_orient_outward(mesh *m, int *closed, rt_error *e)
         }
     return RT_OK;
 }
+
+void mesh_append(mesh *dst, const mesh *src, const float colour[4])
+{
+    uint32_t base = (uint32_t)dst->nv;
+    static const float up[3] = {0, 1, 0};
+    for (size_t i = 0; i < src->nv; i++)
+        mesh_add_vertex(dst, src->pos + 3 * i, src->nrm ? src->nrm + 3 * i : up, src->col ? src->col + 4 * i : colour);
+    for (size_t t = 0; t < src->nt; t++)
+        mesh_add_tri(dst, base + src->tri[3 * t], base + src->tri[3 * t + 1], base + src->tri[3 * t + 2]);
+}
+
+void mesh_grow_box(const mesh *m, double lo[3], double hi[3])
+{
+    for (size_t i = 0; i < m->nv; i++)
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fmin(lo[d], m->pos[3 * i + d]);
+            hi[d] = fmax(hi[d], m->pos[3 * i + d]);
+        }
+}

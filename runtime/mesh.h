@@ -30,6 +30,14 @@ void mesh_free(mesh *m);
  * memory (m->failed is set). */
 uint32_t mesh_add_vertex(mesh *m, const float p[3], const float n[3], const float c[4]);
 void mesh_add_tri(mesh *m, uint32_t a, uint32_t b, uint32_t c);
+/* Append src's vertices and triangles to dst (its triangles re-indexed past
+ * dst's vertices). Where src has no normals a vertex gets (0, 1, 0), where it
+ * has no colours `colour`; attributes dst lacks are dropped. The caller keeps
+ * dst->nv + src->nv below 2^32 - 1; an allocation failure sets dst->failed. */
+void mesh_append(mesh *dst, const mesh *src, const float colour[4]);
+/* Grow the box lo..hi to hold every vertex (start from lo = +inf, hi = -inf
+ * for the bounding box; NaN coordinates are passed over, as fmin does). */
+void mesh_grow_box(const mesh *m, double lo[3], double hi[3]);
 
 /* Topology statistics: edges shared by 1 triangle (boundary), by > 2
  * (non-manifold), Euler characteristic V - E + F (counting only vertices

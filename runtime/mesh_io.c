@@ -2,6 +2,8 @@
 #include "mesh_io.h"
 #include "rt_alloc.h"
 #include "provenance.h"
+#include "sample.h"
+#include "textline.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -168,28 +170,19 @@ static rt_code reader_oom(mesh *m, rt_error *e)
     return m->failed ? rt_fail(e, RT_ENOMEM, "out of memory reading a mesh") : RT_OK;
 }
 
-/* PLY scalar types */
-enum { P_NONE, P_I8, P_U8, P_I16, P_U16, P_I32, P_U32, P_F32, P_F64 };
-
 static int ply_type(const char *s)
 {
     static const struct {
         const char *n;
         int t;
-    } tt[] = {{"char", P_I8},    {"int8", P_I8},     {"uchar", P_U8},    {"uint8", P_U8},
-              {"short", P_I16},  {"int16", P_I16},   {"ushort", P_U16},  {"uint16", P_U16},
-              {"int", P_I32},    {"int32", P_I32},   {"uint", P_U32},    {"uint32", P_U32},
-              {"float", P_F32},  {"float32", P_F32}, {"double", P_F64},  {"float64", P_F64}};
+    } tt[] = {{"char", SAMPLE_I8},    {"int8", SAMPLE_I8},     {"uchar", SAMPLE_U8},    {"uint8", SAMPLE_U8},
+              {"short", SAMPLE_I16},  {"int16", SAMPLE_I16},   {"ushort", SAMPLE_U16},  {"uint16", SAMPLE_U16},
+              {"int", SAMPLE_I32},    {"int32", SAMPLE_I32},   {"uint", SAMPLE_U32},    {"uint32", SAMPLE_U32},
+              {"float", SAMPLE_F32},  {"float32", SAMPLE_F32}, {"double", SAMPLE_F64},  {"float64", SAMPLE_F64}};
     for (size_t i = 0; i < sizeof tt / sizeof tt[0]; i++)
         if (strcmp(s, tt[i].n) == 0)
             return tt[i].t;
-    return P_NONE;
-}
-
-static size_t ply_size(int t)
-{
-    static const size_t sz[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
-    return sz[t];
+    return SAMPLE_NONE;
 }
 
 #define PLY_MAXPROP 32
@@ -197,7 +190,7 @@ static size_t ply_size(int t)
 
 typedef struct ply_prop {
     char name[64];
-    int type, count_type; /* count_type != P_NONE: a list */
+    int type, count_type; /* count_type != SAMPLE_NONE: a list */
 } ply_prop;
 
 typedef struct ply_elem {
@@ -233,41 +226,14 @@ static double ply_read(ply_in *in, int t)
             in->bad = 1;
         return v;
     }
-    size_t sz = ply_size(t);
+    size_t sz = sample_size((sample_type)t);
     if (in->n - in->pos < sz) {
         in->bad = 1;
         return 0;
     }
-    uint64_t u = 0;
-    const unsigned char *p = in->d + in->pos;
-    for (size_t i = 0; i < sz; i++)
-        u |= (uint64_t)p[in->fmt == 2 ? i : sz - 1 - i] << (8 * (sz - 1 - i));
+    double v = sample_get(in->d + in->pos, (sample_type)t, in->fmt == 2);
     in->pos += sz;
-    switch (t) {
-    case P_I8:
-        return (int8_t)(uint8_t)u;
-    case P_U8:
-        return (double)u;
-    case P_I16:
-        return (int16_t)(uint16_t)u;
-    case P_U16:
-        return (double)u;
-    case P_I32:
-        return (int32_t)(uint32_t)u;
-    case P_U32:
-        return (double)u;
-    case P_F32: {
-        uint32_t w = (uint32_t)u;
-        float f;
-        memcpy(&f, &w, 4);
-        return f;
-    }
-    default: {
-        double dd;
-        memcpy(&dd, &u, 8);
-        return dd;
-    }
-    }
+    return v;
 }
 
 static int add_poly(mesh *m, const double *idx, size_t k, size_t nv)
@@ -290,19 +256,8 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     size_t pos = 0;
     char line[512];
     for (;;) {
-        if (pos >= n)
+        if (textline_next(d, n, &pos, line, sizeof line) < 0)
             return rt_fail(e, RT_EFORMAT, "PLY header has no end_header");
-        size_t end = pos;
-        while (end < n && d[end] != '\n')
-            end++;
-        size_t len = end - pos;
-        if (len && d[pos + len - 1] == '\r')
-            len--;
-        if (len >= sizeof line)
-            len = sizeof line - 1;
-        memcpy(line, d + pos, len);
-        line[len] = 0;
-        pos = end < n ? end + 1 : end;
         lineno++;
         char a[64], b[64], c[64], dd[64];
         int nw = sscanf(line, "%63s %63s %63s %63s", a, b, c, dd);
@@ -344,7 +299,7 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                     return rt_fail(e, RT_EFORMAT, "PLY header line %d: unknown type in '%s'", lineno, line);
             } else {
                 P->type = ply_type(b);
-                P->count_type = P_NONE;
+                P->count_type = SAMPLE_NONE;
                 snprintf(P->name, sizeof P->name, "%s", c);
                 if (!P->type)
                     return rt_fail(e, RT_EFORMAT, "PLY header line %d: unknown type '%s'", lineno, b);
@@ -413,7 +368,7 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                         else if (q < 6)
                             nn[q - 3] = (float)v;
                         else
-                            cc[q - 6] = (float)(P->type == P_F32 || P->type == P_F64 ? v : v / 255.0);
+                            cc[q - 6] = (float)(P->type == SAMPLE_F32 || P->type == SAMPLE_F64 ? v : v / 255.0);
                     }
             }
             if (is_v && !in.bad)
@@ -457,15 +412,7 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
             nv = 0;
         }
         while (pos < n) {
-            size_t end = pos;
-            while (end < n && d[end] != '\n')
-                end++;
-            size_t len = end - pos;
-            if (len >= sizeof line)
-                len = sizeof line - 1;
-            memcpy(line, d + pos, len);
-            line[len] = 0;
-            pos = end < n ? end + 1 : end;
+            textline_next(d, n, &pos, line, sizeof line);
             lineno++;
             char *s = line;
             while (*s == ' ' || *s == '\t')
@@ -579,11 +526,11 @@ typedef struct weld_slot {
 rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
 {
     mesh_init(m, 0, 0);
-    if (n >= 5 && memcmp(d, "solid", 5) == 0 && (n < 84 || 84 + 50 * (size_t)(d[80] | d[81] << 8 | d[82] << 16 | (uint32_t)d[83] << 24) != n))
+    if (n >= 5 && memcmp(d, "solid", 5) == 0 && (n < 84 || 84 + 50 * (size_t)sample_uint(d + 80, 4, 0) != n))
         return rt_fail(e, RT_EFORMAT, "ASCII STL is not read (only binary STL)");
     if (n < 84)
         return rt_fail(e, RT_EFORMAT, "STL file is %zu bytes, shorter than its 84-byte header", n);
-    uint32_t nt = (uint32_t)d[80] | (uint32_t)d[81] << 8 | (uint32_t)d[82] << 16 | (uint32_t)d[83] << 24;
+    uint32_t nt = (uint32_t)sample_uint(d + 80, 4, 0);
     if ((n - 84) / 50 < nt)
         return rt_fail(e, RT_EFORMAT, "STL file holds %zu triangles, its header says %u", (n - 84) / 50, (unsigned)nt);
     size_t cap = 16;
@@ -607,7 +554,7 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
             float p[3];
             for (int a = 0; a < 3; a++) {
                 const unsigned char *b = f + 12 * k + 4 * a;
-                key[a] = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+                key[a] = (uint32_t)sample_uint(b, 4, 0);
                 memcpy(&p[a], &key[a], 4);
             }
             uint64_t h = ((uint64_t)key[0] * 0x9e3779b97f4a7c15ull) ^ ((uint64_t)key[1] * 0xc2b2ae3d27d4eb4full) ^

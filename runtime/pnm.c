@@ -10,6 +10,7 @@
 
 #include "png.h"
 #include "provenance.h"
+#include "sample.h"
 
 typedef struct hdr {
     const unsigned char *d;
@@ -74,16 +75,39 @@ static rt_code end_header(hdr *h, rt_error *e)
     return RT_OK;
 }
 
-static rt_code check_size(const char *what, int w, int h, int channels, size_t bps, size_t have,
-                          size_t *need, rt_error *e)
+/* The start every netpbm-style header shares: 'P', a kind byte (kinds[0]
+ * gives 1 channel, kinds[1] 3), the width and the height; im is empty until
+ * start_data. */
+static rt_code read_head(image *im, const unsigned char *d, size_t n, const char kinds[2], const char *what1,
+                         const char *what3, const char *not_msg, hdr *h, int *ch, unsigned long *w,
+                         unsigned long *ht, rt_error *e)
 {
-    size_t k = rt_mul_size(rt_mul_size(rt_mul_size((size_t)w, (size_t)h), (size_t)channels), bps);
+    im->w = im->h = 0;
+    im->px = NULL;
+    if (n < 2 || d[0] != 'P' || (d[1] != kinds[0] && d[1] != kinds[1]))
+        return rt_fail(e, RT_EFORMAT, "%s", not_msg);
+    *ch = d[1] == kinds[0] ? 1 : 3;
+    *h = (hdr){d, n, 2, *ch == 1 ? what1 : what3};
+    rt_code c = read_num(h, "width", INT_MAX, w, e);
+    return c ? c : read_num(h, "height", INT_MAX, ht, e);
+}
+
+/* The end every header shares: the one whitespace byte, then room for the
+ * samples (bps bytes each) and the image. */
+static rt_code start_data(hdr *h, unsigned long w, unsigned long ht, int channels, size_t bps, image *im,
+                          rt_error *e)
+{
+    rt_code c = end_header(h, e);
+    if (c)
+        return c;
+    size_t k = rt_mul_size(rt_mul_size(rt_mul_size((size_t)w, (size_t)ht), (size_t)channels), bps);
     if (k == 0)
-        return rt_fail(e, RT_EFORMAT, "%s size %d×%d is too large", what, w, h);
-    if (have < k)
-        return rt_fail(e, RT_EFORMAT, "%s data are truncated (%zu of %zu bytes)", what, have, k);
-    *need = k;
-    return RT_OK;
+        return rt_fail(e, RT_EFORMAT, "%s size %d×%d is too large", h->what, (int)w, (int)ht);
+    if (h->n - h->pos < k)
+        return rt_fail(e, RT_EFORMAT, "%s data are truncated (%zu of %zu bytes)", h->what, h->n - h->pos, k);
+    if ((c = rt_check_pixels((double)w, (double)ht, e)))
+        return c;
+    return image_init(im, (int)w, (int)ht, e);
 }
 
 /* ---------------------------------------------------------------- P5/P6 */
@@ -127,21 +151,16 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
 
 rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, rt_error *e)
 {
-    im->w = im->h = 0;
-    im->px = NULL;
-    if (n < 2 || d[0] != 'P' || (d[1] != '5' && d[1] != '6'))
-        return rt_fail(e, RT_EFORMAT, "not a binary PGM/PPM file (expected 'P5' or 'P6')");
-    int ch = d[1] == '5' ? 1 : 3;
-    hdr h = {d, n, 2, ch == 1 ? "PGM" : "PPM"};
+    int ch;
+    hdr h;
     unsigned long w, ht, maxval;
     rt_code c;
-    if ((c = read_num(&h, "width", INT_MAX, &w, e)) || (c = read_num(&h, "height", INT_MAX, &ht, e)) ||
-        (c = read_num(&h, "maxval", 65535, &maxval, e)) || (c = end_header(&h, e)))
+    const char *not_msg = "not a binary PGM/PPM file (expected 'P5' or 'P6')";
+    if ((c = read_head(im, d, n, "56", "PGM", "PPM", not_msg, &h, &ch, &w, &ht, e)) ||
+        (c = read_num(&h, "maxval", 65535, &maxval, e)))
         return c;
-    size_t bps = maxval < 256 ? 1 : 2, need;
-    if ((c = check_size(h.what, (int)w, (int)ht, ch, bps, n - h.pos, &need, e)))
-        return c;
-    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
+    size_t bps = maxval < 256 ? 1 : 2;
+    if ((c = start_data(&h, w, ht, ch, bps, im, e)))
         return c;
     const unsigned char *s = d + h.pos;
     size_t np = (size_t)w * (size_t)ht;
@@ -164,13 +183,8 @@ rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
             o[1] = o[2] = o[0];
         o[3] = 1.0f;
     }
-    if (info) {
-        info->w = (int)w;
-        info->h = (int)ht;
-        info->channels = ch;
-        info->maxval = (unsigned)maxval;
-        info->little_endian = 0;
-    }
+    if (info)
+        *info = (pnm_info){(int)w, (int)ht, ch, (unsigned)maxval, 0};
     return RT_OK;
 }
 
@@ -197,15 +211,11 @@ rt_code pfm_encode(const image *im, int channels, bytebuf *out, rt_error *e)
 
 rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, rt_error *e)
 {
-    im->w = im->h = 0;
-    im->px = NULL;
-    if (n < 2 || d[0] != 'P' || (d[1] != 'F' && d[1] != 'f'))
-        return rt_fail(e, RT_EFORMAT, "not a PFM file (expected 'PF' or 'Pf')");
-    int ch = d[1] == 'F' ? 3 : 1;
-    hdr h = {d, n, 2, "PFM"};
+    int ch;
+    hdr h;
     unsigned long w, ht;
     rt_code c;
-    if ((c = read_num(&h, "width", INT_MAX, &w, e)) || (c = read_num(&h, "height", INT_MAX, &ht, e)))
+    if ((c = read_head(im, d, n, "fF", "PFM", "PFM", "not a PFM file (expected 'PF' or 'Pf')", &h, &ch, &w, &ht, e)))
         return c;
     if (!skip_ws(&h) || h.pos >= h.n)
         return rt_fail(e, RT_EFORMAT, "PFM header is truncated (no scale)");
@@ -221,12 +231,7 @@ rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     double scale = strtod(tok, &end);
     if (end == tok || *end || !(scale != 0) || !isfinite(scale))
         return rt_fail(e, RT_EFORMAT, "PFM scale '%s' is not a non-zero number", tok);
-    if ((c = end_header(&h, e)))
-        return c;
-    size_t need;
-    if ((c = check_size("PFM", (int)w, (int)ht, ch, 4, n - h.pos, &need, e)))
-        return c;
-    if ((c = rt_check_pixels((double)w, (double)ht, e)) || (c = image_init(im, (int)w, (int)ht, e)))
+    if ((c = start_data(&h, w, ht, ch, 4, im, e)))
         return c;
     int le = scale < 0;
     const unsigned char *s = d + h.pos;
@@ -234,22 +239,13 @@ rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
         for (int x = 0; x < (int)w; x++) {
             float *o = image_at(im, x, y);
             for (int j = 0; j < ch; j++, s += 4) {
-                uint32_t u = le ? (uint32_t)s[0] | (uint32_t)s[1] << 8 | (uint32_t)s[2] << 16 |
-                                      (uint32_t)s[3] << 24
-                                : (uint32_t)s[3] | (uint32_t)s[2] << 8 | (uint32_t)s[1] << 16 |
-                                      (uint32_t)s[0] << 24;
-                memcpy(&o[j], &u, 4);
+                sample_f32(s, !le, &o[j]);
             }
             if (ch == 1)
                 o[1] = o[2] = o[0];
             o[3] = 1.0f;
         }
-    if (info) {
-        info->w = (int)w;
-        info->h = (int)ht;
-        info->channels = ch;
-        info->maxval = 0;
-        info->little_endian = le;
-    }
+    if (info)
+        *info = (pnm_info){(int)w, (int)ht, ch, 0, le};
     return RT_OK;
 }

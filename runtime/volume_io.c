@@ -7,6 +7,8 @@
 #include "volume_io.h"
 #include "rt_alloc.h"
 #include "provenance.h"
+#include "sample.h"
+#include "textline.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -193,75 +195,42 @@ rt_code vio_save_vtk(const char *path, const volume *v, rt_error *e)
 
 /* ---- reading ---- */
 
-enum { T_NONE, T_U8, T_I16, T_U16, T_I32, T_F32, T_F64 };
-
 static int parse_type(const char *s)
 {
     static const struct {
         const char *name;
         int t;
     } names[] = {
-        {"uchar", T_U8},          {"unsigned char", T_U8},      {"uint8", T_U8},
-        {"uint8_t", T_U8},        {"short", T_I16},             {"short int", T_I16},
-        {"signed short", T_I16},  {"signed short int", T_I16},  {"int16", T_I16},
-        {"int16_t", T_I16},       {"ushort", T_U16},            {"unsigned short", T_U16},
-        {"unsigned short int", T_U16}, {"uint16", T_U16},       {"uint16_t", T_U16},
-        {"int", T_I32},           {"signed int", T_I32},        {"int32", T_I32},
-        {"int32_t", T_I32},       {"float", T_F32},             {"double", T_F64},
+        {"uchar", SAMPLE_U8},          {"unsigned char", SAMPLE_U8},      {"uint8", SAMPLE_U8},
+        {"uint8_t", SAMPLE_U8},        {"short", SAMPLE_I16},             {"short int", SAMPLE_I16},
+        {"signed short", SAMPLE_I16},  {"signed short int", SAMPLE_I16},  {"int16", SAMPLE_I16},
+        {"int16_t", SAMPLE_I16},       {"ushort", SAMPLE_U16},            {"unsigned short", SAMPLE_U16},
+        {"unsigned short int", SAMPLE_U16}, {"uint16", SAMPLE_U16},       {"uint16_t", SAMPLE_U16},
+        {"int", SAMPLE_I32},           {"signed int", SAMPLE_I32},        {"int32", SAMPLE_I32},
+        {"int32_t", SAMPLE_I32},       {"float", SAMPLE_F32},             {"double", SAMPLE_F64},
     };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(s, names[i].name) == 0)
             return names[i].t;
-    return T_NONE;
+    return SAMPLE_NONE;
 }
 
-static size_t tsize(int t)
-{
-    switch (t) {
-    case T_U8:
-        return 1;
-    case T_I16:
-    case T_U16:
-        return 2;
-    case T_I32:
-    case T_F32:
-        return 4;
-    default:
-        return 8;
-    }
-}
-
-static uint64_t get_uint(const unsigned char *p, size_t n, int big)
-{
-    uint64_t v = 0;
-    for (size_t i = 0; i < n; i++)
-        v |= (uint64_t)p[big ? i : n - 1 - i] << (8 * (n - 1 - i));
-    return v;
-}
-
+/* A sample as a voxel value: 8- and 16-bit unsigned samples scaled to
+ * [0, 1], the others as they are. */
 static float decode(const unsigned char *p, int t, int big)
 {
-    uint64_t u = get_uint(p, tsize(t), big);
     switch (t) {
-    case T_U8:
-        return (float)(u / 255.0);
-    case T_U16:
-        return (float)(u / 65535.0);
-    case T_I16:
-        return (float)(int16_t)(uint16_t)u;
-    case T_I32:
-        return (float)(int32_t)(uint32_t)u;
-    case T_F32: {
-        uint32_t w = (uint32_t)u;
+    case SAMPLE_U8:
+        return (float)(sample_get(p, SAMPLE_U8, big) / 255.0);
+    case SAMPLE_U16:
+        return (float)(sample_get(p, SAMPLE_U16, big) / 65535.0);
+    case SAMPLE_F32: {
         float f;
-        memcpy(&f, &w, 4);
+        sample_f32(p, big, &f);
         return f;
     }
-    default: {
-        double d;
-        memcpy(&d, &u, 8);
-        return (float)d;
-    }
+    default:
+        return (float)sample_get(p, (sample_type)t, big);
     }
 }
 
@@ -309,7 +278,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     v->v = NULL;
     if (n < 8 || memcmp(d, "NRRD000", 7) != 0 || d[7] < '1' || d[7] > '5')
         return rt_fail(e, RT_EFORMAT, "not a NRRD file (no NRRD0001..NRRD0005 magic)");
-    int type = T_NONE, dim = 0, endian = -1, have_sizes = 0, have_dirs = 0, have_sp = 0;
+    int type = SAMPLE_NONE, dim = 0, endian = -1, have_sizes = 0, have_dirs = 0, have_sp = 0;
     int have_org = 0, have_lo = 0, have_hi = 0, have_enc = 0;
     long sizes[3] = {0, 0, 0};
     double sp[3] = {1, 1, 1}, org[3] = {0, 0, 0}, flo[3], fhi[3];
@@ -319,18 +288,10 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     int lineno = 0, ended = 0;
     char line[2048];
     while (pos < n) {
-        size_t end = pos;
-        while (end < n && d[end] != '\n')
-            end++;
-        size_t len = end - pos;
-        if (len && d[pos + len - 1] == '\r')
-            len--;
+        long len = textline_next(d, n, &pos, line, sizeof line);
         lineno++;
-        if (len >= sizeof line)
+        if (len >= (long)sizeof line)
             return rt_fail(e, RT_EFORMAT, "NRRD header line %d is too long", lineno);
-        memcpy(line, d + pos, len);
-        line[len] = 0;
-        pos = end < n ? end + 1 : end;
         if (lineno == 1)
             continue;
         if (len == 0) {
@@ -365,7 +326,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
             val++;
         if (strcmp(key, "type") == 0) {
             type = parse_type(val);
-            if (type == T_NONE)
+            if (type == SAMPLE_NONE)
                 return rt_fail(e, RT_EFORMAT,
                                "NRRD header line %d: type '%.40s' is not one of uchar, short, ushort, int, float, double",
                                lineno, val);
@@ -438,7 +399,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         /* other fields (space, kinds, centers, content, ...) do not change
          * the samples */
     }
-    if (type == T_NONE)
+    if (type == SAMPLE_NONE)
         return rt_fail(e, RT_EFORMAT, "NRRD header has no 'type' field");
     if (!dim)
         return rt_fail(e, RT_EFORMAT, "NRRD header has no 'dimension' field");
@@ -446,12 +407,12 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         return rt_fail(e, RT_EFORMAT, "NRRD header has no 'sizes' field");
     if (!have_enc)
         return rt_fail(e, RT_EFORMAT, "NRRD header has no 'encoding' field");
-    if (tsize(type) > 1 && endian < 0)
-        return rt_fail(e, RT_EFORMAT, "NRRD header has no 'endian' field for %zu-byte samples", tsize(type));
+    if (sample_size((sample_type)type) > 1 && endian < 0)
+        return rt_fail(e, RT_EFORMAT, "NRRD header has no 'endian' field for %zu-byte samples", sample_size((sample_type)type));
     if (have_dirs && have_sp)
         return rt_fail(e, RT_EFORMAT, "NRRD header has both 'space directions' and 'spacings'");
     size_t count = rt_mul_size(rt_mul_size((size_t)sizes[0], (size_t)sizes[1]), (size_t)sizes[2]);
-    size_t need = rt_mul_size(count, tsize(type));
+    size_t need = rt_mul_size(count, sample_size((sample_type)type));
     if (!need)
         return rt_fail(e, RT_EFORMAT, "NRRD sizes are too large");
     rt_code lc = rt_check_voxels((double)sizes[0], (double)sizes[1], (double)sizes[2], e);
@@ -498,7 +459,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
     if (at > dn || dn - at < need) {
         rt_free(file);
         return rt_fail(e, RT_EFORMAT, "NRRD data is %zu bytes, expected %zu (%ld×%ld×%ld samples of %zu byte(s))",
-                       at > dn ? 0 : dn - at, need, sizes[0], sizes[1], sizes[2], tsize(type));
+                       at > dn ? 0 : dn - at, need, sizes[0], sizes[1], sizes[2], sample_size((sample_type)type));
     }
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
@@ -523,7 +484,7 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
         rt_free(file);
         return rc;
     }
-    size_t ts = tsize(type);
+    size_t ts = sample_size((sample_type)type);
     for (size_t i = 0; i < count; i++)
         v->v[i] = decode(data + at + i * ts, type, endian == 1);
     rt_free(file);
@@ -552,43 +513,24 @@ rt_code vio_load_nrrd(const char *path, volume *v, rt_error *e)
     return rc;
 }
 
-/* Next line of a VTK header into buf; returns -1 at the end of data. */
-static int next_line(const unsigned char *d, size_t n, size_t *pos, char *buf, size_t bn)
-{
-    if (*pos >= n)
-        return -1;
-    size_t end = *pos;
-    while (end < n && d[end] != '\n')
-        end++;
-    size_t len = end - *pos;
-    if (len && d[*pos + len - 1] == '\r')
-        len--;
-    if (len >= bn)
-        len = bn - 1;
-    memcpy(buf, d + *pos, len);
-    buf[len] = 0;
-    *pos = end < n ? end + 1 : end;
-    return 0;
-}
-
 rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *e)
 {
     v->v = NULL;
     size_t pos = 0;
     char line[512];
-    if (next_line(d, n, &pos, line, sizeof line) || strncmp(line, "# vtk DataFile Version", 22) != 0)
+    if (textline_next(d, n, &pos, line, sizeof line) < 0 || strncmp(line, "# vtk DataFile Version", 22) != 0)
         return rt_fail(e, RT_EFORMAT, "not a legacy VTK file (no '# vtk DataFile Version' line)");
-    if (next_line(d, n, &pos, line, sizeof line))
+    if (textline_next(d, n, &pos, line, sizeof line) < 0)
         return rt_fail(e, RT_EFORMAT, "VTK file ends after its first line");
-    if (next_line(d, n, &pos, line, sizeof line) || strcmp(line, "BINARY") != 0)
+    if (textline_next(d, n, &pos, line, sizeof line) < 0 || strcmp(line, "BINARY") != 0)
         return rt_fail(e, RT_EFORMAT, "VTK line 3: '%.40s', only BINARY is read", line);
-    if (next_line(d, n, &pos, line, sizeof line) || strcmp(line, "DATASET STRUCTURED_POINTS") != 0)
+    if (textline_next(d, n, &pos, line, sizeof line) < 0 || strcmp(line, "DATASET STRUCTURED_POINTS") != 0)
         return rt_fail(e, RT_EFORMAT, "VTK line 4: '%.40s', only DATASET STRUCTURED_POINTS is read", line);
     double dims[3] = {0, 0, 0}, org[3] = {0, 0, 0}, sp[3] = {1, 1, 1};
     int have_dims = 0, lineno = 4;
     for (;;) {
         lineno++;
-        if (next_line(d, n, &pos, line, sizeof line))
+        if (textline_next(d, n, &pos, line, sizeof line) < 0)
             return rt_fail(e, RT_EFORMAT, "VTK file ends in its header");
         if (!line[0])
             continue;
@@ -642,7 +584,7 @@ rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *
     if (rc)
         return rc;
     for (size_t i = 0; i < count; i++)
-        v->v[i] = decode(d + pos + 4 * i, T_F32, 1);
+        v->v[i] = decode(d + pos + 4 * i, SAMPLE_F32, 1);
     return RT_OK;
 }
 

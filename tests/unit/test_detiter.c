@@ -31,6 +31,106 @@ static void hand(const affine *m, double *x, double *y)
 }
 
 /* Drawing: coverage facts computed by hand. */
+/* Per-vertex colours (draw_polyline_rgba) by hand: a 4×2 image whose pixels
+ * are world units (py = 2 - y); the line y = 1.5 runs through row 0's
+ * centres from x = 0.5 (red) to 2.5 (blue) to 3.5 (green), width 2 (reach
+ * r = 1.5). Segment 0 has (½, 0, ½, 1), segment 1 (0, ½, ½, 1). Row 0
+ * (distance 0): coverage 1, pixel 3 lies 1 from segment 0 (½) and on
+ * segment 1 (1), so it is segment 1's; pixel 2 is on both and stays with
+ * the first. Row 1 (distance 1): coverage ½, pixel 3 goes to segment 1
+ * (1 vs √2 away). On a transparent black image a pixel becomes colour·k
+ * with alpha k. */
+static void test_rgba_line(void)
+{
+    rt_error e;
+    image im;
+    draw_view v;
+    CHECK(image_init(&im, 4, 2, &e) == RT_OK, "image");
+    CHECK(draw_view_fit(&v, 4, 2, (double[]){0, 0}, (double[]){4, 2}, 0, &e) == RT_OK, "view");
+    draw_clear(&im, (float[]){0, 0, 0, 0});
+    const double xy[6] = {0.5, 1.5, 2.5, 1.5, 3.5, 1.5};
+    const float rgba[12] = {1, 0, 0, 1, 0, 0, 1, 1, 0, 1, 0, 1};
+    CHECK(draw_polyline_rgba(&im, &v, 3, xy, rgba, 0, 2, &e) == RT_OK, "draw: %s", e.msg);
+    static const float want[8][4] = {
+        {0.5f, 0, 0.5f, 1}, {0.5f, 0, 0.5f, 1}, {0.5f, 0, 0.5f, 1}, {0, 0.5f, 0.5f, 1},
+        {0.25f, 0, 0.25f, 0.5f}, {0.25f, 0, 0.25f, 0.5f}, {0.25f, 0, 0.25f, 0.5f}, {0, 0.25f, 0.25f, 0.5f},
+    };
+    int same = 1;
+    for (int i = 0; i < 8; i++)
+        for (int c = 0; c < 4; c++)
+            if (im.px[4 * i + c] != want[i][c]) {
+                same = 0;
+                fprintf(stderr, "pixel %d channel %d: %g, want %g\n", i, c, im.px[4 * i + c], want[i][c]);
+            }
+    CHECK(same, "per-vertex colour strokes");
+    /* Over opaque white with alpha ½ at every vertex: k = ½ in row 0, so
+     * pixel 0 is white·½ + (½, 0, ½)·½ = (¾, ½, ¾), alpha stays 1. */
+    draw_clear(&im, (float[]){1, 1, 1, 1});
+    float half[12];
+    for (int i = 0; i < 12; i++)
+        half[i] = i % 4 == 3 ? 0.5f : rgba[i];
+    CHECK(draw_polyline_rgba(&im, &v, 3, xy, half, 0, 2, &e) == RT_OK, "draw ½");
+    CHECK(im.px[0] == 0.75f && im.px[1] == 0.5f && im.px[2] == 0.75f && im.px[3] == 1, "alpha ½: %g %g %g %g",
+          im.px[0], im.px[1], im.px[2], im.px[3]);
+    draw_view small;
+    CHECK(draw_view_fit(&small, 2, 2, (double[]){0, 0}, (double[]){4, 2}, 0, &e) == RT_OK, "small view");
+    CHECK(draw_polyline_rgba(&im, &small, 3, xy, rgba, 0, 2, &e) == RT_EINVAL &&
+              strcmp(e.msg, "view is 2×2 but the image is 4×2") == 0,
+          "view and image differ: %s", e.msg);
+    image_free(&im);
+}
+
+/* Shape arithmetic by hand: A = the polyline (0,0)-(1,0)-(1,2), B = the
+ * triangle (3,1),(4,1),(3,3) (closed). */
+static void test_arith(void)
+{
+    rt_error e;
+    detiter_shape a, b, j, m;
+    CHECK(detiter_shape_make(&a, 2, 3, (double[]){0, 0, 1, 0, 1, 2}, DETITER_POLYLINE, &e) == RT_OK, "A");
+    CHECK(detiter_shape_make(&b, 2, 3, (double[]){3, 1, 4, 1, 3, 3}, DETITER_POLYGON, &e) == RT_OK, "B");
+    double lo[2], hi[2];
+    detiter_bounds(&b, lo, hi);
+    CHECK(lo[0] == 3 && hi[0] == 4 && lo[1] == 1 && hi[1] == 3, "bounds of B");
+    /* A ∪ B: 6 vertices, polylines starting at 0 and 3, only the second closed. */
+    CHECK(detiter_shape_join(&a, &b, &j, &e) == RT_OK, "join: %s", e.msg);
+    CHECK(j.nverts == 6 && j.npoly == 2 && j.start[0] == 0 && j.start[1] == 3 && j.start[2] == 6 && !j.closed[0] &&
+              j.closed[1] && j.v[6] == 3 && j.v[11] == 3,
+          "join layout");
+    CHECK_NEAR(detiter_length(&j), 3 + (1 + 2 + sqrt(5)), 1e-12, "join length = |A| + |B|");
+    detiter_bounds(&j, lo, hi);
+    CHECK(lo[0] == 0 && hi[0] == 4 && lo[1] == 0 && hi[1] == 3, "bounds of A ∪ B");
+    /* A + (2, -1) = (2,-1)-(3,-1)-(3,1); A · 1.5 = (0,0)-(1.5,0)-(1.5,3). */
+    CHECK(detiter_shape_shift(&a, (double[]){2, -1}, &m, &e) == RT_OK, "shift");
+    CHECK(memcmp(m.v, (double[]){2, -1, 3, -1, 3, 1}, 6 * sizeof(double)) == 0 && m.npoly == 1 && !m.closed[0],
+          "shift values");
+    detiter_shape_free(&m);
+    CHECK(detiter_shape_scale(&a, 1.5, &m, &e) == RT_OK, "scale");
+    CHECK(memcmp(m.v, (double[]){0, 0, 1.5, 0, 1.5, 3}, 6 * sizeof(double)) == 0, "scale values");
+    detiter_shape_free(&m);
+    /* The rotation by 90° (x, y) -> (-y, x) plus (1, 0): B -> (0,3),(0,4),(-2,3). */
+    affine r = affine_from_2d(0, -1, 1, 0, 1, 0);
+    CHECK(detiter_shape_map(&b, &r, &m, &e) == RT_OK && m.closed[0], "map");
+    CHECK(memcmp(m.v, (double[]){0, 3, 0, 4, -2, 3}, 6 * sizeof(double)) == 0, "map values");
+    detiter_shape_free(&m);
+    /* A 2-D map keeps a 3-D shape's z; a 3-D map does not apply to a 2-D shape. */
+    detiter_shape c3;
+    CHECK(detiter_shape_make(&c3, 3, 2, (double[]){1, 2, 7, 0, 1, -5}, DETITER_POINTS, &e) == RT_OK, "3-D points");
+    CHECK(detiter_shape_map(&c3, &r, &m, &e) == RT_OK, "2-D map on 3-D");
+    CHECK(memcmp(m.v, (double[]){-1, 1, 7, 0, 0, -5}, 6 * sizeof(double)) == 0, "z kept");
+    detiter_shape_free(&m);
+    affine r3 = affine_identity(3);
+    CHECK(detiter_shape_map(&a, &r3, &m, &e) == RT_EINVAL &&
+              strcmp(e.msg, "a 3-D map cannot apply to a 2-D shape") == 0,
+          "3-D map on 2-D: %s", e.msg);
+    CHECK(detiter_shape_join(&a, &c3, &m, &e) == RT_EINVAL &&
+              strcmp(e.msg, "a 2-D and a 3-D shape cannot be joined") == 0,
+          "join 2-D and 3-D: %s", e.msg);
+    detiter_shape_free(&c3);
+    detiter_shape_free(&j);
+    detiter_shape_free(&a);
+    detiter_shape_free(&b);
+}
+
 static void test_draw(void)
 {
     rt_error e;
@@ -220,5 +320,7 @@ int main(void)
     detiter_shape_free(&p5);
     detiter_shape_free(&k0);
     test_draw();
+    test_arith();
+    test_rgba_line();
     return check_done("test_detiter");
 }

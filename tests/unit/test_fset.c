@@ -146,6 +146,49 @@ int main(void)
     CHECK_NEAR(h.count[0] / 50000.0, 0.25, 5 * sqrt(0.1875 / 50000), "walk map frequency");
     hist2_free(&h);
 
+    /* ---- window fitting (fset_fit_aspect, fset_chaos_fit) ----
+     * [0, 2]×[0, 1], margin 1/4: extents 3 × 1.5 about the centre (1, 1/2);
+     * for 4:1 the x side becomes 1.5·4 = 6: [-2, 4]×[-1/4, 5/4]. */
+    double wlo[2] = {0, 0}, whi[2] = {2, 1};
+    fset_fit_aspect(wlo, whi, 4, 1, 0.25);
+    CHECK(wlo[0] == -2 && whi[0] == 4 && wlo[1] == -0.25 && whi[1] == 1.25, "aspect 4:1: [%g, %g]×[%g, %g]",
+          wlo[0], whi[0], wlo[1], whi[1]);
+    /* 1:2, no margin: the y side becomes 2/(1/2) = 4 about 1/2: [-3/2, 5/2]. */
+    wlo[0] = wlo[1] = 0, whi[0] = 2, whi[1] = 1;
+    fset_fit_aspect(wlo, whi, 1, 2, 0);
+    CHECK(wlo[0] == 0 && whi[0] == 2 && wlo[1] == -1.5 && whi[1] == 2.5, "aspect 1:2: [%g, %g]×[%g, %g]", wlo[0],
+          whi[0], wlo[1], whi[1]);
+    /* A point at (5, 5): each extent becomes 10 % of 5 = 1/2: [4.75, 5.25]². */
+    wlo[0] = wlo[1] = whi[0] = whi[1] = 5;
+    fset_fit_aspect(wlo, whi, 1, 1, 0);
+    CHECK(wlo[0] == 4.75 && whi[0] == 5.25 && wlo[1] == 4.75 && whi[1] == 5.25, "degenerate: [%g, %g]×[%g, %g]",
+          wlo[0], whi[0], wlo[1], whi[1]);
+    /* The periodic game above plots only (1/3, 0) and (2/3, 0). R = 0.5/(1 - 0.5)
+     * + |start| = 1.9; pass 1 has cells of 3.8/256 and each later window is the
+     * occupied cells plus one cell each side, so the x extent before the margin
+     * is in [1/3, 1/3 + 3·b4] with b4 <= 0.3378/256 (bounds by hand: E2 <= 1/3 +
+     * 3·3.8/256, E3 <= 1/3 + 3·E2/256 ...), centred within 2 cells of 1/2; y is
+     * widened to the same extent (square image), centred within 2 cells of 0. */
+    co.plot_period = 0;
+    co.points = 20000;
+    CHECK(fset_chaos_fit(&f12, &o12, &co, 100, 100, wlo, whi, NULL, &e) == RT_OK, "fit: %s", e.msg);
+    double ex = whi[0] - wlo[0], ey = whi[1] - wlo[1];
+    CHECK(ex >= 1.06 / 3 && ex <= 1.06 * (1.0 / 3 + 3 * 0.3378 / 256), "fit x extent %.9g", ex);
+    CHECK_NEAR(ey, ex, 1e-12, "fit square window");
+    CHECK_NEAR((wlo[0] + whi[0]) / 2, 0.5, 2 * 0.3378 / 256, "fit x centre");
+    CHECK_NEAR((wlo[1] + whi[1]) / 2, 0, 2 * 0.3378 / 256, "fit y centre");
+    CHECK(wlo[0] <= 1.0 / 3 && whi[0] >= 2.0 / 3, "fit holds both points");
+    CHECK(fset_chaos_fit(&f12, &o12, &co, 300, 100, wlo, whi, NULL, &e) == RT_OK, "fit 3:1: %s", e.msg);
+    CHECK_NEAR((whi[0] - wlo[0]) / (whi[1] - wlo[1]), 3, 1e-12, "fit aspect 3:1");
+    /* x + 3e6 is not contractive (R = 1e6) and every plotted point lies
+     * beyond 3e6 · 64 steps of burn-in: no point in the window. */
+    affine far = affine_from_2d(1, 0, 0, 1, 3e6, 0);
+    fset_ifs wf = {1, &far, NULL};
+    fset ff = {1, &wf};
+    CHECK(fset_chaos_fit(&ff, &o0, &co, 100, 100, wlo, whi, NULL, &e) == RT_EINVAL &&
+              strcmp(e.msg, "no point of the chaos game fell near the origin; give window: [xmin, xmax, ymin, ymax]") == 0,
+          "fit with no point: %s", e.msg);
+
     /* ---- Koch with a random order of Koch and its mirror image in the x
      * axis: every map has ratio s = 1/√3 and moves c = (1/2, 0) by
      * d = |ω(c) − c| = √(1/16 + 1/48), so all maps send the disc of centre c

@@ -74,5 +74,44 @@ int main(void)
     CHECK(mesh_compute_stats(&m, &st, &e) == RT_OK, "%s", e.msg);
     CHECK_NEAR(st.volume, 1.0 / 6, 1e-12, "one triangle");
     mesh_free(&m);
+    /* mesh_append: two cubes side by side are one closed mesh of 16
+     * vertices, 24 triangles, Euler characteristic 4 (two spheres) and volume
+     * 2; the second cube's triangles index vertices 8..15. The cubes have no
+     * normals or colours, so the merged mesh (which has both) gets (0, 1, 0)
+     * and the fallback colour, while a coloured source keeps its own. */
+    mesh one, two, all;
+    cube(&one, zero, 0);
+    cube(&two, (double[]){1.5, 0, 0}, 0);
+    mesh_init(&all, 1, 1);
+    const float grey[4] = {0.5f, 0.5f, 0.5f, 1};
+    mesh_append(&all, &one, grey);
+    mesh_append(&all, &two, grey);
+    CHECK(!all.failed && all.nv == 16 && all.nt == 24, "appended: %zu vertices, %zu triangles", all.nv, all.nt);
+    CHECK(all.tri[3 * 12] == 8 + FACES[0][0] && all.tri[3 * 12 + 1] == 8 + FACES[0][1] &&
+              all.tri[3 * 12 + 2] == 8 + FACES[0][2],
+          "second cube re-indexed");
+    CHECK(all.pos[3 * 9] == 2.5f && all.nrm[3 * 9 + 1] == 1 && all.nrm[3 * 9] == 0 && all.col[4 * 9] == 0.5f,
+          "vertex 9 = (2.5, 0, 0), normal up, fallback colour");
+    CHECK(mesh_compute_stats(&all, &st, &e) == RT_OK && st.euler == 4 && st.boundary_edges == 0, "two closed cubes");
+    CHECK_NEAR(st.volume, 2, 1e-9, "two cubes' volume");
+    /* The box of the two cubes is [0, 2.5] × [0, 1] × [0, 1]; a box that
+     * already holds more (down to z = -3) keeps it. */
+    double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    mesh_grow_box(&all, blo, bhi);
+    CHECK(blo[0] == 0 && blo[1] == 0 && blo[2] == 0 && bhi[0] == 2.5 && bhi[1] == 1 && bhi[2] == 1,
+          "box [%g, %g] × [%g, %g] × [%g, %g]", blo[0], bhi[0], blo[1], bhi[1], blo[2], bhi[2]);
+    blo[2] = -3;
+    mesh_grow_box(&one, blo, bhi);
+    CHECK(blo[2] == -3 && bhi[0] == 2.5, "a box only grows");
+    mesh tri;
+    mesh_init(&tri, 0, 1);
+    const float red[4] = {1, 0, 0, 1};
+    mesh_add_vertex(&tri, a, NULL, red);
+    mesh_append(&all, &tri, grey);
+    CHECK(all.nv == 17 && all.col[4 * 16] == 1 && all.col[4 * 16 + 1] == 0, "own colour kept");
+    mesh_free(&tri);
+    mesh_free(&one);
+    mesh_free(&two);
+    mesh_free(&all);
     return check_done("test_mesh");
 }
