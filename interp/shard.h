@@ -42,7 +42,7 @@
 #include "par.h"
 #include "state.h"
 
-#define SHARD_FORMAT 1
+#define SHARD_FORMAT 2
 #define SHARD_MAX_FULL 4096
 #define SHARD_MAX_PARTS 65536
 
@@ -62,7 +62,7 @@ typedef struct shard {
 
     /* one attempt */
     interp *I;
-    uint64_t hash;        /* FNV-1a 64 of the script text */
+    unsigned char hash[32]; /* SHA-256 of the script text */
     uint32_t seq;         /* shardable calls begun */
     long pending;         /* call whose partial result awaits its builtin's return; -1 none */
     const node *pending_at;
@@ -77,6 +77,9 @@ typedef struct shard {
     /* merge */
     shard_rec *recs;      /* the records of shard 0, in order (all parts have the same) */
     uint32_t nrecs, next_rec;
+    uint32_t ncalls;      /* the engine calls the shards' evaluation made */
+    bytebuf files;        /* the files the shards read: path NUL, SHA-256, … */
+    bytebuf reads;        /* shard: the paths this evaluation read, NUL-terminated */
     int *order;           /* order[i]: the index in parts of shard i */
     long *off;            /* per shard: file offset of its next record */
 } shard;
