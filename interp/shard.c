@@ -157,8 +157,46 @@ void shard_init_merge(shard *s, char *const *parts, int nparts)
 {
     shard_zero(s);
     s->merging = 1;
-    s->parts = parts;
-    s->nparts = nparts;
+    s->all = parts;
+    s->nall = nparts;
+}
+
+static int peek_frame(const char *path, long *f);
+
+void shard_new_frame(shard *s)
+{
+    s->nfull = 0;
+    s->again = 0;
+}
+
+/* merge --frames: this frame's parts among all given (by their headers); a
+ * part of a frame outside the range is an error. */
+static int select_frame(shard *s)
+{
+    interp *I = s->I;
+    s->parts = s->all;
+    s->nparts = s->nall;
+    if (!I->frames_given)
+        return 0;
+    s->sel = mem_calloc(I, (size_t)s->nall + 1, sizeof *s->sel);
+    if (!s->sel)
+        return -1;
+    int n = 0;
+    for (int p = 0; p < s->nall; p++) {
+        long f;
+        if (peek_frame(s->all[p], &f)) {
+            s->sel[n++] = s->all[p]; /* check_part says what is wrong with it */
+            continue;
+        }
+        if (f < I->frame_first || f > I->frame_last || (f - I->frame_first) % I->frame_step != 0)
+            return err_pos(I, -1, 0, 0, ERR_VALUE, "merge: '%s' is of frame %ld, not one of --frames %ld..%ld:%ld", s->all[p], f,
+                           I->frame_first, I->frame_last, I->frame_step);
+        if (f == I->frame)
+            s->sel[n++] = s->all[p];
+    }
+    s->parts = s->sel;
+    s->nparts = n;
+    return 0;
 }
 
 /* ---- the header --------------------------------------------------------------- */
@@ -178,6 +216,15 @@ static void params_text(interp *I, bytebuf *b)
     bytebuf_byte(b, 0);
 }
 
+/* "for frame 3 of --frames 0..8:2", or "without --frames" */
+static void frame_text(char *buf, size_t size, int given, long f, long a, long b, long step)
+{
+    if (!given)
+        snprintf(buf, size, "without --frames");
+    else
+        snprintf(buf, size, "for frame %ld of --frames %ld..%ld:%ld", f, a, b, step);
+}
+
 static void header(shard *s, bytebuf *b, int index, int count)
 {
     bytebuf pt;
@@ -189,7 +236,12 @@ static void header(shard *s, bytebuf *b, int index, int count)
     put_str(b, "sha256");
     bytebuf_append(b, s->hash, sizeof s->hash);
     put_u64(b, s->I->seed);
-    put_u32(b, 0); /* frame */
+    interp *I = s->I; /* the frame: --frames given, the frame, the range */
+    put_u32(b, (uint32_t)I->frames_given);
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_first : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_last : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_step : 0));
     put_str(b, pt.data ? (const char *)pt.data : "");
     put_u32(b, (uint32_t)index);
     put_u32(b, (uint32_t)count);
@@ -507,10 +559,40 @@ static int rd_str(reader *r, char *buf, size_t max)
     return 0;
 }
 
+/* The header's frame block (fb, 36 bytes) is this run's frame. */
+static int same_frame(const interp *I, const unsigned char *fb)
+{
+    if (!I->frames_given)
+        return get_u32(fb) == 0;
+    return get_u32(fb) == 1 && (long)get_u64(fb + 4) == I->frame && (long)get_u64(fb + 12) == I->frame_first &&
+           (long)get_u64(fb + 20) == I->frame_last && (long)get_u64(fb + 28) == I->frame_step;
+}
+
+/* The frame of a part, from its header, without checking anything else:
+ * 0 and *f, or -1 (not a part of a --frames run, or unreadable: check_part
+ * says what is wrong). */
+static int peek_frame(const char *path, long *f)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return -1;
+    reader r = {fp, path, 0, 0};
+    unsigned char b[40];
+    char str[256];
+    int rc = -1;
+    if (!rd(&r, b, 12) && memcmp(b, "FRACPART", 8) == 0 && get_u32(b + 8) == SHARD_FORMAT && !rd_str(&r, str, sizeof str) &&
+        !rd_str(&r, str, sizeof str) && !rd(&r, b, 40) && !rd(&r, b, 36) && get_u32(b) == 1) {
+        *f = (long)get_u64(b + 4);
+        rc = 0;
+    }
+    fclose(fp);
+    return rc;
+}
+
 /* The header: each field against this run's. 0, or -1 with the reason in msg. */
 static int read_header(shard *s, reader *r, int *index, int *count, char *msg, size_t ms)
 {
-    unsigned char b[16], hb[32];
+    unsigned char b[16], hb[32], fb[36];
     char str[4096];
     bytebuf pt;
     bytebuf_init(&pt);
@@ -533,11 +615,15 @@ static int read_header(shard *s, reader *r, int *index, int *count, char *msg, s
     else if (get_u64(b) != s->I->seed)
         snprintf(msg, ms, "was made with --seed %llu, not %llu", (unsigned long long)get_u64(b),
                  (unsigned long long)s->I->seed);
-    else if (rd(r, b, 4) || rd_str(r, str, sizeof str))
+    else if (rd(r, fb, sizeof fb) || rd_str(r, str, sizeof str))
         snprintf(msg, ms, "is truncated or corrupt (in its header)");
-    else if (get_u32(b) != 0)
-        snprintf(msg, ms, "is of frame %u, not frame 0", get_u32(b));
-    else if (strcmp(str, pt.data ? (const char *)pt.data : "") != 0)
+    else if (!same_frame(s->I, fb)) {
+        char a[96], c[96];
+        frame_text(a, sizeof a, get_u32(fb) != 0, (long)get_u64(fb + 4), (long)get_u64(fb + 12), (long)get_u64(fb + 20),
+                   (long)get_u64(fb + 28));
+        frame_text(c, sizeof c, s->I->frames_given, s->I->frame, s->I->frame_first, s->I->frame_last, s->I->frame_step);
+        snprintf(msg, ms, "was made %s; this merge is %s", a, c);
+    } else if (strcmp(str, pt.data ? (const char *)pt.data : "") != 0)
         snprintf(msg, ms, "was made with other -D params");
     else if (rd(r, b, 8))
         snprintf(msg, ms, "is truncated (in its header)");
@@ -861,7 +947,7 @@ int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned 
     I->shard = s;
     par_set_sharder(&s->rt);
     if (s->merging)
-        return merge_open(s);
+        return select_frame(s) || merge_open(s);
     header(s, &s->part, s->index, s->count);
     bytebuf_init(&s->reads);
     fileio_set_path_hook(on_path, s);
@@ -910,7 +996,12 @@ int shard_attempt_end(shard *s, int ok, const char *script)
         if (bl > 5 && strcmp(base + bl - 5, ".frac") == 0)
             bl -= 5;
         char name[1024], path[FILEIO_PATH_MAX];
-        snprintf(name, sizeof name, "%.*s.shard-%d-of-%d.part", (int)(bl < 900 ? bl : 900), base, s->index, s->count);
+        char fr[64] = "";
+        int fw = I->frame_width > 0 && I->frame_width < 24 ? I->frame_width : 1;
+        if (I->frames_given) /* NAME.fF.shard-I-of-N.part, F as %f in output paths */
+            snprintf(fr, sizeof fr, ".f%s%0*lu", I->frame < 0 ? "-" : "", fw,
+                     I->frame < 0 ? 0ul - (unsigned long)I->frame : (unsigned long)I->frame);
+        snprintf(name, sizeof name, "%.*s%s.shard-%d-of-%d.part", (int)(bl < 900 ? bl : 900), base, fr, s->index, s->count);
         if (rc)
             ;
         else if (lang_join_path(I, NULL, I->out_dir, name, strlen(name), path, sizeof path, "--shard"))
@@ -933,6 +1024,8 @@ int shard_attempt_end(shard *s, int ok, const char *script)
     }
     bytebuf_free(&s->part);
     bytebuf_free(&s->files);
+    mem_free(I, s->sel);
+    s->sel = NULL;
     mem_free(I, s->recs);
     mem_free(I, s->order);
     mem_free(I, s->off);

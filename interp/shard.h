@@ -52,8 +52,11 @@ typedef struct shard {
     rt_sharder rt; /* the runtime's view (first member) */
     int merging;   /* 0: a shard writing its part; 1: merge */
     int index, count;
-    char *const *parts; /* merge: the part paths as given */
+    char *const *all;   /* merge: the part paths as given */
+    int nall;
+    char *const *parts; /* merge: those of this attempt's frame (all without --frames) */
     int nparts;
+    char **sel;         /* merge --frames: this frame's parts (one attempt) */
 
     /* kept across attempts */
     uint32_t full[SHARD_MAX_FULL]; /* calls computed fully (tainted) */
@@ -88,6 +91,9 @@ typedef struct shard {
  * 0, or -1 after printing a usage error to stderr. */
 int shard_init_run(shard *s, const char *spec);
 void shard_init_merge(shard *s, char *const *parts, int nparts);
+/* --frames: a new frame starts (its engine calls are numbered afresh, no
+ * call is known to be full yet). */
+void shard_new_frame(shard *s);
 
 /* An attempt: I is the fresh interpreter, text the script. Merge checks
  * every part here (an error is recorded in I and -1 returned). */

@@ -37,7 +37,7 @@ for path in sys.argv[2:]:
     assert sstr() == b'sha256'
     assert take(32) == hashlib.sha256(script).digest(), 'script hash'
     assert u64() == 1, 'seed'
-    assert u32() == 0, 'frame'
+    assert u32() == 0 and take(32) == bytes(32), 'no frames'
     assert sstr() == b'n=3e6\n', 'params'
     index, count = u32(), u32()
     assert count == 3

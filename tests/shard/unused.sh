@@ -66,7 +66,7 @@ for path in sys.argv[2:]:
         n, = struct.unpack('<I', b[pos:pos + 4])
         pos += 4 + n
     b[pos:pos + 32] = h
-    pos += 32 + 8 + 4
+    pos += 32 + 8 + 36  # hash, seed, frames
     n, = struct.unpack('<I', b[pos:pos + 4])
     pos += 4 + n + 8  # params, shard I and N
     b[pos:pos + 4] = struct.pack('<I', zlib.crc32(bytes(b[:pos])))
