@@ -421,12 +421,16 @@ int cli_run_frames(interp *T, opts *o)
         }
         if (tty)
             fprintf(stderr, "frame %ld (%ld of %ld)\n", f, k + 1, count);
-        interp st, *I = &st;
-        cli_fresh_interp(I, T);
-        cli_set_frame(I, f, o->fa, o->fb, o->fstep);
-        rc = cli_run_frac(I, o);
-        interp_free(I);
-        rt_alloc_set_hook(&T->hook); /* T's blocks (the script, the options) are counted by T */
+        if (o->sh) /* --shard or merge: each frame its own calls and re-runs (shard.h) */
+            shard_new_frame(o->sh);
+        do {
+            interp st, *I = &st;
+            cli_fresh_interp(I, T);
+            cli_set_frame(I, f, o->fa, o->fb, o->fstep);
+            rc = cli_run_frac(I, o);
+            interp_free(I);
+            rt_alloc_set_hook(&T->hook); /* T's blocks (the script, the options) are counted by T */
+        } while (rc == EX_OK && o->sh && o->sh->again);
         if (rc != EX_OK && count > 1)
             fprintf(stderr, "frac: stopped at frame %ld (%ld of %ld frames done)\n", f, k, count);
     }

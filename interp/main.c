@@ -105,7 +105,9 @@ static const char usage_text[] =
     "                        width of B; `%%` is a %. See docs/animation.md\n"
     "  --shard I/N | auto    with run: shard I (0 ≤ I < N) of N; auto takes them from\n"
     "                        SLURM_ARRAY_TASK_ID/_COUNT/_MIN, SLURM_PROCID/SLURM_NTASKS,\n"
-    "                        OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE\n"
+    "                        OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE; with\n"
+    "                        --frames, one part a frame: SCRIPT.fF.shard-I-of-N.part\n"
+    "                        (merge --frames A..B SCRIPT PART... merges every frame)\n"
     "limits (whole numbers ≥ 1; a script that exceeds one stops with an error\n"
     "naming it):\n"
     "  --max-memory MIB      all memory: values, images, volumes, engine buffers (default 4096)\n"
@@ -454,7 +456,7 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
         return cli_usage_error("%s", "--show goes with `frac watch` (in a script or the REPL, use show(image))");
     if (strcmp(o->mode, "watch") == 0 && (!o->script || strcmp(o->script, "-") == 0))
         return cli_usage_error("%s", "watch needs a script file to watch: frac watch SCRIPT.frac [-o DIR] [-D NAME=VALUE]");
-    if (o->frames && strcmp(o->mode, "run") != 0)
+    if (o->frames && strcmp(o->mode, "run") != 0 && strcmp(o->mode, "merge") != 0)
         return cli_usage_error("--frames goes with `frac run` (frac run --frames A..B SCRIPT), not with %s",
                            strcmp(o->mode, "eval") == 0 ? "-e" : o->mode);
     if (strcmp(o->mode, "merge") == 0 && (!o->script || !o->nargs))
@@ -466,8 +468,6 @@ static int parse_command_line(interp *I, int argc, char **argv, opts *o)
     if (o->shard && o->nargs)
         return cli_usage_error("--shard runs a script without arguments (got '%s'): merge could not give them to it",
                            o->args[0]);
-    if (o->frames && (o->shard || strcmp(o->mode, "merge") == 0))
-        return cli_usage_error("%s", "--frames does not go with --shard or merge yet: shard each frame with --frames N..N");
     if (o->list_params && strcmp(o->mode, "check") != 0)
         return cli_usage_error("%s", "--params goes with `frac check`");
     if (o->nov && (strcmp(o->mode, "eval") == 0 || strcmp(o->mode, "repl") == 0))

@@ -2,6 +2,7 @@
 #include "shard.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,17 +11,44 @@
 #include "builtin.h"
 #include "lang_objects.h"
 #include "session.h"
+#include "sha256.h"
 
 /* ---- small helpers ------------------------------------------------------------ */
 
-static uint64_t fnv1a64(const unsigned char *p, size_t n)
+/* CRC-32 of the PNG/zlib kind (reflected polynomial 0xEDB88320; equal to
+ * deflate_crc32), eight bytes a step ("slicing-by-8": table k advances a
+ * byte through k more zero bytes), so checking parts costs little next to
+ * reading them. */
+static uint32_t crc_tab[8][256];
+static pthread_once_t crc_once = PTHREAD_ONCE_INIT;
+
+static void crc_init(void)
 {
-    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a 64-bit offset basis and prime */
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
+    for (uint32_t n = 0; n < 256; n++) {
+        uint32_t c = n;
+        for (int k = 0; k < 8; k++)
+            c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        crc_tab[0][n] = c;
     }
-    return h;
+    for (uint32_t n = 0; n < 256; n++)
+        for (int k = 1; k < 8; k++)
+            crc_tab[k][n] = crc_tab[0][crc_tab[k - 1][n] & 0xFF] ^ (crc_tab[k - 1][n] >> 8);
+}
+
+static uint32_t part_crc(uint32_t crc, const void *data, size_t n)
+{
+    pthread_once(&crc_once, crc_init);
+    const unsigned char *p = data;
+    uint32_t c = crc ^ 0xFFFFFFFFu;
+    for (; n >= 8; n -= 8, p += 8) {
+        uint32_t lo = c ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
+        uint32_t hi = (uint32_t)p[4] | (uint32_t)p[5] << 8 | (uint32_t)p[6] << 16 | (uint32_t)p[7] << 24;
+        c = crc_tab[7][lo & 0xFF] ^ crc_tab[6][(lo >> 8) & 0xFF] ^ crc_tab[5][(lo >> 16) & 0xFF] ^ crc_tab[4][lo >> 24] ^
+            crc_tab[3][hi & 0xFF] ^ crc_tab[2][(hi >> 8) & 0xFF] ^ crc_tab[1][(hi >> 16) & 0xFF] ^ crc_tab[0][hi >> 24];
+    }
+    while (n--)
+        c = crc_tab[0][(c ^ *p++) & 0xFF] ^ (c >> 8);
+    return c ^ 0xFFFFFFFFu;
 }
 
 static void put_u32(bytebuf *b, uint32_t v) { bytebuf_u32le(b, v); }
@@ -129,8 +157,46 @@ void shard_init_merge(shard *s, char *const *parts, int nparts)
 {
     shard_zero(s);
     s->merging = 1;
-    s->parts = parts;
-    s->nparts = nparts;
+    s->all = parts;
+    s->nall = nparts;
+}
+
+static int peek_frame(const char *path, long *f);
+
+void shard_new_frame(shard *s)
+{
+    s->nfull = 0;
+    s->again = 0;
+}
+
+/* merge --frames: this frame's parts among all given (by their headers); a
+ * part of a frame outside the range is an error. */
+static int select_frame(shard *s)
+{
+    interp *I = s->I;
+    s->parts = s->all;
+    s->nparts = s->nall;
+    if (!I->frames_given)
+        return 0;
+    s->sel = mem_calloc(I, (size_t)s->nall + 1, sizeof *s->sel);
+    if (!s->sel)
+        return -1;
+    int n = 0;
+    for (int p = 0; p < s->nall; p++) {
+        long f;
+        if (peek_frame(s->all[p], &f)) {
+            s->sel[n++] = s->all[p]; /* check_part says what is wrong with it */
+            continue;
+        }
+        if (f < I->frame_first || f > I->frame_last || (f - I->frame_first) % I->frame_step != 0)
+            return err_pos(I, -1, 0, 0, ERR_VALUE, "merge: '%s' is of frame %ld, not one of --frames %ld..%ld:%ld", s->all[p], f,
+                           I->frame_first, I->frame_last, I->frame_step);
+        if (f == I->frame)
+            s->sel[n++] = s->all[p];
+    }
+    s->parts = s->sel;
+    s->nparts = n;
+    return 0;
 }
 
 /* ---- the header --------------------------------------------------------------- */
@@ -150,6 +216,15 @@ static void params_text(interp *I, bytebuf *b)
     bytebuf_byte(b, 0);
 }
 
+/* "for frame 3 of --frames 0..8:2", or "without --frames" */
+static void frame_text(char *buf, size_t size, int given, long f, long a, long b, long step)
+{
+    if (!given)
+        snprintf(buf, size, "without --frames");
+    else
+        snprintf(buf, size, "for frame %ld of --frames %ld..%ld:%ld", f, a, b, step);
+}
+
 static void header(shard *s, bytebuf *b, int index, int count)
 {
     bytebuf pt;
@@ -158,15 +233,20 @@ static void header(shard *s, bytebuf *b, int index, int count)
     bytebuf_append(b, "FRACPART", 8);
     put_u32(b, SHARD_FORMAT);
     put_str(b, FRAC_VERSION);
-    put_str(b, "fnv1a-64");
-    put_u64(b, s->hash);
+    put_str(b, "sha256");
+    bytebuf_append(b, s->hash, sizeof s->hash);
     put_u64(b, s->I->seed);
-    put_u32(b, 0); /* frame */
+    interp *I = s->I; /* the frame: --frames given, the frame, the range */
+    put_u32(b, (uint32_t)I->frames_given);
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_first : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_last : 0));
+    put_u64(b, (uint64_t)(I->frames_given ? I->frame_step : 0));
     put_str(b, pt.data ? (const char *)pt.data : "");
     put_u32(b, (uint32_t)index);
     put_u32(b, (uint32_t)count);
     bytebuf_free(&pt);
-    put_u32(b, deflate_crc32(0, b->data, b->len));
+    put_u32(b, part_crc(0, b->data, b->len));
 }
 
 /* ---- records -------------------------------------------------------------------- */
@@ -193,6 +273,62 @@ static void rec_head(bytebuf *b, const shard_rec *r, uint64_t lo, uint64_t hi, u
     put_u64(b, r->chunk_bytes);
     put_u64(b, payload);
 }
+
+/* Sums are stored as unsigned LEB128 (7 bits a byte, low group first, the
+ * high bit set on every byte but a value's last); returns the bytes added. */
+static uint64_t put_sums(bytebuf *b, const uint64_t *a, size_t n)
+{
+    unsigned char blk[1 << 14];
+    size_t k = 0, start = b->len;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t v = a[i];
+        while (v >= 0x80) {
+            blk[k++] = (unsigned char)(v | 0x80);
+            v >>= 7;
+        }
+        blk[k++] = (unsigned char)v;
+        if (k > sizeof blk - 10 || i + 1 == n) {
+            bytebuf_append(b, blk, k);
+            k = 0;
+        }
+    }
+    return b->len - start;
+}
+
+/* Decoding sums block by block (a value may straddle two blocks). */
+typedef struct sum_dec {
+    uint64_t v, n, want; /* value so far; values done; values expected */
+    unsigned shift;
+    int bad; /* more than 64 bits, or more values than expected */
+} sum_dec;
+
+/* acc: add each value into acc[n] (NULL: only check the structure). */
+static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t *acc)
+{
+    for (size_t i = 0; i < len && !d->bad; i++) {
+        unsigned c = p[i];
+        if (d->shift > 63 || (d->shift == 63 && (c & 0x7e))) {
+            d->bad = 1;
+            break;
+        }
+        d->v |= (uint64_t)(c & 0x7f) << d->shift;
+        if (c & 0x80) {
+            d->shift += 7;
+            continue;
+        }
+        if (d->n >= d->want) {
+            d->bad = 1;
+            break;
+        }
+        if (acc)
+            acc[d->n] += d->v;
+        d->n++;
+        d->v = 0;
+        d->shift = 0;
+    }
+}
+
+static int sum_done(const sum_dec *d) { return !d->bad && d->shift == 0 && d->n == d->want; }
 
 static void payload_range(const shard_rec *r, size_t lo, size_t hi, uint64_t *from, uint64_t *len)
 {
@@ -246,6 +382,17 @@ static int taint(shard *s, uint32_t seq, const node *at, const char *why)
     return err_at(I, NULL, ERR_RUNTIME, "--shard: abandoned to re-run (call %u is computed fully)", seq);
 }
 
+/* merge: the parts hold a record this evaluation did not use (they were
+ * made by an evaluation that went otherwise: another script or variant). */
+static int unused_record(shard *s)
+{
+    const shard_rec *r = &s->recs[s->next_rec];
+    return err_pos(s->I, -1, 0, 0, ERR_VALUE,
+                   "merge: the parts' record %u (engine call %u, %.16s) is not used by this evaluation of the script: "
+                   "the parts come from another script or variant",
+                   s->next_rec, r->seq, r->kind);
+}
+
 static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo, size_t *hi)
 {
     shard *s = (shard *)rs;
@@ -257,6 +404,10 @@ static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo
     uint32_t seq = s->seq++;
     s->cur = -1;
     if (s->merging) {
+        if (s->next_rec < s->nrecs && s->recs[s->next_rec].seq < seq) { /* the call it was for went by */
+            unused_record(s);
+            return -1;
+        }
         if (s->next_rec < s->nrecs && s->recs[s->next_rec].seq == seq) {
             const shard_rec *r = &s->recs[s->next_rec];
             if (strncmp(r->kind, kind, 16) != 0 || r->nchunks != nchunks) {
@@ -319,19 +470,32 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     payload_range(&r, lo, hi, &from, &len);
     size_t start = s->part.len;
     rec_head(&s->part, &r, lo, hi, len);
-    static const uint16_t one = 1;
-    if (op == PAR_OP_SUM && *(const unsigned char *)&one != 1) { /* a big-endian host: word by word */
-        const uint64_t *a = buf;
-        for (size_t k = 0; k < total / 8; k++)
-            put_u64(&s->part, a[k]);
+    if (op == PAR_OP_SUM) { /* LEB128, 7 bits a byte: most sums are small */
+        len = put_sums(&s->part, buf, total / 8);
+        for (int q = 0; !s->part.failed && q < 8; q++) /* the length field, the head's last */
+            s->part.data[start + REC_HEAD - 8 + q] = (unsigned char)(len >> 8 * q);
     } else {
         bytebuf_append(&s->part, (const unsigned char *)buf + from, (size_t)len); /* the host's bytes: little-endian */
     }
     if (s->part.failed)
         return rt_fail(e, RT_ENOMEM, "out of memory for the part file (%llu bytes)", (unsigned long long)len);
-    put_u32(&s->part, deflate_crc32(0, s->part.data + start, s->part.len - start));
+    put_u32(&s->part, part_crc(0, s->part.data + start, s->part.len - start));
     s->nrec++;
     return s->part.failed ? rt_fail(e, RT_ENOMEM, "out of memory for the part file") : RT_OK;
+}
+
+static int file_sha256(const char *path, unsigned char out[32], rt_error *e)
+{
+    unsigned char *data = NULL;
+    size_t n = 0;
+    if (fileio_read_all(path, (size_t)1 << 30, &data, &n, e))
+        return -1;
+    sha256_ctx h;
+    sha256_init(&h);
+    sha256_update(&h, data, n);
+    sha256_final(&h, out);
+    rt_free(data);
+    return 0;
 }
 
 /* ---- merge: reading parts ------------------------------------------------------------ */
@@ -347,7 +511,7 @@ static int rd(reader *r, void *p, size_t n)
 {
     if (fread(p, 1, n, r->f) != n)
         return -1;
-    r->crc = deflate_crc32(r->crc, p, n);
+    r->crc = part_crc(r->crc, p, n);
     r->pos += (long)n;
     return 0;
 }
@@ -395,10 +559,40 @@ static int rd_str(reader *r, char *buf, size_t max)
     return 0;
 }
 
+/* The header's frame block (fb, 36 bytes) is this run's frame. */
+static int same_frame(const interp *I, const unsigned char *fb)
+{
+    if (!I->frames_given)
+        return get_u32(fb) == 0;
+    return get_u32(fb) == 1 && (long)get_u64(fb + 4) == I->frame && (long)get_u64(fb + 12) == I->frame_first &&
+           (long)get_u64(fb + 20) == I->frame_last && (long)get_u64(fb + 28) == I->frame_step;
+}
+
+/* The frame of a part, from its header, without checking anything else:
+ * 0 and *f, or -1 (not a part of a --frames run, or unreadable: check_part
+ * says what is wrong). */
+static int peek_frame(const char *path, long *f)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return -1;
+    reader r = {fp, path, 0, 0};
+    unsigned char b[40];
+    char str[256];
+    int rc = -1;
+    if (!rd(&r, b, 12) && memcmp(b, "FRACPART", 8) == 0 && get_u32(b + 8) == SHARD_FORMAT && !rd_str(&r, str, sizeof str) &&
+        !rd_str(&r, str, sizeof str) && !rd(&r, b, 40) && !rd(&r, b, 36) && get_u32(b) == 1) {
+        *f = (long)get_u64(b + 4);
+        rc = 0;
+    }
+    fclose(fp);
+    return rc;
+}
+
 /* The header: each field against this run's. 0, or -1 with the reason in msg. */
 static int read_header(shard *s, reader *r, int *index, int *count, char *msg, size_t ms)
 {
-    unsigned char b[16];
+    unsigned char b[16], hb[32], fb[36];
     char str[4096];
     bytebuf pt;
     bytebuf_init(&pt);
@@ -414,18 +608,22 @@ static int read_header(shard *s, reader *r, int *index, int *count, char *msg, s
         snprintf(msg, ms, "is truncated or corrupt (in its header)");
     else if (strcmp(str, FRAC_VERSION) != 0)
         snprintf(msg, ms, "was made by frac %.64s; this is frac %s", str, FRAC_VERSION);
-    else if (rd_str(r, str, sizeof str) || strcmp(str, "fnv1a-64") != 0 || rd(r, b, 16))
+    else if (rd_str(r, str, sizeof str) || strcmp(str, "sha256") != 0 || rd(r, hb, sizeof hb) || rd(r, b, 8))
         snprintf(msg, ms, "is truncated or corrupt (in its header)");
-    else if (get_u64(b) != s->hash)
+    else if (memcmp(hb, s->hash, sizeof hb) != 0)
         snprintf(msg, ms, "was made from another script (its hash differs)");
-    else if (get_u64(b + 8) != s->I->seed)
-        snprintf(msg, ms, "was made with --seed %llu, not %llu", (unsigned long long)get_u64(b + 8),
+    else if (get_u64(b) != s->I->seed)
+        snprintf(msg, ms, "was made with --seed %llu, not %llu", (unsigned long long)get_u64(b),
                  (unsigned long long)s->I->seed);
-    else if (rd(r, b, 4) || rd_str(r, str, sizeof str))
+    else if (rd(r, fb, sizeof fb) || rd_str(r, str, sizeof str))
         snprintf(msg, ms, "is truncated or corrupt (in its header)");
-    else if (get_u32(b) != 0)
-        snprintf(msg, ms, "is of frame %u, not frame 0", get_u32(b));
-    else if (strcmp(str, pt.data ? (const char *)pt.data : "") != 0)
+    else if (!same_frame(s->I, fb)) {
+        char a[96], c[96];
+        frame_text(a, sizeof a, get_u32(fb) != 0, (long)get_u64(fb + 4), (long)get_u64(fb + 12), (long)get_u64(fb + 20),
+                   (long)get_u64(fb + 28));
+        frame_text(c, sizeof c, s->I->frames_given, s->I->frame, s->I->frame_first, s->I->frame_last, s->I->frame_step);
+        snprintf(msg, ms, "was made %s; this merge is %s", a, c);
+    } else if (strcmp(str, pt.data ? (const char *)pt.data : "") != 0)
         snprintf(msg, ms, "was made with other -D params");
     else if (rd(r, b, 8))
         snprintf(msg, ms, "is truncated (in its header)");
@@ -481,14 +679,45 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         if (e < 0)
             break;
         if (e == 1) {
-            if (rd(&r, b, 8)) {
-                snprintf(msg, sizeof msg, "it is truncated (in the end marker)");
+            bytebuf tail; /* the files read: path, SHA-256 */
+            bytebuf_init(&tail);
+            int bad = rd(&r, b, 12) != 0;
+            for (uint32_t f = 0; !bad && f < get_u32(b + 8); f++) {
+                char fp[FILEIO_PATH_MAX];
+                unsigned char fh[32];
+                bad = rd_str(&r, fp, sizeof fp) || rd(&r, fh, sizeof fh);
+                if (!bad) {
+                    bytebuf_append(&tail, fp, strlen(fp) + 1);
+                    bytebuf_append(&tail, fh, sizeof fh);
+                }
+            }
+            uint32_t crc = r.crc;
+            if (bad || fread(b + 12, 1, 4, r.f) != 4) {
+                bytebuf_free(&tail);
+                snprintf(msg, sizeof msg, "it is truncated or corrupt (in the end marker)");
                 break;
             }
-            if (get_u32(b) != k || get_u32(b + 4) != deflate_crc32(0, "END ", 4)) {
+            if (get_u32(b) != k || get_u32(b + 12) != crc) {
+                bytebuf_free(&tail);
                 snprintf(msg, sizeof msg, "it is corrupt (end marker)");
                 break;
             }
+            int same = first || (tail.len == s->files.len && (!tail.len || memcmp(tail.data, s->files.data, tail.len) == 0));
+            if (first) {
+                bytebuf_free(&s->files);
+                s->files = tail;
+            } else {
+                bytebuf_free(&tail);
+            }
+            if (!same || s->files.failed) {
+                snprintf(msg, sizeof msg, "its shard read other files than the first part's");
+                break;
+            }
+            if (!first && get_u32(b + 4) != s->ncalls) {
+                snprintf(msg, sizeof msg, "it has %u engine calls, the first part given has %u", get_u32(b + 4), s->ncalls);
+                break;
+            }
+            s->ncalls = get_u32(b + 4);
             if (!first && k != s->nrecs) {
                 snprintf(msg, sizeof msg, "it has %u records, the first part given has %u", k, s->nrecs);
                 break;
@@ -505,16 +734,21 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         chunk_range(h.nchunks, *index, *count, &elo, &ehi);
         uint64_t efrom, elen;
         payload_range(&h, elo, ehi, &efrom, &elen);
-        if (lo != elo || hi != ehi || len != elen || h.op < PAR_OP_SUM || h.op > PAR_OP_COMBINE ||
+        int sums = h.op == PAR_OP_SUM; /* LEB128: one to ten bytes a value */
+        if (lo != elo || hi != ehi || (sums ? len < h.total / 8 || len / 10 > h.total / 8 : len != elen) ||
+            h.op < PAR_OP_SUM || h.op > PAR_OP_COMBINE ||
             (h.op == PAR_OP_SUM && h.total % 8) || (h.op == PAR_OP_COMBINE && (!h.chunk_bytes || h.total % h.chunk_bytes))) {
             snprintf(msg, sizeof msg, "it is corrupt (record at byte %ld)", at);
             break;
         }
         uint64_t left = len;
+        sum_dec sd = {0, 0, h.total / 8, 0, 0};
         while (left) {
             size_t n = left < (1u << 16) ? (size_t)left : 1u << 16;
             if (rd(&r, blk, n))
                 break;
+            if (sums)
+                sum_decode(&sd, blk, n, NULL);
             left -= n;
         }
         uint32_t crc = r.crc;
@@ -525,6 +759,10 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         r.pos += 4;
         if (get_u32(b) != crc) {
             snprintf(msg, sizeof msg, "it is corrupt (checksum of record %u, engine call %u)", k, h.seq);
+            break;
+        }
+        if (sums && !sum_done(&sd)) {
+            snprintf(msg, sizeof msg, "it is corrupt (the sums of record %u, engine call %u)", k, h.seq);
             break;
         }
         if (first) {
@@ -595,6 +833,19 @@ static int merge_open(shard *s)
                 rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: shard %d of %d is missing (%d part%s given)", i, count, n,
                              n == 1 ? "" : "s");
     }
+    /* the files the shards read (imports, data) must be the ones this
+     * evaluation will read: checked before anything is evaluated or written */
+    for (size_t k = 0; !rc && k < s->files.len;) {
+        const char *f = (const char *)s->files.data + k;
+        size_t fl = strlen(f) + 1;
+        unsigned char h[32];
+        rt_error e;
+        if (file_sha256(f, h, &e))
+            rc = err_pos(I, -1, 0, 0, ERR_IO, "merge: cannot read '%s', which the shards read: %s", f, e.msg);
+        else if (memcmp(h, s->files.data + k + fl, 32) != 0)
+            rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: '%s' is not the file the shards read (its SHA-256 differs)", f);
+        k += fl + 32;
+    }
     mem_free(I, idx);
     mem_free(I, first);
     return rc;
@@ -633,14 +884,16 @@ static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_com
                     fn(ctx, (unsigned char *)buf + k, blk, n / want->chunk_bytes);
             }
         } else if (want->op == PAR_OP_SUM) {
-            uint64_t *acc = buf;
+            sum_dec sd = {0, 0, want->total / 8, 0, 0};
             for (uint64_t k = 0; k < len && !c; k += sizeof blk) {
                 size_t n = len - k < sizeof blk ? (size_t)(len - k) : sizeof blk;
                 if (rd(&r, blk, n))
                     c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging", path);
-                for (size_t q = 0; !c && q < n; q += 8)
-                    acc[(k + q) / 8] += get_u64(blk + q);
+                else
+                    sum_decode(&sd, blk, n, buf);
             }
+            if (!c && !sum_done(&sd))
+                c = rt_fail(e, RT_EFORMAT, "merge: '%s' changed while merging (sums)", path);
         } else {
             uint64_t from, l2;
             payload_range(want, (size_t)lo, (size_t)hi, &from, &l2);
@@ -660,6 +913,19 @@ static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_com
 
 /* ---- attempts ----------------------------------------------------------------------- */
 
+/* A shard notes every file its evaluation reads (imports, load_ifs, images
+ * …; the path hook of fileio.h), once each, NUL-terminated in s->reads. */
+static void on_path(void *ud, const char *path, int wrote)
+{
+    shard *s = ud;
+    if (wrote)
+        return;
+    for (size_t k = 0; k < s->reads.len; k += strlen((const char *)s->reads.data + k) + 1)
+        if (strcmp((const char *)s->reads.data + k, path) == 0)
+            return;
+    bytebuf_append(&s->reads, path, strlen(path) + 1);
+}
+
 int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned char *text, size_t len)
 {
     (void)script;
@@ -671,15 +937,20 @@ int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned 
     s->live = 0;
     s->nrec = 0;
     s->next_rec = 0;
-    s->hash = fnv1a64(text, len);
+    sha256_ctx h;
+    sha256_init(&h);
+    sha256_update(&h, text, len);
+    sha256_final(&h, s->hash);
     s->rt.begin = cb_begin;
     s->rt.section = cb_section;
     bytebuf_init(&s->part);
     I->shard = s;
     par_set_sharder(&s->rt);
     if (s->merging)
-        return merge_open(s);
+        return select_frame(s) || merge_open(s);
     header(s, &s->part, s->index, s->count);
+    bytebuf_init(&s->reads);
+    fileio_set_path_hook(on_path, s);
     s->devnull = fopen("/dev/null", "w");
     if (!s->devnull)
         return err_pos(I, -1, 0, 0, ERR_IO, "--shard: cannot open /dev/null: %s", strerror(errno));
@@ -691,17 +962,49 @@ int shard_attempt_end(shard *s, int ok, const char *script)
 {
     interp *I = s->I;
     int rc = 0;
+    if (ok && s->merging && (s->next_rec < s->nrecs || s->seq != s->ncalls)) {
+        if (s->next_rec < s->nrecs)
+            unused_record(s);
+        else
+            err_pos(I, -1, 0, 0, ERR_VALUE, "merge: this evaluation of the script made %u engine calls, the shards' made %u: "
+                    "the parts come from another script or variant", s->seq, s->ncalls);
+        rc = -1;
+    }
     if (ok && !s->merging && !s->again) {
+        fileio_set_path_hook(NULL, NULL);
+        size_t end = s->part.len;
         bytebuf_append(&s->part, "END ", 4);
         put_u32(&s->part, s->nrec);
-        put_u32(&s->part, deflate_crc32(0, "END ", 4));
+        put_u32(&s->part, s->seq); /* engine calls of the evaluation, split or not */
+        uint32_t nf = 0;
+        for (size_t k = 0; k < s->reads.len; k += strlen((const char *)s->reads.data + k) + 1)
+            nf++;
+        put_u32(&s->part, nf);
+        for (size_t k = 0; k < s->reads.len && !rc; k += strlen((const char *)s->reads.data + k) + 1) {
+            const char *f = (const char *)s->reads.data + k;
+            unsigned char h[32];
+            rt_error e;
+            if (file_sha256(f, h, &e))
+                rc = err_pos(I, -1, 0, 0, ERR_IO, "--shard: cannot read '%s' again to hash it: %s", f, e.msg);
+            put_str(&s->part, f);
+            bytebuf_append(&s->part, h, sizeof h);
+        }
+        if (!s->part.failed)
+            put_u32(&s->part, part_crc(0, s->part.data + end, s->part.len - end));
         const char *base = strrchr(script, '/') ? strrchr(script, '/') + 1 : script;
         size_t bl = strlen(base);
         if (bl > 5 && strcmp(base + bl - 5, ".frac") == 0)
             bl -= 5;
         char name[1024], path[FILEIO_PATH_MAX];
-        snprintf(name, sizeof name, "%.*s.shard-%d-of-%d.part", (int)(bl < 900 ? bl : 900), base, s->index, s->count);
-        if (lang_join_path(I, NULL, I->out_dir, name, strlen(name), path, sizeof path, "--shard"))
+        char fr[64] = "";
+        int fw = I->frame_width > 0 && I->frame_width < 24 ? I->frame_width : 1;
+        if (I->frames_given) /* NAME.fF.shard-I-of-N.part, F as %f in output paths */
+            snprintf(fr, sizeof fr, ".f%s%0*lu", I->frame < 0 ? "-" : "", fw,
+                     I->frame < 0 ? 0ul - (unsigned long)I->frame : (unsigned long)I->frame);
+        snprintf(name, sizeof name, "%.*s%s.shard-%d-of-%d.part", (int)(bl < 900 ? bl : 900), base, fr, s->index, s->count);
+        if (rc)
+            ;
+        else if (lang_join_path(I, NULL, I->out_dir, name, strlen(name), path, sizeof path, "--shard"))
             rc = -1;
         else if (s->part.failed)
             rc = mem_engine_error(I, "--shard", "out of memory for the part file");
@@ -715,7 +1018,14 @@ int shard_attempt_end(shard *s, int ok, const char *script)
         }
     }
     par_set_sharder(NULL);
+    if (!s->merging) {
+        fileio_set_path_hook(NULL, NULL);
+        bytebuf_free(&s->reads);
+    }
     bytebuf_free(&s->part);
+    bytebuf_free(&s->files);
+    mem_free(I, s->sel);
+    s->sel = NULL;
     mem_free(I, s->recs);
     mem_free(I, s->order);
     mem_free(I, s->off);

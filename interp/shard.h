@@ -42,7 +42,7 @@
 #include "par.h"
 #include "state.h"
 
-#define SHARD_FORMAT 1
+#define SHARD_FORMAT 2
 #define SHARD_MAX_FULL 4096
 #define SHARD_MAX_PARTS 65536
 
@@ -52,8 +52,11 @@ typedef struct shard {
     rt_sharder rt; /* the runtime's view (first member) */
     int merging;   /* 0: a shard writing its part; 1: merge */
     int index, count;
-    char *const *parts; /* merge: the part paths as given */
+    char *const *all;   /* merge: the part paths as given */
+    int nall;
+    char *const *parts; /* merge: those of this attempt's frame (all without --frames) */
     int nparts;
+    char **sel;         /* merge --frames: this frame's parts (one attempt) */
 
     /* kept across attempts */
     uint32_t full[SHARD_MAX_FULL]; /* calls computed fully (tainted) */
@@ -62,7 +65,7 @@ typedef struct shard {
 
     /* one attempt */
     interp *I;
-    uint64_t hash;        /* FNV-1a 64 of the script text */
+    unsigned char hash[32]; /* SHA-256 of the script text */
     uint32_t seq;         /* shardable calls begun */
     long pending;         /* call whose partial result awaits its builtin's return; -1 none */
     const node *pending_at;
@@ -77,6 +80,9 @@ typedef struct shard {
     /* merge */
     shard_rec *recs;      /* the records of shard 0, in order (all parts have the same) */
     uint32_t nrecs, next_rec;
+    uint32_t ncalls;      /* the engine calls the shards' evaluation made */
+    bytebuf files;        /* the files the shards read: path NUL, SHA-256, … */
+    bytebuf reads;        /* shard: the paths this evaluation read, NUL-terminated */
     int *order;           /* order[i]: the index in parts of shard i */
     long *off;            /* per shard: file offset of its next record */
 } shard;
@@ -85,6 +91,9 @@ typedef struct shard {
  * 0, or -1 after printing a usage error to stderr. */
 int shard_init_run(shard *s, const char *spec);
 void shard_init_merge(shard *s, char *const *parts, int nparts);
+/* --frames: a new frame starts (its engine calls are numbered afresh, no
+ * call is known to be full yet). */
+void shard_new_frame(shard *s);
 
 /* An attempt: I is the fresh interpreter, text the script. Merge checks
  * every part here (an error is recorded in I and -1 returned). */

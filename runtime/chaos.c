@@ -778,35 +778,28 @@ static void fill_stats(chaos_stats *st, const worker *w, int nw)
 
 /* A sharded or merging call (par.h): the workers' exact integer sums —
  * k = 1 (count) or 4 (count, r, g, b) per bin — then plotted and inside, go
- * through par_part_sum as one section; returns the summed array (n words). */
-static uint64_t *shard_sums(const par_part *pp, const worker *w, int nw, size_t nbins, int colour,
-                            size_t *n, rt_code *rc, rt_error *e)
+ * through par_part_sum as one section. tot (n = nbins * k + 2 words, zeroed
+ * by the caller) may already hold worker 0's counts (it counted there
+ * directly); workers without counts (a merge computes no chunks) add nothing. */
+static rt_code shard_sums(const par_part *pp, const worker *w, int nw, size_t nbins, int colour,
+                          uint64_t *tot, size_t n, rt_error *e)
 {
     size_t k = colour ? 4 : 1;
-    *n = nbins * k + 2;
-    uint64_t *tot = rt_calloc(*n, sizeof *tot);
-    if (!tot) {
-        *rc = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
-        return NULL;
-    }
-    for (size_t b = 0; b < nbins; b++)
-        for (int i = 0; i < nw; i++) {
-            if (!colour)
+    for (int i = 0; i < nw; i++) {
+        if (!w[i].cnt)
+            continue;
+        if (!colour)
+            for (size_t b = 0; b < nbins; b++)
                 tot[b] += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
-            else
-                for (size_t q = 0; q < 4; q++)
-                    tot[4 * b + q] += w[i].cnt[4 * b + q] + (w[i].carry ? w[i].carry[4 * b + q] : 0);
-        }
+        else
+            for (size_t q = 0; q < 4 * nbins; q++)
+                tot[q] += w[i].cnt[q] + (w[i].carry ? w[i].carry[q] : 0);
+    }
     for (int i = 0; i < nw; i++) {
         tot[nbins * k] += w[i].plotted;
         tot[nbins * k + 1] += w[i].inside;
     }
-    *rc = par_part_sum(pp, tot, *n, e);
-    if (*rc) {
-        rt_free(tot);
-        return NULL;
-    }
-    return tot;
+    return par_part_sum(pp, tot, n, e);
 }
 
 rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_stats *st,
@@ -836,31 +829,54 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         sys_free(d);
         return rc;
     }
-    /* worker 0 counts straight into the histogram, except in a shard or a
-     * merge: there every worker's counts go through shard_sums */
-    if (o->colour == CHAOS_COLOUR_NONE && pp.mode == PAR_FULL)
+    /* Worker 0 counts straight into the histogram, in a shard too: without
+     * colour the histogram's own counts are the section (merge adds the
+     * parts into them), then plotted and inside as a second one. With colour
+     * the sums (count, r, g, b per bin) go through tot. A merge computes no
+     * chunks and needs no counts of its own. */
+    int colour = o->colour != CHAOS_COLOUR_NONE;
+    size_t ntot = pp.mode == PAR_FULL ? 0 : colour ? j.nbins * 4 + 2 : 2;
+    uint64_t *tot = ntot ? rt_calloc(ntot, sizeof *tot) : NULL;
+    if (ntot && !tot) {
+        sys_free(d);
+        return rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
+    }
+    if (!colour && pp.mode != PAR_MERGE)
         j.direct = hs->count;
-    rc = alloc_workers(&j.w, nw, j.nbins, j.direct ? 2 : 1, o->colour != CHAOS_COLOUR_NONE, 0, e);
+    rc = alloc_workers(&j.w, nw, j.nbins, pp.mode == PAR_MERGE ? 0 : j.direct ? 2 : 1, colour, 0, e);
     if (rc) {
+        rt_free(tot);
         sys_free(d);
         return rc;
     }
     rc = par_part_for(&pp, "chaos game", hist_fns[d->kind][o->colour], &j);
     rc = finish_par(rc, j.w, nw, e);
-    if (!rc && pp.mode != PAR_FULL) {
-        int colour = o->colour != CHAOS_COLOUR_NONE;
-        size_t n;
-        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, colour, &n, &rc, e);
-        for (size_t b = 0; tot && b < j.nbins; b++) {
-            hs->count[b] += tot[colour ? 4 * b : b];
-            for (int ch = 0; colour && ch < 3; ch++)
+    if (!rc && pp.mode != PAR_FULL && !colour) {
+        for (size_t b = 0; b < j.nbins && nw > 1 && pp.mode == PAR_SHARD; b++)
+            hs->count[b] += total_count(j.w, nw, b); /* worker 0's are there already */
+        for (int i = 0; i < nw; i++) {
+            tot[0] += j.w[i].plotted;
+            tot[1] += j.w[i].inside;
+        }
+        rc = par_part_sum(&pp, hs->count, j.nbins, e);
+        if (!rc)
+            rc = par_part_sum(&pp, tot, 2, e);
+        if (!rc && st) {
+            st->plotted = tot[0];
+            st->inside = tot[1];
+        }
+    } else if (!rc && pp.mode != PAR_FULL) {
+        rc = shard_sums(&pp, j.w, nw, j.nbins, colour, tot, ntot, e);
+        /* a shard's histogram is never used (its result is a partial value) */
+        for (size_t b = 0; !rc && pp.mode == PAR_MERGE && b < j.nbins; b++) {
+            hs->count[b] += tot[4 * b];
+            for (int ch = 0; ch < 3; ch++)
                 hs->csum[3 * b + ch] += (float)((double)tot[4 * b + ch + 1] / 65535.0);
         }
-        if (tot && st) {
-            st->plotted = tot[n - 2];
-            st->inside = tot[n - 1];
+        if (!rc && st) {
+            st->plotted = tot[ntot - 2];
+            st->inside = tot[ntot - 1];
         }
-        rt_free(tot);
     } else if (!rc) {
         size_t merge = j.direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
         for (size_t b = 0; b < merge; b++) {
@@ -878,6 +894,7 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         }
         fill_stats(st, j.w, nw);
     }
+    rt_free(tot);
     free_workers(j.w, nw);
     sys_free(d);
     return rc;
@@ -920,9 +937,10 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
         rc = par_part_for(&pp, "chaos game", vol_fns[maps_diagonal(d)][d->kind], &j);
     rc = finish_par(rc, j.w, nw, e);
     if (!rc && pp.mode != PAR_FULL) {
-        size_t n;
-        uint64_t *tot = shard_sums(&pp, j.w, nw, j.nbins, 0, &n, &rc, e);
-        if (tot) {
+        size_t n = j.nbins + 2;
+        uint64_t *tot = rt_calloc(n, sizeof *tot);
+        rc = tot ? shard_sums(&pp, j.w, nw, j.nbins, 0, tot, n, e) : rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
+        if (!rc) {
             uint64_t mx = 0;
             for (size_t b = 0; b < j.nbins; b++)
                 if (tot[b] > mx)

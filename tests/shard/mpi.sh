@@ -1,26 +1,36 @@
 #!/bin/sh
-# mpi.sh — the shards of tests/shard/small.frac run under `mpirun -np 3 frac
-# run --shard auto`, then merge; the files must equal the single run's
-# (tests/cli/shard_mpirun.cli). Prints "mpirun: ok N=3", or
-# "mpirun: skipped (…)" when mpirun is not installed; exits non-zero on a failure.
+# mpi.sh — the MPI recipe of docs/scale.md, read from it and run as written:
+# the shards of tests/shard/small.frac (copied as scene.frac) under
+# `mpirun --oversubscribe -np 3 frac run … --shard auto`, then merge; the
+# files must equal the single run's (tests/cli/shard_mpirun.cli). Prints
+# "mpirun: ok N=3", or "mpirun: skipped (…)" when mpirun is not installed;
+# exits non-zero on a failure.
 set -u
 frac=${FRAC:-frac}
-here=$(dirname "$0")
-s=$here/small.frac
+here=$(cd "$(dirname "$0")" && pwd)
 if ! command -v mpirun >/dev/null 2>&1; then
     echo "mpirun: skipped (mpirun is not installed; Debian: apt-get install openmpi-bin)"
     exit 0
 fi
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-mpi-XXXXXX") || exit 1
 trap 'rm -rf "$tmp"' EXIT
-fracpath=$(command -v "$frac")
-"$frac" -q -o "$tmp/single" "$s" || exit 1
-# Open MPI refuses to run as root unless told; --oversubscribe: more ranks than cores
-OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
-    mpirun --oversubscribe -np 3 "$fracpath" run -q --threads 1 --shard auto -o "$tmp/p" "$s" ||
-    { echo "mpirun: FAIL (mpirun exited $?)"; exit 1; }
-"$frac" merge -q -o "$tmp/m" "$s" "$tmp/p"/*.part || { echo "mpirun: FAIL (merge)"; exit 1; }
+# the recipe calls `frac`: the one under test, first on PATH
+bin=$(mktemp -d "$tmp/bin-XXXXXX") && ln -s "$(command -v "$frac")" "$bin/frac" || exit 1
+PATH=$bin:$PATH
+export PATH
+cp "$here/small.frac" "$tmp/scene.frac" && cd "$tmp" || exit 1
+frac -q -o single scene.frac || exit 1
+# Open MPI refuses to run as root unless told so (docs/scale.md)
+if [ "$(id -u)" = 0 ]; then
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+    export OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
+fi
+# the recipe: the sh block after the marker naming this file in docs/scale.md
+awk '/tests\/shard\/mpi.sh runs these/ { on = 1; next } on && /^```sh/ { inb = 1; next }
+     inb && /^```/ { exit } inb { print }' "$here/../../docs/scale.md" >recipe.sh
+grep -q '^mpirun ' recipe.sh || { echo "mpirun: FAIL (no mpirun recipe in docs/scale.md)"; exit 1; }
+sh -e recipe.sh >recipe.out 2>&1 || { echo "mpirun: FAIL (the recipe: $(tail -n 3 recipe.out))"; exit 1; }
 for f in a.png b.pfm; do
-    cmp -s "$tmp/single/$f" "$tmp/m/$f" || { echo "mpirun: FAIL ($f differs)"; exit 1; }
+    cmp -s "single/$f" "out/$f" || { echo "mpirun: FAIL ($f differs)"; exit 1; }
 done
-echo "mpirun: ok N=$(ls "$tmp/p" | wc -l)"
+echo "mpirun: ok N=$(ls parts | wc -l), the recipe of docs/scale.md"
