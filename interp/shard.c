@@ -1170,9 +1170,9 @@ int shard_skip_save(interp *I)
 
 /* ---- for the fuzz harness ------------------------------------------------------------ */
 
-int shard_check_parts(shard *s, interp *I, uint64_t script_hash)
+int shard_check_parts(shard *s, interp *I, const unsigned char script_hash[32])
 {
     s->I = I;
-    s->hash = script_hash;
+    memcpy(s->hash, script_hash, 32);
     return merge_open(s);
 }

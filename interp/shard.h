@@ -103,9 +103,9 @@ int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned 
 int shard_attempt_end(shard *s, int ok, const char *script);
 
 /* Merge's check of every part (set up by shard_init_merge) against a script
- * whose FNV-1a hash is given, without a script: for tests/fuzz/fuzz_shard.c.
+ * whose SHA-256 is given, without a script: for tests/fuzz/fuzz_shard.c.
  * 0, or -1 with the error in I; shard_attempt_end(s, 0, "") frees. */
-int shard_check_parts(shard *s, interp *I, uint64_t script_hash);
+int shard_check_parts(shard *s, interp *I, const unsigned char script_hash[32]);
 
 /* The evaluator's hooks (eval.c), cheap when s has no partial values. */
 int shard_scan_args(interp *I, const char *builtin_name, const node *call, const value *pos, int npos,

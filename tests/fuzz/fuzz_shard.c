@@ -7,7 +7,7 @@
  * mutations reach the record checks: the header CRC and every record's
  * CRC are recomputed where the structure allows. The script hash the parts
  * are checked against is the one in the first part's header (an input
- * whose length is 63 mod 64 uses that hash + 1, so "made from another
+ * whose length is 63 mod 64 flips its low bit, so "made from another
  * script" is reached too); the seed is 1, with no -D params. The parts are handed over as
  * memory files (memfd, /proc/self/fd/N), so nothing touches the disk.
  *
@@ -69,16 +69,17 @@ static int skip_str(const unsigned char *d, size_t n, size_t *pos)
     return 0;
 }
 
-/* The layout of interp/shard.c (docs/scale.md): header fields, then its
- * CRC; records "REC " + 76 bytes of head + payload, then a CRC of head and
- * payload. Repairs in place; *hash gets the header's script hash. */
-static void repair(unsigned char *d, size_t n, uint64_t *hash)
+/* The layout of interp/shard.c, part format 2 (docs/scale.md): header
+ * fields, then its CRC; records "REC " + 76 bytes of head + payload, then a
+ * CRC of head and payload; the end ("END ", counts, the files read), then
+ * its CRC. Repairs in place; hash gets the header's script hash. */
+static void repair(unsigned char *d, size_t n, unsigned char hash[32])
 {
     size_t pos = 12; /* "FRACPART", format */
-    if (n < pos || skip_str(d, n, &pos) || skip_str(d, n, &pos) || n - pos < 20)
+    if (n < pos || skip_str(d, n, &pos) || skip_str(d, n, &pos) || n - pos < 32 + 8 + 4 + 32)
         return;
-    *hash = le64(d + pos);
-    pos += 20; /* hash, seed, frame */
+    memcpy(hash, d + pos, 32);
+    pos += 32 + 8 + 4 + 32; /* hash, seed, frames flag, frame and range */
     if (skip_str(d, n, &pos) || n - pos < 12)
         return;
     pos += 8; /* index, count */
@@ -92,6 +93,17 @@ static void repair(unsigned char *d, size_t n, uint64_t *hash)
         put_le32(d + end, deflate_crc32(0, d + pos, end - pos));
         pos = end + 4;
     }
+    if (n - pos < 16 || memcmp(d + pos, "END ", 4))
+        return;
+    size_t e = pos + 16;
+    uint32_t files = le32(d + pos + 12);
+    for (uint32_t f = 0; f < files; f++) {
+        if (skip_str(d, n, &e) || n - e < 32)
+            return;
+        e += 32;
+    }
+    if (n - e >= 4)
+        put_le32(d + e, deflate_crc32(0, d + pos, e - pos));
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -110,12 +122,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!copy)
         return 0;
     memcpy(copy, data, size);
-    uint64_t hash = 0;
+    unsigned char hash[32] = {0};
     for (int i = 0; i < k; i++) {
-        uint64_t h = 0;
-        repair(copy + at[i], at[i + 1] - at[i], &h);
-        if (i == 0)
-            hash = h + (size % 64 == 63);
+        unsigned char h[32] = {0};
+        repair(copy + at[i], at[i + 1] - at[i], h);
+        if (i == 0) {
+            memcpy(hash, h, 32);
+            hash[0] ^= (unsigned char)(size % 64 == 63);
+        }
         size_t len = at[i + 1] - at[i];
         if (ftruncate(fds[i], 0) || pwrite(fds[i], copy + at[i], len, 0) != (ssize_t)len) {
             perror("memfd");
