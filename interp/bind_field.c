@@ -621,8 +621,11 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
         return -1;
     w = (int)sz[0];
     h = (int)sz[1];
-    if (lang_get_camera(I, a[1], &cam, "raymarch") || lang_get_box(I, a[3], a[4], o.lo, o.hi, "raymarch"))
+    if ((a[1].k != V_NIL && lang_get_camera(I, a[1], &cam, "raymarch")) ||
+        lang_get_box(I, a[3], a[4], o.lo, o.hi, "raymarch"))
         return -1;
+    if (a[1].k == V_NIL && camera_frame_box(&cam, o.lo, o.hi, w, h, 30, 20, 40)) /* the one default framing */
+        return err_at(I, NULL, ERR_VALUE, "raymarch: cannot frame the box");
     /* declared: mode str{emission,solid}, sigma num>0, step num>0 */
     o.mode = strcmp(AS_STR(a[5])->s, "solid") == 0 ? RM_SOLID : RM_EMISSION;
     o.threshold = a[6].u.n;
@@ -714,7 +717,7 @@ static const bparam p_sample[] = {{"field", "num|field", NULL}, {"grid", TY_GRID
 static const bparam p_iso[] = {{"field", "num|field|volume", NULL}, {"level", "num", "0.5"}, {"grid", TY_GRID3, "64"},
                                {"lo", "vec3", "[-1, -1, -1]"},       {"hi", "vec3", "[1, 1, 1]"},
                                {"colour", "num|field|volume", "nil"}, {"palette", "list", "nil"}};
-static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", TY_CAMERA, "orbit()"},
+static const bparam p_rm[] = {{"field", "num|field|volume", NULL}, {"camera", TY_CAMERA "|nil", "nil"},
                               {"size", TY_SIZE, "[256, 256]"},   {"lo", "vec3", "[-1, -1, -1]"},
                               {"hi", "vec3", "[1, 1, 1]"},         {"mode", "str{emission,solid}", "\"emission\""},
                               {"threshold", "num", "0.5"},         {"sigma", "num>0", "8"},
@@ -747,7 +750,7 @@ static const builtin field_builtins[] = {
     BUILTIN("isosurface", b_isosurface, p_iso,
             "A closed triangle mesh of {field = level} (marching cubes, asymptotic decider), from a field over a grid or from a volume; optional vertex colours from another field through a palette."),
     BUILTIN("raymarch", b_raymarch, p_rm,
-            "Render a field or volume with a camera: mode \"emission\" (density as opacity, extinction sigma) or \"solid\" (surfaces where density >= threshold)."),
+            "Render a field or volume with a camera (default: the box lo..hi framed as by framing()): mode \"emission\" (density as opacity, extinction sigma) or \"solid\" (surfaces where density >= threshold)."),
 };
 
 int bind_field_init(interp *I)

@@ -500,7 +500,7 @@ static int b_textured(interp *I, value *a, int n, value *out)
     camera cam;
     int w, h;
     ramp r;
-    if (lang_get_camera(I, a[2], &cam, W) || lang_arg_size2(I, a[3], &w, &h, "textured: size") ||
+    if ((a[2].k != V_NIL && lang_get_camera(I, a[2], &cam, W)) || lang_arg_size2(I, a[3], &w, &h, "textured: size") ||
         lang_get_ramp(I, a[4], &r, "textured: palette") || get_vec3(I, a[7], s.center, "textured: center") ||
         get_vec3(I, a[10], s.normal, "textured: normal"))
         return -1;
@@ -509,6 +509,14 @@ static int b_textured(interp *I, value *a, int n, value *out)
     rt_error e;
     if (texobj_shape_check(&s, &e))
         return err_at(I, NULL, ERR_VALUE, "textured: %s", e.msg);
+    if (a[2].k == V_NIL) {
+        /* the one default framing, of the object's bounding sphere (a plane: the disc of `radius`) */
+        double br = s.kind == TEXOBJ_CUBE ? s.radius * sqrt(3.0)
+                   : s.kind == TEXOBJ_CYLINDER ? sqrt(s.radius * s.radius + 0.25 * s.height * s.height)
+                                               : s.radius;
+        if (camera_frame_sphere(&cam, s.center, br, w, h, 30, 20, 40))
+            return err_at(I, NULL, ERR_VALUE, "textured: cannot frame the object");
+    }
     texobj_opts o;
     texobj_opts_default(&o);
     if (get_vec3(I, a[11], o.light, "textured: light"))
@@ -609,7 +617,7 @@ static const bparam p_perturb[] = {{"base", "num|field|volume", NULL}, {"fluct",
                                    {"axis", TY_AXIS3, "\"z\""},        {"origin", "vec3", "[0, 0, 0]"}};
 static const bparam p_textured[] = {
     {"texture", "num|field|volume", NULL}, {"object", "str{sphere,cube,cylinder,plane}", "\"sphere\""},
-    {"camera", TY_CAMERA, "orbit()"},      {"size", TY_SIZE, "[256, 256]"},  {"palette", "list", "nil"},
+    {"camera", TY_CAMERA "|nil", "nil"}, {"size", TY_SIZE, "[256, 256]"},  {"palette", "list", "nil"},
     {"lo", "num", "0"},                    {"hi", "num", "1"},               {"center", "vec3", "[0, 0, 0]"},
     {"radius", "num", "1"},                {"height", "num", "2"},           {"normal", "vec3", "[0, 0, 1]"},
     {"light", "vec3", "[1, 1, 1]"},        {"ambient", "num[0,1]", "0.2"},   {"diffuse", "num[0,1]", "0.8"},
@@ -638,7 +646,8 @@ static const builtin solid_builtins[] = {
             "The perturbation P' = F(P, D(P)) of any base field: mode \"linear\" moves P by k D along axis "
             "(eq. (7) for \"z\"), \"radial\" away from the line through origin along axis."),
     BUILTIN("textured", b_textured, p_textured,
-            "An image of a sphere, cube, cylinder or plane cut out of a solid texture, seen by a camera: the "
+            "An image of a sphere, cube, cylinder or plane cut out of a solid texture, seen by a camera (default: "
+            "the object's bounding sphere framed as by framing(); a plane: the disc of radius): the "
             "texture is evaluated only at the visible surface points, mapped from lo..hi through the palette, "
             "and shaded by one directional light."),
     BUILTIN("slice_plane", b_slice_plane, p_slice_plane,

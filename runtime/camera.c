@@ -89,18 +89,16 @@ int camera_project(const camera *c, int w, int h, const double p[3], double *sx,
     return 0;
 }
 
-int camera_frame_box(camera *c, const double lo[3], const double hi[3], int w, int h, double az, double el,
-                     double fov)
+int camera_frame_sphere(camera *c, const double ctr[3], double r, int w, int h, double az, double el, double fov)
 {
-    double ctr[3], r = 0, far = 0;
+    double far = 0;
     for (int i = 0; i < 3; i++) {
-        if (!isfinite(lo[i]) || !isfinite(hi[i]))
+        if (!isfinite(ctr[i]))
             return -1;
-        ctr[i] = 0.5 * (lo[i] + hi[i]);
-        r += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
         far += ctr[i] * ctr[i];
     }
-    r = sqrt(r);
+    if (!isfinite(r))
+        return -1;
     if (!(r > 0))
         r = fmax(1.0, 1e-3 * sqrt(far));
     if (!(fov > 0 && fov < 179))
@@ -110,4 +108,17 @@ int camera_frame_box(camera *c, const double lo[3], const double hi[3], int w, i
         half = atan(tan(half) * w / h); /* the horizontal half-angle is the smaller */
     camera_orbit(c, ctr, 1.05 * r / sin(half), az, el, fov);
     return camera_setup(c);
+}
+
+int camera_frame_box(camera *c, const double lo[3], const double hi[3], int w, int h, double az, double el,
+                     double fov)
+{
+    double ctr[3], r = 0;
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(lo[i]) || !isfinite(hi[i]))
+            return -1;
+        ctr[i] = 0.5 * (lo[i] + hi[i]);
+        r += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
+    }
+    return camera_frame_sphere(c, ctr, sqrt(r), w, h, az, el, fov);
 }

@@ -35,9 +35,10 @@ void camera_ray(const camera *c, int w, int h, double sx, double sy, double dir[
 int camera_project(const camera *c, int w, int h, const double p[3], double *sx, double *sy, double *z);
 
 /* The one default framing of every renderer (view, rasterize, chaos_fset in
- * 3-D, the REPL's previews): an orbit camera (camera_orbit's azimuth az and
- * elevation el, vertical field of view fov degrees) looking at the centre of
- * the box [lo, hi], from the distance at which the box's bounding sphere,
+ * 3-D, raymarch (its box lo..hi), textured (camera_frame_sphere), the REPL's
+ * previews): an orbit camera (camera_orbit's azimuth az and elevation el,
+ * vertical field of view fov degrees) looking at the centre of the box
+ * [lo, hi], from the distance at which the box's bounding sphere,
  * widened by 5 %, fits inside both the vertical and the horizontal field of
  * view of a w × h image: dist = 1.05 r / sin(min(fov_v, fov_h) / 2). Every
  * point of the box then projects inside the image, at least
@@ -47,5 +48,11 @@ int camera_project(const camera *c, int w, int h, const double p[3], double *sx,
  * larger). Returns -1 if a corner is not finite, 0 otherwise. */
 int camera_frame_box(camera *c, const double lo[3], const double hi[3], int w, int h, double az, double el,
                      double fov);
+
+/* The same framing for an object known by a bounding sphere (centre ctr,
+ * radius r; r <= 0 as a box of zero size): camera_frame_box frames its box's
+ * bounding sphere through this, so both share the one formula. textured()
+ * frames its object's sphere with it. Returns -1 if ctr or r is not finite. */
+int camera_frame_sphere(camera *c, const double ctr[3], double r, int w, int h, double az, double el, double fov);
 
 #endif

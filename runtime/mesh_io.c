@@ -517,6 +517,194 @@ rt_code mio_obj_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
     return reader_oom(m, e);
 }
 
+/* ---- STL: pieces apart again ----
+ * Welding equal positions also joins separate closed pieces that touch (the
+ * K_n of a function set): an edge where two pieces meet gets four
+ * triangles. So after welding, the triangles are grouped into pieces by
+ * their edges, and each piece gets its own copies of the vertices it shares
+ * with another. An edge of two triangles joins them. At an edge (a, b) of
+ * more triangles the pairs are found by turning about it: each triangle
+ * wound a→b closes, with the first triangle wound b→a met when turning from
+ * it into its inside (the side its normal points away from), the wedge of
+ * one piece's solid; each b→a triangle closes one wedge. (Two pieces sharing
+ * a face give two coincident triangles of opposite winding; each stays with
+ * its own piece. A piece given twice ties: the nearer triangle in the file
+ * wins.) A mesh
+ * whose vertices all lie on one edge-connected piece comes back unchanged. */
+
+typedef struct edge_use {
+    uint32_t lo, hi; /* the undirected edge, lo < hi */
+    uint32_t use;    /* 3 t + k: corner k of triangle t starts it */
+} edge_use;
+
+static int edge_use_cmp(const void *pa, const void *pb)
+{
+    const edge_use *a = pa, *b = pb;
+    if (a->lo != b->lo)
+        return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi)
+        return a->hi < b->hi ? -1 : 1;
+    return a->use < b->use ? -1 : a->use > b->use;
+}
+
+static uint32_t uf_find(uint32_t *parent, uint32_t t)
+{
+    while (parent[t] != t) {
+        parent[t] = parent[parent[t]];
+        t = parent[t];
+    }
+    return t;
+}
+
+static void uf_join(uint32_t *parent, uint32_t a, uint32_t b)
+{
+    a = uf_find(parent, a);
+    b = uf_find(parent, b);
+    if (a != b)
+        parent[a > b ? a : b] = a < b ? a : b; /* the smaller index is the root: deterministic */
+}
+
+/* the pairs at one edge of n >= 3 uses (see above) */
+static void join_around_edge(const mesh *m, const edge_use *u, size_t n, unsigned char *taken, uint32_t *parent)
+{
+    const float *pa = m->pos + 3 * (size_t)u[0].lo, *pb = m->pos + 3 * (size_t)u[0].hi;
+    double ax[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+    double len = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    if (!(len > 0))
+        return;
+    for (int i = 0; i < 3; i++)
+        ax[i] /= len;
+    /* e1 ⊥ ax, e2 = ax × e1: angles about ax increase from e1 toward e2 */
+    int k0 = fabs(ax[0]) < fabs(ax[1]) ? (fabs(ax[0]) < fabs(ax[2]) ? 0 : 2) : (fabs(ax[1]) < fabs(ax[2]) ? 1 : 2);
+    double e1[3] = {0, 0, 0}, e2[3];
+    e1[k0] = 1;
+    double d = e1[0] * ax[0] + e1[1] * ax[1] + e1[2] * ax[2];
+    for (int i = 0; i < 3; i++)
+        e1[i] -= d * ax[i];
+    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int i = 0; i < 3; i++)
+        e1[i] /= l1;
+    e2[0] = ax[1] * e1[2] - ax[2] * e1[1];
+    e2[1] = ax[2] * e1[0] - ax[0] * e1[2];
+    e2[2] = ax[0] * e1[1] - ax[1] * e1[0];
+    for (size_t i = 0; i < n; i++) {
+        uint32_t t = u[i].use / 3, k = u[i].use % 3;
+        if (m->tri[3 * t + k] != u[i].lo) /* wound b→a: found from its partner */
+            continue;
+        /* a→b: its normal ax × w turns toward increasing angle, its inside
+         * toward decreasing: take the b→a use with the smallest turn in (0, 2π] */
+        double best = INFINITY;
+        size_t pick = n;
+        const float *pc = m->pos + 3 * (size_t)m->tri[3 * t + (k + 2) % 3];
+        double w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
+        double th = atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2], w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+        for (size_t j = 0; j < n; j++) {
+            uint32_t tj = u[j].use / 3, kj = u[j].use % 3;
+            if (m->tri[3 * tj + kj] == u[j].lo || taken[j])
+                continue;
+            const float *qc = m->pos + 3 * (size_t)m->tri[3 * tj + (kj + 2) % 3];
+            double v[3] = {qc[0] - pa[0], qc[1] - pa[1], qc[2] - pa[2]};
+            double tj_th = atan2(v[0] * e2[0] + v[1] * e2[1] + v[2] * e2[2], v[0] * e1[0] + v[1] * e1[1] + v[2] * e1[2]);
+            double turn = th - tj_th;
+            while (turn <= 0)
+                turn += 2 * 3.14159265358979323846;
+            while (turn > 2 * 3.14159265358979323846)
+                turn -= 2 * 3.14159265358979323846;
+            /* a tie: the same third vertex, a piece given twice; keep
+             * neighbours in the file together */
+            if (turn < best || (turn == best && pick < n && llabs((long long)tj - t) < llabs((long long)(u[pick].use / 3) - t))) {
+                best = turn;
+                pick = j;
+            }
+        }
+        if (pick < n) {
+            taken[pick] = 1;
+            uf_join(parent, t, u[pick].use / 3);
+        }
+    }
+}
+
+typedef struct split_slot {
+    uint64_t key; /* piece << 32 | vertex */
+    uint32_t idx; /* UINT32_MAX = empty */
+} split_slot;
+
+/* *m welded; replaced by the same triangles with one set of vertices per piece */
+static rt_code split_pieces(mesh *m, rt_error *e)
+{
+    size_t nt = m->nt, nu = 3 * nt;
+    if (nt == 0 || nt > UINT32_MAX / 3) /* uses are numbered in 32 bits */
+        return RT_OK;
+    size_t cap = 16;
+    while (cap < nu * 2)
+        cap *= 2;
+    rt_code lc = rt_check_bytes((double)nu * (sizeof(edge_use) + 1) + (double)nt * 4 + (double)cap * sizeof(split_slot) +
+                                    (double)nu * 12 + (double)nt * 12,
+                                "separating the STL's pieces", e);
+    if (lc)
+        return lc;
+    edge_use *u = rt_malloc(nu * sizeof *u);
+    uint32_t *parent = rt_malloc(nt * sizeof *parent);
+    unsigned char *taken = rt_calloc(nu, 1);
+    split_slot *tab = rt_malloc(cap * sizeof *tab);
+    mesh out;
+    mesh_init(&out, 0, 0);
+    rt_code rc = RT_OK;
+    if (!u || !parent || !taken || !tab) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory reading a mesh");
+        goto done;
+    }
+    for (size_t i = 0; i < nu; i++) {
+        uint32_t a = m->tri[i], b = m->tri[i % 3 == 2 ? i - 2 : i + 1];
+        u[i].lo = a < b ? a : b;
+        u[i].hi = a < b ? b : a;
+        u[i].use = (uint32_t)i;
+    }
+    qsort(u, nu, sizeof *u, edge_use_cmp);
+    for (size_t t = 0; t < nt; t++)
+        parent[t] = (uint32_t)t;
+    for (size_t i = 0; i < nu;) {
+        size_t j = i + 1;
+        while (j < nu && u[j].lo == u[i].lo && u[j].hi == u[i].hi)
+            j++;
+        if (j - i == 2)
+            uf_join(parent, u[i].use / 3, u[i + 1].use / 3);
+        else if (j - i > 2 && u[i].lo != u[i].hi)
+            join_around_edge(m, u + i, j - i, taken + i, parent);
+        i = j;
+    }
+    for (size_t i = 0; i < cap; i++)
+        tab[i].idx = UINT32_MAX;
+    for (size_t t = 0; t < nt && !out.failed; t++) {
+        uint32_t piece = uf_find(parent, (uint32_t)t), v[3];
+        for (int k = 0; k < 3; k++) {
+            uint64_t key = (uint64_t)piece << 32 | m->tri[3 * t + k];
+            size_t s = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 20) & (cap - 1);
+            while (tab[s].idx != UINT32_MAX && tab[s].key != key)
+                s = (s + 1) & (cap - 1);
+            if (tab[s].idx == UINT32_MAX) {
+                tab[s].key = key;
+                tab[s].idx = mesh_add_vertex(&out, m->pos + 3 * (size_t)m->tri[3 * t + k], NULL, NULL);
+            }
+            v[k] = tab[s].idx;
+        }
+        mesh_add_tri(&out, v[0], v[1], v[2]);
+    }
+    rc = reader_oom(&out, e);
+done:
+    rt_free(u);
+    rt_free(parent);
+    rt_free(taken);
+    rt_free(tab);
+    if (rc) {
+        mesh_free(&out);
+        return rc;
+    }
+    mesh_free(m);
+    *m = out;
+    return RT_OK;
+}
+
 /* Weld table: bit patterns of positions -> vertex index. */
 typedef struct weld_slot {
     uint32_t key[3];
@@ -571,7 +759,8 @@ rt_code mio_stl_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
         mesh_add_tri(m, v[0], v[1], v[2]);
     }
     rt_free(tab);
-    return reader_oom(m, e);
+    rt_code rc = reader_oom(m, e);
+    return rc ? rc : split_pieces(m, e);
 }
 
 rt_code mio_load(const char *path, mesh *m, rt_error *e)

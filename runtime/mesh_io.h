@@ -19,7 +19,11 @@
  *   timestamp), uint32 count, then per triangle the unit facet normal
  *   (right-hand rule; zero for a degenerate triangle), three vertices and a
  *   zero uint16. The reader welds bit-identical positions back into shared
- *   vertices, so a closed mesh stays closed; ASCII STL is refused.
+ *   vertices, so a closed mesh stays closed, then gives each edge-connected
+ *   piece its own vertices again (closed pieces that touch at an edge, a
+ *   face or a corner, like a function set's K_n, come back apart: at an edge
+ *   of more than two triangles each triangle pairs with the next one met
+ *   turning about the edge into its inside); ASCII STL is refused.
  *
  * Every file is written through fileio_write_atomic.
  */

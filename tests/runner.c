@@ -1007,7 +1007,10 @@ static void run_fail_alloc(const char *frac, const char *script)
  * tests/tools/NAME.py scripts, run as `/usr/bin/python3 tests/tools/NAME.py FRAC`.
  * tests/tools/vdb_check.py opens frac's .vdb files with the OpenVDB library
  * (Debian python3-openvdb, for /usr/bin/python3); tests/tools/mesh_check.py
- * reads the meshes of 3-D function sets with its own PLY/OBJ/STL readers. An
+ * reads the meshes of 3-D function sets with its own PLY/OBJ/STL readers;
+ * admesh_check.py, vtk_check.py and blender_check.py open frac's meshes (and
+ * a .vtk and a .vdb volume) with ADMesh, VTK and Blender (tests/tools/_meshes.py
+ * makes the meshes and works out what each must show). An
  * exit 77 (a module or python missing) prints its "skipped: …" line and
  * counts neither way. */
 static void run_py_check(const char *frac, const char *name)
@@ -1369,6 +1372,9 @@ int main(int argc, char **argv)
     }
     run_py_check(fracabs, "vdb_check.py");
     run_py_check(fracabs, "mesh_check.py");   /* 3-D function sets' meshes: own PLY/OBJ/STL readers */
+    run_py_check(fracabs, "admesh_check.py"); /* STL meshes opened by ADMesh */
+    run_py_check(fracabs, "vtk_check.py");    /* PLY/OBJ/STL meshes and a .vtk volume read by VTK */
+    run_py_check(fracabs, "blender_check.py"); /* meshes and a .vdb imported by Blender (optional) */
     run_py_check(fracabs, "frames_check.py"); /* --frames from outside: frame identity, tty progress */
     run_py_check(fracabs, "apng_check.py");   /* APNG: own decoder, pngcheck, PIL, apngdis */
     run_py_check(fracabs, "watch_check.py");  /* frac watch in the background: edits, cancel, Ctrl-C */

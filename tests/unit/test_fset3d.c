@@ -1,7 +1,7 @@
 /* test_fset3d.c — 3-D function sets (seed 003 §3-4): iterating a mesh
  * (fset_iterate_mesh), orienting polyhedra (mesh_orient_outward), the 3-D
  * chaos game through a camera (fset_chaos_view, fset_chaos_box) and the one
- * default framing (camera_frame_box). Expected values are worked by hand. */
+ * default framing (camera_frame_box, camera_frame_sphere). Expected values are worked by hand. */
 #include <string.h>
 
 #include "camera.h"
@@ -133,6 +133,40 @@ int main(void)
           "a point is framed as a unit sphere");
     double bad[3] = {0, NAN, 0};
     CHECK(camera_frame_box(&cam, bad, pt, 10, 10, 0, 0, 40) == -1, "non-finite box refused");
+
+    /* camera_frame_sphere: the box's framing is that of its bounding sphere
+     * (the same camera, bit for bit); a sphere's outline, where the ray from
+     * the eye grazes it, reaches tan(asin(sin θ / 1.05)) / tan θ of the
+     * half-height exactly (0.947 at θ = 20°) */
+    camera cs;
+    double ctr[3], rr = 0;
+    for (int i = 0; i < 3; i++) {
+        ctr[i] = 0.5 * (blo[i] + bhi[i]);
+        rr += 0.25 * (bhi[i] - blo[i]) * (bhi[i] - blo[i]);
+    }
+    rr = sqrt(rr); /* 2.5144, half the diagonal */
+    CHECK(camera_frame_box(&cam, blo, bhi, 64, 48, 30, 20, 40) == 0 &&
+              camera_frame_sphere(&cs, ctr, rr, 64, 48, 30, 20, 40) == 0 && memcmp(&cam, &cs, sizeof cam) == 0,
+          "frame_box = frame_sphere of its bounding sphere");
+    double sc[3] = {0.3, -1, 2}, sr = 0.6;
+    CHECK(camera_frame_sphere(&cs, sc, sr, 80, 60, 30, 20, 40) == 0, "frame a sphere");
+    double d = 0;
+    for (int i = 0; i < 3; i++)
+        d += (cs.eye[i] - sc[i]) * (cs.eye[i] - sc[i]);
+    d = sqrt(d);
+    CHECK_NEAR(d, 1.05 * sr / sin(20 * PI / 180), 1e-12, "distance 1.05 r / sin 20°");
+    /* the topmost grazing point: from the centre along upv by r·cos(a), back
+     * toward the eye by r·sin(a), where sin(a) = r / d */
+    double sa = sr / d, ca = sqrt(1 - sa * sa), top[3], sx, sy, z;
+    for (int i = 0; i < 3; i++)
+        top[i] = sc[i] + sr * ca * cs.upv[i] - sr * sa * cs.fwd[i];
+    CHECK(camera_project(&cs, 80, 60, top, &sx, &sy, &z) == 0, "in front");
+    CHECK_NEAR(1 - 2 * sy / 60, tan(asin(sin(20 * PI / 180) / 1.05)) / tan(20 * PI / 180), 1e-12, "outline at 0.947");
+    CHECK(camera_frame_sphere(&cs, sc, INFINITY, 80, 60, 30, 20, 40) == -1 &&
+              camera_frame_sphere(&cs, bad, 1, 80, 60, 30, 20, 40) == -1,
+          "non-finite centre or radius refused");
+    CHECK(camera_frame_sphere(&cs, pt, 0, 10, 10, 0, 0, 40) == 0 && fabs(cs.eye[2] - 5 - 1.05 / sin(20 * PI / 180)) < 1e-9,
+          "radius 0 is framed as a unit sphere");
     mesh_free(&cube);
     return check_done("test_fset3d");
 }

@@ -281,6 +281,96 @@ static void test_obj_early_error_initialises(void)
     }
 }
 
+/* unit cubes wound outward at the given corners (lower corners) */
+static void cubes(mesh *m, const float (*at)[3], int n)
+{
+    static const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    mesh_init(m, 0, 0);
+    for (int c = 0; c < n; c++) {
+        uint32_t base = (uint32_t)m->nv;
+        for (int i = 0; i < 8; i++) {
+            float p[3] = {at[c][0] + (float)(i & 1), at[c][1] + (float)((i >> 1) & 1), at[c][2] + (float)((i >> 2) & 1)};
+            mesh_add_vertex(m, p, NULL, NULL);
+        }
+        for (int f = 0; f < 6; f++) {
+            mesh_add_tri(m, base + q[f][0], base + q[f][1], base + q[f][2]);
+            mesh_add_tri(m, base + q[f][0], base + q[f][2], base + q[f][3]);
+        }
+    }
+}
+
+/* STL keeps no shared vertices; the reader welds equal positions and then
+ * gives each edge-connected piece its own vertices again, so closed pieces
+ * that touch (along an edge, a whole face, a corner) or even coincide come
+ * back as the closed pieces they were: 8 vertices and Euler characteristic 2
+ * each, no non-manifold edge, the same triangles in the same order. */
+static void test_stl_pieces(void)
+{
+    static const float edge[2][3] = {{0, 0, 0}, {1, 1, 0}}, face[2][3] = {{0, 0, 0}, {1, 0, 0}},
+                       corner[2][3] = {{0, 0, 0}, {1, 1, 1}}, twice[2][3] = {{0, 0, 0}, {0, 0, 0}},
+                       four[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    const struct {
+        const float (*at)[3];
+        int n;
+        const char *what;
+        size_t welded; /* distinct positions */
+    } cases[] = {{edge, 2, "along an edge", 14}, {face, 2, "face to face", 12}, {corner, 2, "at a corner", 15},
+                 {twice, 2, "one cube given twice", 8}, {four, 4, "four in a square (a shared edge of 8 triangles)", 18}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        mesh m, r;
+        rt_error e;
+        bytebuf b;
+        bytebuf_init(&b);
+        cubes(&m, cases[k].at, cases[k].n);
+        CHECK(mio_stl_to_mem(&m, &b, &e) == RT_OK, "%s: write", cases[k].what);
+        CHECK(mio_stl_from_mem(b.data, b.len, &r, &e) == RT_OK, "%s: read: %s", cases[k].what, e.msg);
+        mesh_stats st;
+        CHECK(mesh_compute_stats(&r, &st, &e) == RT_OK, "stats");
+        CHECK(r.nv == 8 * (size_t)cases[k].n && r.nt == m.nt, "%s: %zu vertices, %zu triangles", cases[k].what, r.nv,
+              r.nt);
+        CHECK(st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.euler == 2 * cases[k].n,
+              "%s: %zu boundary, %zu non-manifold edges, Euler %ld", cases[k].what, st.boundary_edges,
+              st.nonmanifold_edges, st.euler);
+        CHECK_NEAR(st.volume, cases[k].n, 1e-9, cases[k].what);
+        int same = 1;
+        for (size_t t = 0; t < m.nt && t < r.nt; t++)
+            for (int c = 0; c < 3; c++)
+                same &= memcmp(m.pos + 3 * m.tri[3 * t + c], r.pos + 3 * r.tri[3 * t + c], 12) == 0;
+        CHECK(same, "%s: the same triangles in the same order", cases[k].what);
+        /* the distinct positions: what a reader that only welds would give */
+        size_t distinct = 0;
+        for (size_t i = 0; i < r.nv; i++) {
+            size_t j = 0;
+            while (j < i && memcmp(r.pos + 3 * j, r.pos + 3 * i, 12) != 0)
+                j++;
+            distinct += j == i;
+        }
+        CHECK(distinct == cases[k].welded, "%s: %zu distinct positions", cases[k].what, distinct);
+        /* each piece a block of 12 triangles on its own 8 vertices */
+        int apart = 1;
+        for (size_t t = 0; t < r.nt; t++)
+            for (int c = 0; c < 3; c++)
+                apart &= r.tri[3 * t + c] / 8 == t / 12;
+        CHECK(apart, "%s: each cube on its own vertices", cases[k].what);
+        mesh_free(&m);
+        mesh_free(&r);
+        bytebuf_free(&b);
+    }
+    /* one piece: the welded mesh unchanged (vertices in order of first use) */
+    mesh m, r;
+    rt_error e;
+    bytebuf b;
+    bytebuf_init(&b);
+    tet(&m, 0, 0);
+    CHECK(mio_stl_to_mem(&m, &b, &e) == RT_OK && mio_stl_from_mem(b.data, b.len, &r, &e) == RT_OK, "tet");
+    CHECK(r.nv == 4 && r.nt == 4, "tet: %zu %zu", r.nv, r.nt);
+    static const uint32_t want[12] = {0, 1, 2, 0, 2, 3, 0, 3, 1, 2, 1, 3};
+    CHECK(memcmp(r.tri, want, sizeof want) == 0, "tet: indices in order of first use");
+    mesh_free(&m);
+    mesh_free(&r);
+    bytebuf_free(&b);
+}
+
 int main(void)
 {
     test_obj_early_error_initialises();
@@ -289,5 +379,6 @@ int main(void)
     test_roundtrip();
     test_errors();
     test_declared_size();
+    test_stl_pieces();
     return check_done("test_mesh_io");
 }
