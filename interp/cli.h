@@ -45,9 +45,11 @@ typedef struct opts {
     shard *sh;         /* --shard or merge: kept across re-runs (shard.h) */
 } opts;
 
-/* SIGINT sets cli_interrupted (a second one exits 130 at once). */
+/* SIGINT sets cli_interrupted (a second one exits 130 at once, leaving no
+ * temp file); SIGTERM and SIGHUP remove temp files (fileio.h).
+ * cli_catch_signals installs both. */
 extern volatile sig_atomic_t cli_interrupted;
-void cli_on_sigint(int sig);
+void cli_catch_signals(void);
 /* Print "frac: MESSAGE" and the --help hint; returns 64. */
 __attribute__((format(printf, 1, 2))) int cli_usage_error(const char *fmt, ...);
 /* A whole number in [lo, hi] written in decimal; 0, or -1. */

@@ -222,12 +222,7 @@ int cli_run_frac(interp *I, opts *o)
     }
     if (set_overrides(I, o))
         return session_report(I);
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = cli_on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    fileio_install_signal_cleanup();
+    cli_catch_signals();
     I->interrupt = o->cancel ? o->cancel : &cli_interrupted;
 
     int check = strcmp(o->mode, "check") == 0;
@@ -386,12 +381,7 @@ static int watch_render(void *ud, volatile sig_atomic_t *cancel)
 
 int cli_run_watch(interp *T, opts *o)
 {
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = cli_on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    fileio_install_signal_cleanup();
+    cli_catch_signals();
     watch_ctx c = {T, o};
     int rc = watch_main(T, watch_render, &c, &cli_interrupted, o->show, T->quiet);
     return rc < 0 ? session_report(T) : rc;

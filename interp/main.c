@@ -123,7 +123,7 @@ static const char usage_text[] =
 
 volatile sig_atomic_t cli_interrupted;
 
-void cli_on_sigint(int sig)
+static void on_sigint(int sig)
 {
     (void)sig;
     if (cli_interrupted) { /* a second Ctrl-C stops at once, leaving no temp file */
@@ -131,6 +131,16 @@ void cli_on_sigint(int sig)
         _exit(130);
     }
     cli_interrupted = 1;
+}
+
+void cli_catch_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    fileio_install_signal_cleanup();
 }
 
 int cli_usage_error(const char *fmt, ...)

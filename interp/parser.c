@@ -422,6 +422,39 @@ static node *parse_expr(parser *p);
 static node *parse_block_until(parser *p, const token *open);
 static node *parse_lambda_rest(parser *p, const token *at, const char *name);
 
+/* The parser's line mode: inside brackets newlines are skipped; a block
+ * (do … end, a function body) reads them as statement ends; neither is in a
+ * table's rows. enter_mode sets a mode and returns the old one, which
+ * restore_mode puts back on the way out. */
+typedef struct parse_mode {
+    int skip_nl, table_mode;
+} parse_mode;
+
+static parse_mode enter_mode(parser *p, int skip_nl)
+{
+    parse_mode m = {p->skip_nl, p->table_mode};
+    p->skip_nl = skip_nl;
+    p->table_mode = 0;
+    return m;
+}
+
+static void restore_mode(parser *p, parse_mode m)
+{
+    p->skip_nl = m.skip_nl;
+    p->table_mode = m.table_mode;
+}
+
+/* enclosed -> expr CLOSE   (after the opener; newlines skipped inside) */
+static node *parse_enclosed(parser *p, tok_type close, const token *open)
+{
+    parse_mode m = enter_mode(p, 1);
+    node *e = parse_expr(p);
+    if (e)
+        expect_close(p, close, open);
+    restore_mode(p, m);
+    return p->failed ? NULL : e;
+}
+
 /* One comma-separated list, the shape every bracketed construct shares:
  *   list -> [item {',' item} [',']] CLOSE
  * (the opener is consumed by the caller). Inside it newlines are white space
@@ -432,16 +465,13 @@ typedef int (*list_item)(parser *p, void *ctx);
 
 static int parse_comma_list(parser *p, const token *open, tok_type close, list_item item, void *ctx)
 {
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 1;
-    p->table_mode = 0;
+    parse_mode m = enter_mode(p, 1);
     while (!check(p, close) && !check(p, T_EOF))
         if (item(p, ctx) || p->failed || !match(p, T_COMMA))
             break;
     if (!p->failed)
         expect_close(p, close, open);
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
+    restore_mode(p, m);
     return p->failed ? -1 : 0;
 }
 
@@ -517,15 +547,8 @@ static node *parse_postfix(parser *p, node *e)
             e = make_call(p, e, &args, t);
         } else if (t->type == T_LBRACKET) {
             token *open = next(p);
-            int save_nl = p->skip_nl, save_tm = p->table_mode;
-            p->skip_nl = 1;
-            p->table_mode = 0;
-            node *ix = parse_expr(p);
-            if (ix)
-                expect_close(p, T_RBRACKET, open);
-            p->skip_nl = save_nl;
-            p->table_mode = save_tm;
-            if (p->failed)
+            node *ix = parse_enclosed(p, T_RBRACKET, open);
+            if (!ix)
                 return NULL;
             e = mk2(p, N_INDEX, open, e, ix);
         } else if (t->type == T_DOT) {
@@ -699,8 +722,7 @@ static int parse_field(parser *p, void *ctx)
 static node *parse_brace(parser *p)
 {
     token *open = next(p);
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->table_mode = 0;
+    parse_mode m = enter_mode(p, p->skip_nl);
     /* look past newlines to decide between record and table */
     size_t i = p->pos;
     while (p->tl.toks[i].type == T_NEWLINE)
@@ -752,8 +774,7 @@ static node *parse_brace(parser *p)
             n->nkids = rows.n;
         }
     }
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
+    restore_mode(p, m);
     return p->failed ? NULL : n;
 }
 
@@ -917,27 +938,16 @@ static node *parse_paren(parser *p)
         return body ? make_lambda(p, t, &params, body, NULL) : NULL;
     }
     next(p);
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 1;
-    p->table_mode = 0;
-    node *e = parse_expr(p);
-    if (e)
-        expect_close(p, T_RPAREN, t);
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
-    return p->failed ? NULL : e;
+    return parse_enclosed(p, T_RPAREN, t);
 }
 
 /* doblock -> 'do' block 'end' */
 static node *parse_do(parser *p)
 {
     token *t = next(p);
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 0;
-    p->table_mode = 0;
+    parse_mode m = enter_mode(p, 0);
     node *b = parse_block_until(p, t);
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
+    restore_mode(p, m);
     if (b && expect_close(p, T_END, t))
         return NULL;
     return b;
@@ -947,12 +957,9 @@ static node *parse_do(parser *p)
 static node *parse_fn_expr(parser *p)
 {
     token *t = next(p);
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 0;
-    p->table_mode = 0;
+    parse_mode m = enter_mode(p, 0);
     node *l = parse_lambda_rest(p, t, NULL);
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
+    restore_mode(p, m);
     return l;
 }
 
@@ -1249,9 +1256,7 @@ static node *parse_statement(parser *p)
  * or end of input. */
 static node *parse_block_until(parser *p, const token *open)
 {
-    int save_nl = p->skip_nl, save_tm = p->table_mode;
-    p->skip_nl = 0;
-    p->table_mode = 0;
+    parse_mode m = enter_mode(p, 0);
     node *b = mk(p, N_BLOCK, open ? open : &p->tl.toks[0]);
     nodevec stmts = {0};
     for (;;) {
@@ -1275,8 +1280,7 @@ static node *parse_block_until(parser *p, const token *open)
             break;
         }
     }
-    p->skip_nl = save_nl;
-    p->table_mode = save_tm;
+    restore_mode(p, m);
     if (p->failed || !b)
         return NULL;
     b->kids = stmts.v;
