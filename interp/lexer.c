@@ -9,11 +9,12 @@
 static const struct {
     const char *word;
     tok_type type;
+    int len; /* strlen(word) */
 } keywords[] = {
-    {"let", T_LET},   {"param", T_PARAM}, {"fn", T_FN},     {"import", T_IMPORT}, {"as", T_AS},
-    {"if", T_IF},     {"then", T_THEN},   {"else", T_ELSE}, {"elif", T_ELIF},     {"do", T_DO},
-    {"end", T_END},   {"for", T_FOR},     {"in", T_IN},     {"and", T_AND},       {"or", T_OR},
-    {"not", T_NOT},   {"true", T_TRUE},   {"false", T_FALSE}, {"nil", T_NIL},
+    {"let", T_LET, 3},   {"param", T_PARAM, 5}, {"fn", T_FN, 2},     {"import", T_IMPORT, 6}, {"as", T_AS, 2},
+    {"if", T_IF, 2},     {"then", T_THEN, 4},   {"else", T_ELSE, 4}, {"elif", T_ELIF, 4},     {"do", T_DO, 2},
+    {"end", T_END, 3},   {"for", T_FOR, 3},     {"in", T_IN, 2},     {"and", T_AND, 3},       {"or", T_OR, 2},
+    {"not", T_NOT, 3},   {"true", T_TRUE, 4},   {"false", T_FALSE, 5}, {"nil", T_NIL, 3},
 };
 
 const char *lex_name(tok_type t)
@@ -174,8 +175,10 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             t.len = (int)(p - t.start);
             t.type = T_IDENT;
             for (size_t i = 0; i < sizeof keywords / sizeof keywords[0]; i++)
-                if ((int)strlen(keywords[i].word) == t.len && memcmp(keywords[i].word, t.start, (size_t)t.len) == 0)
+                if (keywords[i].len == t.len && memcmp(keywords[i].word, t.start, (size_t)t.len) == 0) {
                     t.type = keywords[i].type;
+                    break;
+                }
         } else if (c == '"') {
             p++;
             while (*p && *p != '"' && *p != '\n') {
