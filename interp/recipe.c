@@ -257,6 +257,8 @@ static int parse_long(const char *s, size_t n, unsigned long long max, long *out
 int recipe_parse(const char *text, size_t len, recipe *r, char *err, size_t errn)
 {
     memset(r, 0, sizeof *r);
+    if (!text || len == 0) /* an empty frac:recipe chunk: no text at all */
+        return fail(r, err, errn, "the recipe is empty (no 'frac-recipe 1' line)");
     const char *p = text, *end = text + len;
     int lineno = 0, seen_script = 0, seen_seed = 0, seen_frame = 0;
     while (p < end && !seen_script) {
