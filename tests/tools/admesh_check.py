@@ -34,14 +34,7 @@ if not shutil.which("admesh"):
     print("skipped: admesh not installed (Debian admesh)")
     sys.exit(77)
 
-FRAC = os.path.abspath(sys.argv[1])
-fails = []
-
-
-def check(cond, what):
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
+from _check import FRAC, check, finish  # noqa: E402
 
 
 def field(text, name):
@@ -80,4 +73,4 @@ with tempfile.TemporaryDirectory() as tmp:
         if vol is not None and "volume_above" in f:
             check(vol > f["volume_above"], "%s.stl: volume %.6f, expected above %.6f" % (name, vol, f["volume_above"]))
 
-sys.exit(1 if fails else 0)
+finish()

@@ -28,14 +28,7 @@ import sys
 import tempfile
 import zlib
 
-FRAC = os.path.abspath(sys.argv[1])
-fails = []
-
-
-def check(cond, what):
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
+from _check import FRAC, check, finish  # noqa: E402
 
 
 def chunks(data):
@@ -271,4 +264,4 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 64 and r.stderr.startswith("frac: apng needs frames: frac apng -o OUT.png FRAME.png..."),
           "apng without frames: %r" % r.stderr)
 
-sys.exit(1 if fails else 0)
+finish()

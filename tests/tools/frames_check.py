@@ -19,14 +19,7 @@ import subprocess
 import sys
 import tempfile
 
-FRAC = os.path.abspath(sys.argv[1])
-fails = []
-
-
-def check(cond, what):
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
+from _check import FRAC, check, finish  # noqa: E402
 
 
 SCRIPT = """
@@ -94,4 +87,4 @@ with tempfile.TemporaryDirectory() as tmp:
                        text=True, timeout=60)
     check(r.returncode == 0 and "frame " not in r.stderr, "stderr not a tty: no progress lines: %r" % r.stderr)
 
-sys.exit(1 if fails else 0)
+finish()

@@ -42,14 +42,7 @@ except ImportError:
     sys.exit(77)
 
 vtk.vtkObject.GlobalWarningDisplayOff()
-FRAC = os.path.abspath(sys.argv[1])
-fails = []
-
-
-def check(cond, what):
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
+from _check import FRAC, check, finish  # noqa: E402
 
 
 def read(path):
@@ -162,4 +155,4 @@ with tempfile.TemporaryDirectory() as tmp:
                     bad += abs(v - (x + 10 * y + 100 * z)) > 1e-4
         check(sc is not None and bad == 0, "v.vtk: %d of %d values differ from x + 10y + 100z" % (bad, n[0] * n[1] * n[2]))
 
-sys.exit(1 if fails else 0)
+finish()

@@ -30,15 +30,7 @@ import tempfile
 import threading
 import time
 
-FRAC = os.path.abspath(sys.argv[1])
-fails = []
-
-
-def check(cond, what):
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
-    return cond
+from _check import FRAC, check, finish  # noqa: E402
 
 
 def write(path, text, rename=False):
@@ -185,4 +177,4 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 64 and r.stderr.startswith("frac: --show goes with `frac watch`"),
           "--show without watch: %r" % r.stderr)
 
-sys.exit(1 if fails else 0)
+finish()
