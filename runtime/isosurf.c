@@ -1189,8 +1189,21 @@ rt_code iso_from_field(rt_field_fn f, const void *ctx, const double lo[3], const
         f = neg_fn;
         ctx = &sd;
     }
-    rc = iso_sample_field(f, ctx, &vol, run, e);
+    /* The sampling is the call's split loop (par.h, docs/scale.md): one z
+     * slice a chunk. A shard samples its slices only and extracts nothing
+     * (its mesh becomes a partial value that nothing uses); merge places the
+     * shards' slices and extracts as a single run does. */
+    par_part pp;
+    rc = par_part_begin(&pp, run, "isosurface", (size_t)vol.nz, e);
     if (!rc) {
+        sample_job s = {f, ctx, &vol};
+        if (par_part_for(&pp, "sampling field", pass_sample, &s))
+            rc = rt_fail(e, RT_ECANCEL, "field sampling interrupted");
+    }
+    size_t slice = (size_t)vol.nx * (size_t)vol.ny * sizeof *vol.v;
+    if (!rc)
+        rc = par_part_rows(&pp, vol.v, slice * (size_t)vol.nz, slice, e);
+    if (!rc && pp.mode != PAR_SHARD) {
         mesh_free(out);
         rc = run_iso(&vol, opts, f, ctx, opts->sdf ? &sd : NULL, run, out, e);
     }
