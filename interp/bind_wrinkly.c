@@ -659,11 +659,15 @@ surf_obj *lang_as_surf(value v)
 
 /* Tessellate after checking the vertex count (--max-points) and the memory
  * the engine needs (--max-memory). cam may be NULL. */
-int lang_surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
-                   mesh **out, const char *what)
+/* split: the mesh is the builtin's result (tessellate), so a shard may
+ * compute its rows only (docs/scale.md); not where it feeds an engine inside
+ * the same builtin (rasterize). */
+static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
+                     int split, mesh **out, const char *what)
 {
     wrinkly_surface ws = {so->pts, so->nu, so->nv, so->au, so->av};
     wrinkly_opts o = so->style;
+    o.split = split;
     o.cam = cam;
     o.width = w;
     o.height = h;
@@ -713,6 +717,12 @@ int lang_surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int 
     return 0;
 }
 
+int lang_surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, int h, double pixel, const lod *l,
+                   mesh **out, const char *what)
+{
+    return surf_mesh(I, so, cam, w, h, pixel, l, 0, out, what);
+}
+
 static int get_camera_lod(interp *I, value cam, value tol, value iters, camera *c, int *use_cam, const char *what)
 {
     *use_cam = cam.k != V_NIL;
@@ -738,7 +748,7 @@ static int b_tessellate(interp *I, value *a, int n, value *out)
         lang_get_lod(I, a[5], a[4], a[6], 4, &l, W))
         return -1;
     mesh *m;
-    if (lang_surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, &m, W))
+    if (surf_mesh(I, so, use_cam ? &cam : NULL, w, h, a[3].u.n, &l, 1, &m, W))
         return -1;
     return lang_mesh_value(I, m, out);
 }

@@ -874,27 +874,53 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         rc = rt_fail(e, RT_EINVAL, "wrinkly surface would have %zu × %zu vertices; lower kmax", nu, nv);
         goto done;
     }
-    r = rt_malloc(rt_mul_size(nvert, 3 * sizeof(double)));
+    /* The rows of v are the call's chunks (par.h): with o->split a shard
+     * computes its rows only (and the displaced rows next to them, which
+     * their normals need); merge computes none and places the shards'. */
+    par_part pp = {run, NULL, PAR_FULL, nv, 0, nv};
+    if (o->split && (rc = par_part_begin(&pp, run, "wrinkly surface", nv, e)))
+        goto done;
+    if (pp.mode != PAR_MERGE)
+        r = rt_malloc(rt_mul_size(nvert, 3 * sizeof(double)));
     rt_free(out->nrm);
     rt_free(out->col);
     out->pos = rt_malloc(rt_mul_size(nvert, 3 * sizeof(float)));
     out->nrm = rt_malloc(rt_mul_size(nvert, 3 * sizeof(float)));
     out->col = rt_malloc(rt_mul_size(nvert, 4 * sizeof(float)));
     out->tri = rt_malloc(rt_mul_size(ntri ? ntri : 1, 3 * sizeof(uint32_t)));
-    if (!r || !out->pos || !out->nrm || !out->col || !out->tri) {
+    if ((!r && pp.mode != PAR_MERGE) || !out->pos || !out->nrm || !out->col || !out->tri) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for a %zu-vertex wrinkly mesh", nvert);
         goto done;
     }
     out->nv = out->cap_v = nvert;
     out->nt = out->cap_t = ntri;
     surf_job J = {s, o, su, sv, nu, nv, s->au.cyclic, s->av.cyclic, r, out, side};
-    rc = par_for(run, "wrinkly surface", nv, surf_row, &J);
+    if (pp.mode == PAR_SHARD) {
+        /* the other shards' rows: never used, but not left undefined */
+        memset(out->pos, 0, nvert * 3 * sizeof(float));
+        memset(out->nrm, 0, nvert * 3 * sizeof(float));
+        memset(out->col, 0, nvert * 4 * sizeof(float));
+    }
+    rc = par_part_for(&pp, "wrinkly surface", surf_row, &J);
+    if (!rc && pp.mode == PAR_SHARD && pp.hi > pp.lo) {
+        /* the neighbour rows of the range, for the central differences */
+        size_t below = pp.lo > 0 ? pp.lo - 1 : J.cyc_v ? nv - 1 : nv;
+        size_t above = pp.hi < nv ? pp.hi : J.cyc_v ? 0 : nv;
+        if (below < nv && (below < pp.lo || below >= pp.hi))
+            surf_row(&J, below, 0);
+        if (above < nv && above != below && (above < pp.lo || above >= pp.hi))
+            surf_row(&J, above, 0);
+    }
     if (!rc)
-        rc = par_for(run, "wrinkly normals", nv, surf_normals, &J);
+        rc = par_part_for(&pp, "wrinkly normals", surf_normals, &J);
     if (rc) {
         rt_fail(e, rc, "wrinkly surface interrupted");
         goto done;
     }
+    if ((rc = par_part_rows(&pp, out->pos, nvert * 3 * sizeof(float), nu * 3 * sizeof(float), e)) ||
+        (rc = par_part_rows(&pp, out->nrm, nvert * 3 * sizeof(float), nu * 3 * sizeof(float), e)) ||
+        (rc = par_part_rows(&pp, out->col, nvert * 4 * sizeof(float), nu * 4 * sizeof(float), e)))
+        goto done;
     size_t t = 0;
     for (size_t j = 0; j < qv; j++)
         for (size_t i = 0; i < qu; i++) {

@@ -112,6 +112,8 @@ typedef struct wrinkly_opts {
     uint64_t seed;
     double crack_band;      /* 0: off; else half-width of the blend band at joints */
     int normal;             /* surfaces: WRINKLY_NORMAL_* (which side N and the heights face) */
+    int split;              /* surfaces: the mesh is the builtin's result, so its rows may be split
+                             * across shards (par.h; 0: always computed in full) */
 } wrinkly_opts;
 
 /* Orientation of a surface's normal N (and so of its heights and winding).
