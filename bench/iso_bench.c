@@ -3,9 +3,11 @@
  *
  * Reports, best of R runs each:
  *   - field sampling of an n³ grid, and the marching-cubes extractor on it,
- *     for n = 128 and 256, with 1 and 2 threads, against the previous
- *     extractor (marching tetrahedra, bench/iso_tet_ref.inc) and a plain
- *     marching-cubes loop (below: unwelded triangle soup, one thread);
+ *     for n = 128 and 256, with 1 and 2 threads, against VTK's
+ *     vtkFlyingEdges3D on the same samples (one thread, bench/iso_vtk.py,
+ *     when python3-vtk9 is installed), a plain marching-cubes loop (below:
+ *     unwelded triangle soup, one thread) and, with the argument `tets`,
+ *     the previous extractor (marching tetrahedra, bench/iso_tet_ref.inc);
  *   - ray marching a 512² image (emission–absorption with lighting, and the
  *     thresholded solid) with 1 and 2 threads;
  * with ratios against plain C baseline loops run in the same process:
@@ -14,16 +16,21 @@
  *   - raymarch: the same number of field evaluations as the render made,
  *     in a plain loop over points (no blocks, no compositing).
  *
- *   build/bench/iso_bench [runs] [iso|rm]
+ *   build/bench/iso_bench [runs] [iso|rm|all] [tets]
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
+#include "fileio.h"
 #include "isosurf.h"
 #include "raymarch.h"
 
@@ -155,10 +162,83 @@ static size_t baseline_scan(const volume *v, float level)
     return c;
 }
 
+/* CPU seconds of the whole process (all threads). */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* VTK's vtkFlyingEdges3D, one thread, on the same samples: v is written to a
+ * temporary file that bench/iso_vtk.py (found beside this program's source,
+ * from the current directory or from argv[0]) reads and meshes; its line is
+ * parsed and the ratios printed. Skipped with a reason when python3-vtk9 is
+ * missing. */
+static void flying_edges(const char *argv0, const volume *v, double level, int runs, double ours_cpu,
+                         double ours_wall, double warm_cpu, double warm_wall, double first_cpu, size_t ours_nt)
+{
+    char script[4096], path[64], cmd[8192];
+    snprintf(script, sizeof script, "bench/iso_vtk.py");
+    FILE *f = fopen(script, "r");
+    if (!f) {
+        const char *sl = strrchr(argv0, '/');
+        int len = sl ? (int)(sl - argv0) : 1;
+        snprintf(script, sizeof script, "%.*s/../../bench/iso_vtk.py", len, sl ? argv0 : ".");
+        f = fopen(script, "r");
+    }
+    if (!f) {
+        printf("  FlyingEdges    skipped: bench/iso_vtk.py not found\n");
+        return;
+    }
+    fclose(f);
+    snprintf(path, sizeof path, "/tmp/frac-iso-bench-%ld.f32", (long)getpid());
+    rt_error e;
+    size_t count = (size_t)v->nx * (size_t)v->ny * (size_t)v->nz;
+    if (fileio_write_atomic(path, v->v, count * sizeof(float), &e)) {
+        printf("  FlyingEdges    skipped: %s\n", e.msg);
+        return;
+    }
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' '%s' %d %.17g %d 2>&1", script, path, v->nx, level, runs);
+    FILE *p = popen(cmd, "r");
+    char line[512] = "";
+    int ok = 0;
+    double cpu = 0, wall = 0, fe_first = 0;
+    long tris = 0, pts = 0;
+    char backend[64] = "";
+    while (p && fgets(line, sizeof line, p)) {
+        int nn;
+        if (sscanf(line, "fe %d %lf %lf %ld %ld %63s %lf", &nn, &cpu, &wall, &tris, &pts, backend, &fe_first) == 7) {
+            ok = 1;
+            break;
+        }
+        if (strncmp(line, "skipped", 7) == 0 || strncmp(line, "error", 5) == 0)
+            break;
+    }
+    if (p)
+        pclose(p);
+    unlink(path);
+    if (!ok) {
+        line[strcspn(line, "\n")] = 0;
+        printf("  FlyingEdges    skipped: %s\n", line[0] ? line : "iso_vtk.py printed nothing");
+        return;
+    }
+    printf("  VTK FlyingEdges 1 thr (%s) CPU %.3f s wall %.3f s   %ld triangles, %ld points\n", backend, cpu, wall,
+           tris, pts);
+    printf("  ours / FlyingEdges: time %.2f (1 thr CPU), %.2f (1 thr wall); triangles %.3f\n", ours_cpu / cpu,
+           ours_wall / wall, (double)ours_nt / (double)tris);
+    if (warm_cpu < 1e9)
+        printf("  ours / FlyingEdges, both on a warm heap: time %.2f (1 thr CPU), %.2f (1 thr wall)\n",
+               warm_cpu / cpu, warm_wall / wall);
+    printf("  first call of each (fresh memory): ours CPU %.3f s, FlyingEdges CPU %.3f s, ratio %.2f\n", first_cpu,
+           fe_first, first_cpu / fe_first);
+}
+
 int main(int argc, char **argv)
 {
     int runs = argc > 1 ? atoi(argv[1]) : 3;
     const char *only = argc > 2 ? argv[2] : "";
+    int tets = argc > 3 && strcmp(argv[3], "tets") == 0;
     if (runs < 1)
         runs = 1;
     rt_error e;
@@ -175,20 +255,20 @@ int main(int argc, char **argv)
         if (volume_init(&v, n, n, n, lo, hi, &e))
             return 1;
         double tsample[3] = {1e9, 1e9, 1e9}, tiso[3] = {1e9, 1e9, 1e9}, ttet[3] = {1e9, 1e9, 1e9};
-        double tbase = 1e9, tplain = 1e9;
+        double tbase = 1e9, tplain = 1e9, ciso = 1e9, cfirst = -1;
         size_t nv = 0, nt = 0, sink = 0, tet_nt = 0, plain_nt = 0;
         for (int th = 1; th <= 2; th++) {
             rt_run run = {th, NULL, 0};
             for (int r = 0; r < runs; r++) {
                 double t0 = now();
                 iso_sample_field(field, NULL, &v, &run, &e);
-                double t1 = now();
+                double t1 = now(), c1 = cpu_now();
                 mesh m;
                 if (iso_from_volume(&v, &o, &run, &m, &e)) {
                     fprintf(stderr, "%s\n", e.msg);
                     return 1;
                 }
-                double t2 = now();
+                double t2 = now(), c2 = cpu_now();
                 nv = m.nv;
                 nt = m.nt;
                 mesh_free(&m);
@@ -196,6 +276,12 @@ int main(int argc, char **argv)
                     tsample[th] = t1 - t0;
                 if (t2 - t1 < tiso[th])
                     tiso[th] = t2 - t1;
+                if (th == 1 && c2 - c1 < ciso)
+                    ciso = c2 - c1;
+                if (cfirst < 0)
+                    cfirst = c2 - c1;
+                if (!tets)
+                    continue;
                 if (tet_from_volume(&v, &o, &run, &m, &e)) {
                     fprintf(stderr, "%s\n", e.msg);
                     return 1;
@@ -207,6 +293,35 @@ int main(int argc, char **argv)
                     ttet[th] = t3 - t2;
             }
         }
+        /* The same extractor on a warm heap: glibc hands every big block of
+         * the same size to mmap again after it is freed (its dynamic threshold
+         * only rises above the sizes seen), so each run above pays one page
+         * fault per 4 KiB of output (about 15 us each on these virtual
+         * machines); VTK's repeated Update() reuses its freed blocks (no page
+         * faults after the first, measured with perf stat). Here the mmap
+         * threshold is raised so our freed blocks are reused too, then reset. */
+        double twarm = 1e9, cwarm = 1e9;
+#ifdef __GLIBC__
+        mallopt(M_MMAP_THRESHOLD, 32 << 20);
+        mallopt(M_TRIM_THRESHOLD, 256 << 20);
+        for (int r = 0; r < runs + 1; r++) {
+            rt_run run = {1, NULL, 0};
+            mesh m;
+            double t1 = now(), c1 = cpu_now();
+            if (iso_from_volume(&v, &o, &run, &m, &e)) {
+                fprintf(stderr, "%s\n", e.msg);
+                return 1;
+            }
+            double t2 = now(), c2 = cpu_now();
+            mesh_free(&m);
+            if (r && t2 - t1 < twarm) /* run 0 fills the heap */
+                twarm = t2 - t1;
+            if (r && c2 - c1 < cwarm)
+                cwarm = c2 - c1;
+        }
+        mallopt(M_MMAP_THRESHOLD, 128 << 10);
+        mallopt(M_TRIM_THRESHOLD, 128 << 10);
+#endif
         pm_table();
         float *soup = NULL;
         size_t cap = 0;
@@ -228,13 +343,17 @@ int main(int argc, char **argv)
         printf("%3d^3: %zu vertices, %zu triangles (sink %zu)\n", n, nv, nt, sink % 7);
         printf("  sample field   1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tsample[1], tsample[2],
                tsample[1] / tsample[2]);
-        printf("  marching cubes 1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tiso[1], tiso[2],
-               tiso[1] / tiso[2]);
-        printf("  old tets       1 thr %7.3f s   2 thr %7.3f s   %zu triangles; new/old time %.2f (1 thr) %.2f (2 thr)\n",
-               ttet[1], ttet[2], tet_nt, tiso[1] / ttet[1], tiso[2] / ttet[2]);
+        printf("  marching cubes 1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx   (1 thr CPU %.3f s)\n",
+               tiso[1], tiso[2], tiso[1] / tiso[2], ciso);
+        if (twarm < 1e9)
+            printf("  marching cubes 1 thr, warm heap %7.3f s   (CPU %.3f s)\n", twarm, cwarm);
+        if (tets)
+            printf("  old tets       1 thr %7.3f s   2 thr %7.3f s   %zu triangles; new/old time %.2f (1 thr) %.2f (2 thr)\n",
+                   ttet[1], ttet[2], tet_nt, tiso[1] / ttet[1], tiso[2] / ttet[2]);
         printf("  plain MC soup  1 thr %7.3f s   %zu triangles; new/plain time %.2f (1 thr), triangles %.3f\n",
                tplain, plain_nt, tiso[1] / tplain, (double)nt / plain_nt);
         printf("  baseline scan  1 thr %7.3f s   ratio march/baseline (1 thr) %.1fx\n", tbase, tiso[1] / tbase);
+        flying_edges(argv[0], &v, 0.3, runs, ciso, tiso[1], cwarm, twarm, cfirst, nt);
         volume_free(&v);
     }
 

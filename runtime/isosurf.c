@@ -11,21 +11,29 @@
  * goes from node to node + d. Surface vertices are keyed by (node, d).
  *
  * Parallel plan (deterministic, flying-edges style: edges first, then
- * cells): chunk c owns cell layers and node layers [z0, z1) with z0 = -1 +
- * 4c. Pass 1 counts the crossing edges each chunk owns and the centre
- * vertices of its cells; prefix sums give each chunk its first vertex id.
- * Pass 2 numbers the crossing edges of each node layer in (y, x, d) order
- * and writes the vertices it owns, then emits the triangles of the cell
- * layer below cell by cell into a per-chunk list; the lists are concatenated
- * in chunk order. The top node layer z1 of a chunk belongs to the next
- * chunk, whose numbering of it starts at that chunk's first id, so both
- * agree without communicating. A last pass places the centre vertices once
- * every edge vertex is final.
+ * cells, counts first, then fills into arrays allocated once). Pass 0
+ * classifies every sample once into inside bits, 64 nodes of an x-row per
+ * word (one chunk per node layer); rows with no inside node are flagged, and
+ * a row's crossing x-, y- and z-edges are then XORs of neighbouring words,
+ * the cells that need a case are those whose 8 corner bits differ, so only
+ * crossing edges and mixed cells are ever visited (one count-trailing-zeros
+ * per one), never a uniform node or cell. Chunk c owns cell layers and node
+ * layers [z0, z1) with z0 = -1 + 4c. Pass 1 counts the crossing edges each
+ * chunk owns (popcounts), the triangles and the centre vertices of its
+ * cells; prefix sums give each chunk its first vertex id, first triangle and
+ * first centre record. Pass 2 numbers the crossing edges of each node layer
+ * in (y, x, d) order and writes the vertices it owns, then writes the
+ * triangles of the cell layer below cell by cell at the chunk's place in the
+ * mesh's triangle array. The top node layer z1 of a chunk belongs to the
+ * next chunk, whose numbering of it starts at that chunk's first id, so
+ * both agree without communicating. A last pass places the centre vertices
+ * once every edge vertex is final. No hash and no growing list anywhere.
  */
 #include "isosurf.h"
 #include "rt_alloc.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -274,43 +282,45 @@ static int build_table(iso_table *tb)
     return 0;
 }
 
-typedef struct tri_list {
-    uint32_t *t;
-    size_t n, cap; /* in triangles */
-    int failed;
-} tri_list;
-
-/* Centre vertices of one chunk: records of CEN_REC words (vertex id, cycle
- * length k, the k vertices of the cycle). */
+/* Centre vertices: records of CEN_REC words (vertex id, cycle length k, the
+ * k vertices of the cycle), in one array; chunk c's start at cen_at[c]. */
 #define CEN_REC 14
-typedef struct cen_list {
-    uint32_t *r;
-    size_t n, cap; /* in records */
-    int failed;
-} cen_list;
 
 typedef struct iso_job {
     const volume *vol;
     double level;
+    float flevel;   /* the least float >= level: f >= flevel exactly when (double)f >= level */
     int n[3];
     double cell[3];
+    double den2[3]; /* 2 * cell: the central difference's denominator */
+    ptrdiff_t stride[3];
     int want_normals;
     int NXp, NYp;   /* layer array width and height */
     size_t lsz;     /* NXp * NYp */
     size_t doff[8]; /* index offset of node + d within a layer */
     size_t eoff[12]; /* per cube edge: offset of its id from the cell's node, in a layer's ids */
     iso_table tb;
+    /* Inside bits: node (x, y, z), each from -1, is bit x + 1 of the W words
+     * of row (y, z); rows y = -1 .. n1 + 1 of layers z = -1 .. n2 + 1, the
+     * padding rows and bits zero. rowany: the row has an inside node. */
+    int W;
+    uint64_t *bits;
+    unsigned char *rowany;
+    double *crd[3]; /* coord(a, i) at crd[a][i + 1], i = -1 .. n[a] */
     size_t nchunks;
     size_t *counts;  /* pass 1: owned vertices per chunk; then first ids */
     size_t *nedge;   /* per chunk: owned edge vertices (its centre vertices follow) */
-    cen_list *cens;
+    size_t *ncen;    /* per chunk: centre vertices */
+    size_t *cen_at;  /* first centre record of each chunk */
+    size_t *ntri;    /* pass 1: triangles per chunk */
+    size_t *tri_at;  /* first triangle of each chunk */
+    uint32_t *cen;   /* the centre records */
     float *pos, *nrm;
-    unsigned char *cap; /* 1 = vertex on a box face (cap) */
-    tri_list *lists;
-    uint32_t *tri_out; /* the mesh's triangle array */
-    size_t *tri_at;    /* first triangle of each chunk in it */
-    int *failed;     /* per chunk: allocation failure */
+    unsigned char *cap; /* 1 = vertex on a box face (cap), 2 = centre vertex */
+    uint32_t *tri;   /* the mesh's triangle array */
     int32_t *edges;  /* with an sdf: each vertex's lattice edge (x, y, z, d) */
+    uint32_t **scratch; /* per worker: two layers of vertex ids (lsz * 3 each) */
+    int nworkers;
 } iso_job;
 
 static int in_range(const iso_job *j, int i, int k, int l)
@@ -323,54 +333,12 @@ static float val(const iso_job *j, int i, int k, int l)
     return *volume_at(j->vol, i, k, l);
 }
 
-/* Layer arrays are indexed by node (x, y) at (y + 1) * NXp + (x + 1) with
- * NXp = n0 + 3: the padding nodes -1 and n plus one more column and row of
- * zeros, so that node + d is always inside the array. */
+/* Layer arrays of vertex ids are indexed by node (x, y) at (y + 1) * NXp +
+ * (x + 1) with NXp = n0 + 3: the padding nodes -1 and n plus one more column
+ * and row, so that node + d is always inside the array. */
 static size_t lidx(const iso_job *j, int x, int y)
 {
     return (size_t)(y + 1) * (size_t)j->NXp + (size_t)(x + 1);
-}
-
-/* Inside flags of node layer z into buf (lsz bytes), then one byte per row
- * (NYp): does the row hold an inside node? Rows of cells whose four node
- * rows have none are skipped whole (the flying-edges trim, per row). */
-static void inside_layer(const iso_job *j, int z, unsigned char *buf)
-{
-    memset(buf, 0, j->lsz + (size_t)j->NYp);
-    if (z < 0 || z >= j->n[2])
-        return;
-    for (int y = 0; y < j->n[1]; y++) {
-        const float *row = volume_at(j->vol, 0, y, z);
-        unsigned char *b = buf + lidx(j, 0, y), any = 0;
-        for (int x = 0; x < j->n[0]; x++) {
-            b[x] = (unsigned char)(row[x] >= j->level); /* NaN: outside */
-            any |= b[x];
-        }
-        buf[j->lsz + (size_t)(y + 1)] = any;
-    }
-}
-
-/* Are node rows y and y + 1 of both layers all outside? */
-static int rows_empty(const iso_job *j, const unsigned char *in0, const unsigned char *in1, int y)
-{
-    const unsigned char *f0 = in0 + j->lsz + (y + 1), *f1 = in1 + j->lsz + (y + 1);
-    return !(f0[0] | f0[1] | f1[0] | f1[1]);
-}
-
-/* Does edge (node at idx, d) cross the surface? */
-static int crosses(const iso_job *j, const unsigned char *in0, const unsigned char *in1, size_t idx, int d)
-{
-    const unsigned char *l2 = (d & 4) ? in1 : in0;
-    return in0[idx] != l2[idx + j->doff[d]];
-}
-
-/* All 8 nodes of the cube based at idx agree: no edge from idx crosses. */
-static int uniform(const iso_job *j, const unsigned char *in0, const unsigned char *in1, size_t idx)
-{
-    size_t w = (size_t)j->NXp;
-    int s = in0[idx] + in0[idx + 1] + in0[idx + w] + in0[idx + w + 1] + in1[idx] + in1[idx + 1] +
-            in1[idx + w] + in1[idx + w + 1];
-    return s == 0 || s == 8;
 }
 
 static double coord(const iso_job *j, int a, int i)
@@ -379,32 +347,204 @@ static double coord(const iso_job *j, int a, int i)
     return v->lo[a] + (v->hi[a] - v->lo[a]) * (i + 0.5) / j->n[a];
 }
 
-/* Central difference of the grid at node (i, k, l) along axis a. */
-static double grid_grad(const iso_job *j, int i, int k, int l, int a)
+static size_t row_index(const iso_job *j, int y, int z)
 {
-    int idx[3] = {i, k, l};
-    int lo = idx[a] - 1, hi = idx[a] + 1;
-    if (lo < 0)
-        lo = 0;
-    if (hi > j->n[a] - 1)
-        hi = j->n[a] - 1;
+    return (size_t)(z + 1) * (size_t)j->NYp + (size_t)(y + 1);
+}
+
+static const uint64_t *row_bits(const iso_job *j, int y, int z)
+{
+    return j->bits + row_index(j, y, z) * (size_t)j->W;
+}
+
+/* Word w of row r moved down one bit: bit i is node i + 1's. */
+static uint64_t next_bits(const uint64_t *r, int w, int W)
+{
+    return r[w] >> 1 | (w + 1 < W ? r[w + 1] << 63 : 0);
+}
+
+/* Pass 0: the inside bits of node layer z (one chunk per layer). */
+static void pass_classify(void *ctx, size_t c, int worker)
+{
+    (void)worker;
+    iso_job *j = ctx;
+    int z = (int)c, W = j->W, n0 = j->n[0];
+    float lv = j->flevel;
+    for (int y = 0; y < j->n[1]; y++) {
+        const float *row = volume_at(j->vol, 0, y, z);
+        uint64_t *b = j->bits + row_index(j, y, z) * (size_t)W, any = 0;
+        /* first node x at bit x of word x / 64, then everything up one bit */
+        for (int w = 0; 64 * w < n0; w++) {
+            int x0 = 64 * w, xa = x0, xe = x0 + 64 < n0 ? x0 + 64 : n0;
+            uint64_t v = 0;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            if (xe - x0 == 64) {
+                /* 64 comparisons into bytes (vectorised), each 8 bytes of 0/1
+                 * gathered into 8 bits by one multiplication */
+                unsigned char t[64];
+                for (int k = 0; k < 64; k++)
+                    t[k] = row[x0 + k] >= lv; /* NaN: outside */
+                for (int k = 0; k < 8; k++) {
+                    uint64_t g;
+                    memcpy(&g, t + 8 * k, 8);
+                    v |= (g * UINT64_C(0x0102040810204080)) >> 56 << (8 * k);
+                }
+                xa = xe;
+            }
+#endif
+            for (int x = xa; x < xe; x++)
+                v |= (uint64_t)(row[x] >= lv) << (x - x0); /* NaN: outside */
+            b[w] = v;
+            any |= v;
+        }
+        for (int w = W - 1; w >= 0; w--) {
+            uint64_t hi = 64 * w < n0 ? b[w] << 1 : 0;
+            b[w] = hi | (w > 0 ? b[w - 1] >> 63 : 0);
+        }
+        j->rowany[row_index(j, y, z)] = any != 0;
+    }
+}
+
+/* The four node rows of cell row (y, z), in corner order (bits 1 and 2 of
+ * the corner: +y, +z); 0 if they are all outside. */
+static int cell_rows(const iso_job *j, int y, int z, const uint64_t *R[4])
+{
+    const unsigned char *a = j->rowany;
+    size_t i0 = row_index(j, y, z), i1 = row_index(j, y, z + 1);
+    if (!(a[i0] | a[i0 + 1] | a[i1] | a[i1 + 1]))
+        return 0;
+    R[0] = row_bits(j, y, z);
+    R[1] = row_bits(j, y + 1, z);
+    R[2] = row_bits(j, y, z + 1);
+    R[3] = row_bits(j, y + 1, z + 1);
+    return 1;
+}
+
+/* Word w of the cell row's corner bits: v[k] bit i is corner k (x = k & 1,
+ * row k >> 1) of the cell based at node 64w + i - 1. Returns the cells whose
+ * 8 corners are not all alike. */
+static uint64_t cell_words(const uint64_t *R[4], int w, int W, uint64_t v[8])
+{
+    uint64_t any = 0, all = ~(uint64_t)0;
+    for (int r = 0; r < 4; r++) {
+        v[2 * r] = R[r][w];
+        v[2 * r + 1] = next_bits(R[r], w, W);
+        any |= v[2 * r] | v[2 * r + 1];
+        all &= v[2 * r] & v[2 * r + 1];
+    }
+    return any & ~all;
+}
+
+/* The mask of inside corners of the cell at bit b of cell_words' v. */
+static int cell_mask(const uint64_t v[8], int b)
+{
+    if (b < 63) /* both corners of each row in one word */
+        return (int)(v[0] >> b & 3) | (int)(v[2] >> b & 3) << 2 | (int)(v[4] >> b & 3) << 4 |
+               (int)(v[6] >> b & 3) << 6;
+    return (int)(v[0] >> 63) | (int)(v[1] >> 63) << 1 | (int)(v[2] >> 63) << 2 | (int)(v[3] >> 63) << 3 |
+           (int)(v[4] >> 63) << 4 | (int)(v[5] >> 63) << 5 | (int)(v[6] >> 63) << 6 | (int)(v[7] >> 63) << 7;
+}
+
+/* The crossing edges of node row (y, z) in word w, per axis; 0 if none. */
+static uint64_t row_crossings(const iso_job *j, int y, int z, int w, uint64_t c[3])
+{
+    const uint64_t *A = row_bits(j, y, z), *B = row_bits(j, y + 1, z), *C = row_bits(j, y, z + 1);
+    uint64_t a = A[w];
+    c[0] = a ^ next_bits(A, w, j->W);
+    c[1] = a ^ B[w];
+    c[2] = a ^ C[w];
+    return c[0] | c[1] | c[2];
+}
+
+static int row_has_crossings(const iso_job *j, int y, int z)
+{
+    const unsigned char *a = j->rowany;
+    return a[row_index(j, y, z)] | a[row_index(j, y + 1, z)] | a[row_index(j, y, z + 1)];
+}
+
+/* Central difference of the grid at node i (pointer p) along axis a
+ * (one-sided at the border, 0 on a one-sample axis). */
+static double grid_grad(const iso_job *j, const float *p, int i, int a)
+{
+    ptrdiff_t st = j->stride[a];
+    int n = j->n[a];
+    if (i > 0 && i < n - 1)
+        return ((double)p[st] - (double)p[-st]) / j->den2[a];
+    int lo = i - 1 < 0 ? 0 : i - 1, hi = i + 1 > n - 1 ? n - 1 : i + 1;
     if (hi == lo)
         return 0;
-    int p[3] = {i, k, l}, q[3] = {i, k, l};
-    p[a] = lo;
-    q[a] = hi;
-    double d = (double)val(j, q[0], q[1], q[2]) - (double)val(j, p[0], p[1], p[2]);
+    double d = (double)p[(hi - i) * st] - (double)p[(lo - i) * st];
     return d / ((hi - lo) * j->cell[a]);
+}
+
+static void write_normal(iso_job *j, uint32_t id, double nv[3], const int p[3], const int q[3], int pin)
+{
+    double l = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    if (!(l > 0) || !isfinite(l)) {
+        /* flat or broken gradient: point from the inside end outward */
+        double sg = pin ? 1.0 : -1.0;
+        for (int a = 0; a < 3; a++)
+            nv[a] = sg * (q[a] - p[a]) * j->cell[a];
+        l = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    }
+    float *N = j->nrm + 3 * (size_t)id;
+    for (int a = 0; a < 3; a++)
+        N[a] = (float)(nv[a] / l);
+}
+
+/* make_vertex for an edge whose two ends are at least one node from the
+ * grid's border on every axis (most edges): the same arithmetic without
+ * the border cases, so the compiler can overlap the divisions. */
+static void make_vertex_inner(iso_job *j, int x, int y, int z, int d, uint32_t id)
+{
+    int p[3] = {x, y, z}, q[3] = {x + (d & 1), y + (d >> 1 & 1), z + (d >> 2 & 1)};
+    const float *P = volume_at(j->vol, x, y, z), *Q = P + j->stride[d >> 1];
+    double fp = *P, fq = *Q, s = 0.5;
+    int pin = fp >= j->level;
+    if (isfinite(fp) && isfinite(fq) && fq != fp) {
+        s = (j->level - fp) / (fq - fp);
+        if (!(s >= S_EPS))
+            s = S_EPS;
+        if (s > 1 - S_EPS)
+            s = 1 - S_EPS;
+    }
+    j->cap[id] = 0;
+    if (j->edges) {
+        int32_t *E = j->edges + 4 * (size_t)id;
+        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
+    }
+    float *O = j->pos + 3 * (size_t)id;
+    for (int a = 0; a < 3; a++) {
+        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
+        O[a] = (float)(cp + s * (cq - cp));
+    }
+    if (j->want_normals) {
+        double g0[3], g1[3], nv[3];
+        for (int a = 0; a < 3; a++) {
+            ptrdiff_t st = j->stride[a];
+            g0[a] = ((double)P[st] - (double)P[-st]) / j->den2[a];
+            g1[a] = ((double)Q[st] - (double)Q[-st]) / j->den2[a];
+        }
+        for (int a = 0; a < 3; a++)
+            nv[a] = -((1 - s) * g0[a] + s * g1[a]);
+        write_normal(j, id, nv, p, q, pin);
+    }
 }
 
 static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
 {
+    int hi = (d & 1) + 1, hj = (d >> 1 & 1) + 1, hk = (d >> 2 & 1) + 1;
+    if (x >= 1 && y >= 1 && z >= 1 && x + hi < j->n[0] && y + hj < j->n[1] && z + hk < j->n[2]) {
+        make_vertex_inner(j, x, y, z, d, id);
+        return;
+    }
     int p[3] = {x, y, z}, q[3] = {x + (d & 1), y + (d >> 1 & 1), z + (d >> 2 & 1)};
     int pr = in_range(j, p[0], p[1], p[2]), qr = in_range(j, q[0], q[1], q[2]);
     double s = 0.5, nv[3] = {0, 0, 0};
     int pin = 0;
     if (pr && qr) {
-        double fp = val(j, p[0], p[1], p[2]), fq = val(j, q[0], q[1], q[2]);
+        const float *fpp = volume_at(j->vol, p[0], p[1], p[2]), *fqp = volume_at(j->vol, q[0], q[1], q[2]);
+        double fp = *fpp, fq = *fqp;
         pin = fp >= j->level;
         if (isfinite(fp) && isfinite(fq) && fq != fp) {
             s = (j->level - fp) / (fq - fp);
@@ -415,7 +555,7 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         }
         if (j->want_normals) {
             for (int a = 0; a < 3; a++) {
-                double g0 = grid_grad(j, p[0], p[1], p[2], a), g1 = grid_grad(j, q[0], q[1], q[2], a);
+                double g0 = grid_grad(j, fpp, p[a], a), g1 = grid_grad(j, fqp, q[a], a);
                 nv[a] = -((1 - s) * g0 + s * g1);
             }
         }
@@ -434,46 +574,35 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
     }
     float *P = j->pos + 3 * (size_t)id;
     for (int a = 0; a < 3; a++) {
-        double cp = coord(j, a, p[a]), cq = coord(j, a, q[a]);
+        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
         P[a] = (float)(cp + s * (cq - cp));
     }
-    if (j->want_normals) {
-        double l = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
-        if (!(l > 0) || !isfinite(l)) {
-            /* flat or broken gradient: point from the inside end outward */
-            double sg = pin ? 1.0 : -1.0;
-            for (int a = 0; a < 3; a++)
-                nv[a] = sg * (q[a] - p[a]) * j->cell[a];
-            l = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
-        }
-        float *N = j->nrm + 3 * (size_t)id;
-        for (int a = 0; a < 3; a++)
-            N[a] = (float)(nv[a] / l);
-    }
+    if (j->want_normals)
+        write_normal(j, id, nv, p, q, pin);
 }
 
-/* Number the crossing edges of node layer z into ids (starting at
- * base + *counter); write the vertices when `write`. */
-static void fill_layer(iso_job *j, int z, const unsigned char *in0, const unsigned char *in1,
-                       uint32_t *ids, size_t base, size_t *counter, int write)
+/* Number the crossing edges of node layer z in (y, x, axis) order into ids
+ * (starting at base + *counter); write the vertices when `write`. */
+static void number_layer(iso_job *j, int z, uint32_t *ids, size_t base, size_t *counter, int write)
 {
     /* ids of edges that do not cross are never read, so they are not set */
     for (int y = -1; y <= j->n[1]; y++) {
-        if (rows_empty(j, in0, in1, y))
+        if (!row_has_crossings(j, y, z))
             continue;
-        for (int x = -1; x <= j->n[0]; x++) {
-            size_t idx = lidx(j, x, y);
-            if (uniform(j, in0, in1, idx))
-                continue;
-            uint32_t *row = ids + idx * 3;
-            for (int a = 0; a < 3; a++) {
-                int d = 1 << a;
-                if (!crosses(j, in0, in1, idx, d))
-                    continue;
-                uint32_t id = (uint32_t)(base + (*counter)++);
-                row[a] = id;
-                if (write)
-                    make_vertex(j, x, y, z, d, id);
+        for (int w = 0; w < j->W; w++) {
+            uint64_t c[3], u = row_crossings(j, y, z, w, c);
+            while (u) {
+                int b = __builtin_ctzll(u), x = 64 * w + b - 1;
+                u &= u - 1;
+                uint32_t *row = ids + lidx(j, x, y) * 3;
+                for (int a = 0; a < 3; a++) {
+                    if (!(c[a] >> b & 1))
+                        continue;
+                    uint32_t id = (uint32_t)(base + (*counter)++);
+                    row[a] = id;
+                    if (write)
+                        make_vertex(j, x, y, z, 1 << a, id);
+                }
             }
         }
     }
@@ -481,64 +610,62 @@ static void fill_layer(iso_job *j, int z, const unsigned char *in0, const unsign
 
 static int decisions(const iso_job *j, int x, int y, int z, int mask);
 
-/* The mask of inside corners of the cell based at node idx. */
-static int cell_mask(const iso_job *j, const unsigned char *in0, const unsigned char *in1, size_t idx)
-{
-    size_t w = (size_t)j->NXp;
-    const unsigned char *a = in0 + idx, *b = in1 + idx;
-    return a[0] | a[1] << 1 | a[w] << 2 | a[w + 1] << 3 | b[0] << 4 | b[1] << 5 | b[w] << 6 | b[w + 1] << 7;
-}
-
 static void chunk_range(const iso_job *j, size_t c, int *z0, int *z1)
 {
     *z0 = -1 + (int)c * SLAB;
     *z1 = *z0 + SLAB < j->n[2] ? *z0 + SLAB : j->n[2];
 }
 
+static const mc_case *cell_case(const iso_job *j, int x, int y, int z, int mask)
+{
+    int ci = j->tb.base[mask];
+    if (j->tb.amb[mask])
+        ci += decisions(j, x, y, z, mask);
+    return &j->tb.cases[ci];
+}
+
+/* Pass 1: the chunk's crossing edges (node layers z0 .. z1-1), and the
+ * triangles and centre vertices of its cell layers. */
 static void pass_count(void *ctx, size_t c, int worker)
 {
     (void)worker;
     iso_job *j = ctx;
-    int z0, z1;
+    int z0, z1, W = j->W;
     chunk_range(j, c, &z0, &z1);
-    size_t lb = j->lsz + (size_t)j->NYp;
-    unsigned char *in0 = rt_malloc(lb), *in1 = rt_malloc(lb);
-    if (!in0 || !in1) {
-        j->failed[c] = 1;
-        rt_free(in0);
-        rt_free(in1);
-        return;
-    }
-    size_t cnt = 0, ncen = 0;
-    inside_layer(j, z0, in0);
+    size_t cnt = 0, ncen = 0, ntri = 0;
     for (int z = z0; z < z1; z++) {
-        inside_layer(j, z + 1, in1);
         for (int y = -1; y <= j->n[1]; y++) {
-            if (rows_empty(j, in0, in1, y))
+            if (!row_has_crossings(j, y, z))
                 continue;
-            for (int x = -1; x <= j->n[0]; x++) {
-                size_t idx = lidx(j, x, y);
-                if (uniform(j, in0, in1, idx))
-                    continue;
-                for (int d = 1; d <= 4; d <<= 1)
-                    cnt += (size_t)crosses(j, in0, in1, idx, d);
-            }
-            if (y == j->n[1])
-                continue;
-            for (int x = -1; x < j->n[0]; x++) { /* the cells of row y */
-                int mask = cell_mask(j, in0, in1, lidx(j, x, y));
-                if (j->tb.cen[mask])
-                    ncen += j->tb.cases[j->tb.base[mask] + decisions(j, x, y, z, mask)].nc;
+            for (int w = 0; w < W; w++) {
+                uint64_t e[3];
+                row_crossings(j, y, z, w, e);
+                cnt += (size_t)(__builtin_popcountll(e[0]) + __builtin_popcountll(e[1]) +
+                                __builtin_popcountll(e[2]));
             }
         }
-        unsigned char *t = in0;
-        in0 = in1;
-        in1 = t;
+        for (int y = -1; y < j->n[1]; y++) {
+            const uint64_t *R[4];
+            if (!cell_rows(j, y, z, R))
+                continue;
+            for (int w = 0; w < W; w++) {
+                uint64_t v[8], act = cell_words(R, w, W, v);
+                while (act) {
+                    int b = __builtin_ctzll(act);
+                    act &= act - 1;
+                    const mc_case *K = cell_case(j, 64 * w + b - 1, y, z, cell_mask(v, b));
+                    ntri += K->nt;
+                    for (int k = 0; k < K->nc; k++)
+                        ntri += K->ck[k];
+                    ncen += K->nc;
+                }
+            }
+        }
     }
     j->nedge[c] = cnt;
+    j->ncen[c] = ncen;
+    j->ntri[c] = ntri;
     j->counts[c] = cnt + ncen;
-    rt_free(in0);
-    rt_free(in1);
 }
 
 /* The asymptotic decider on face f of the cell at (x, y, z): the bilinear
@@ -574,43 +701,6 @@ static int decisions(const iso_job *j, int x, int y, int z, int mask)
     return ci;
 }
 
-static void push_tri(tri_list *L, uint32_t a, uint32_t b, uint32_t c)
-{
-    if (L->failed)
-        return;
-    if (L->n == L->cap) {
-        size_t nc = L->cap ? L->cap * 2 : 1024;
-        uint32_t *nt = rt_realloc(L->t, nc * 3 * sizeof(uint32_t));
-        if (!nt) {
-            L->failed = 1;
-            return;
-        }
-        L->t = nt;
-        L->cap = nc;
-    }
-    uint32_t *t = L->t + 3 * L->n++;
-    t[0] = a;
-    t[1] = b;
-    t[2] = c;
-}
-
-static void push_cen(cen_list *L, const uint32_t *rec)
-{
-    if (L->failed)
-        return;
-    if (L->n == L->cap) {
-        size_t nc = L->cap ? L->cap * 2 : 64;
-        uint32_t *nr = rt_realloc(L->r, nc * CEN_REC * sizeof(uint32_t));
-        if (!nr) {
-            L->failed = 1;
-            return;
-        }
-        L->r = nr;
-        L->cap = nc;
-    }
-    memcpy(L->r + CEN_REC * L->n++, rec, CEN_REC * sizeof(uint32_t));
-}
-
 /* Centre vertices: the mean of their cycle's vertices (after any root
  * finding), normal the normalised mean of theirs. */
 typedef struct cen_job {
@@ -622,10 +712,10 @@ static void pass_centres(void *ctx, size_t c, int worker)
 {
     (void)worker;
     cen_job *C = ctx;
-    const cen_list *L = &C->j->cens[c];
+    const iso_job *j = C->j;
     mesh *m = C->m;
-    for (size_t i = 0; i < L->n; i++) {
-        const uint32_t *rec = L->r + CEN_REC * i;
+    for (size_t i = 0; i < j->ncen[c]; i++) {
+        const uint32_t *rec = j->cen + CEN_REC * (j->cen_at[c] + i);
         int n = (int)rec[1];
         double p[3] = {0, 0, 0}, q[3] = {0, 0, 0};
         for (int r = 0; r < n; r++)
@@ -643,99 +733,67 @@ static void pass_centres(void *ctx, size_t c, int worker)
     }
 }
 
+/* Pass 2: number and write the chunk's vertices, and write its triangles
+ * and centre records at the places pass 1 counted for them. */
 static void pass_build(void *ctx, size_t c, int worker)
 {
-    (void)worker;
     iso_job *j = ctx;
-    int z0, z1;
+    int z0, z1, W = j->W;
     chunk_range(j, c, &z0, &z1);
-    size_t lsz = j->lsz;
-    unsigned char *ins[3];
-    uint32_t *ids[2];
-    ins[0] = rt_malloc(lsz + (size_t)j->NYp);
-    ins[1] = rt_malloc(lsz + (size_t)j->NYp);
-    ins[2] = rt_malloc(lsz + (size_t)j->NYp);
-    ids[0] = rt_malloc(lsz * 3 * sizeof(uint32_t));
-    ids[1] = rt_malloc(lsz * 3 * sizeof(uint32_t));
-    tri_list *L = &j->lists[c];
-    if (!ins[0] || !ins[1] || !ins[2] || !ids[0] || !ids[1]) {
-        j->failed[c] = 1;
-        goto done;
-    }
+    uint32_t *ids[2] = {j->scratch[worker], j->scratch[worker] + j->lsz * 3};
     size_t counter = 0, ncen = 0, base = j->counts[c];
-    inside_layer(j, z0, ins[0]);
-    inside_layer(j, z0 + 1, ins[1]);
-    fill_layer(j, z0, ins[0], ins[1], ids[0], base, &counter, 1);
+    uint32_t *T = j->tri + 3 * j->tri_at[c];
+    uint32_t *CR = j->cen + CEN_REC * j->cen_at[c];
+    number_layer(j, z0, ids[0], base, &counter, 1);
     for (int z = z0; z < z1; z++) {
-        /* ins[0] = layer z, ins[1] = layer z+1; number layer z+1 */
-        inside_layer(j, z + 2, ins[2]);
+        /* ids[0] = layer z; number layer z+1 (the next chunk's first layer
+         * is numbered from that chunk's first id and not written here) */
         if (z + 1 < z1) {
-            fill_layer(j, z + 1, ins[1], ins[2], ids[1], base, &counter, 1);
+            number_layer(j, z + 1, ids[1], base, &counter, 1);
         } else {
             size_t c2 = 0, nb = c + 1 < j->nchunks ? j->counts[c + 1] : 0;
-            fill_layer(j, z + 1, ins[1], ins[2], ids[1], nb, &c2, 0);
+            number_layer(j, z + 1, ids[1], nb, &c2, 0);
         }
         for (int y = -1; y < j->n[1]; y++) {
-            if (rows_empty(j, ins[0], ins[1], y))
+            const uint64_t *R[4];
+            if (!cell_rows(j, y, z, R))
                 continue;
-            for (int x = -1; x < j->n[0]; x++) {
-                size_t idx = lidx(j, x, y);
-                int mask = cell_mask(j, ins[0], ins[1], idx);
-                if (mask == 0 || mask == 255)
-                    continue;
-                int ci = j->tb.base[mask];
-                if (j->tb.amb[mask])
-                    ci += decisions(j, x, y, z, mask);
-                const mc_case *K = &j->tb.cases[ci];
-                for (int ti = 0; ti < K->nt; ti++) {
-                    uint32_t v[3];
-                    for (int r = 0; r < 3; r++) {
-                        int e = K->e[ti][r];
-                        v[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+            for (int w = 0; w < W; w++) {
+                uint64_t v[8], act = cell_words(R, w, W, v);
+                while (act) {
+                    int b = __builtin_ctzll(act), x = 64 * w + b - 1;
+                    act &= act - 1;
+                    size_t idx = lidx(j, x, y);
+                    const mc_case *K = cell_case(j, x, y, z, cell_mask(v, b));
+                    for (int ti = 0; ti < K->nt; ti++, T += 3)
+                        for (int r = 0; r < 3; r++) {
+                            int e = K->e[ti][r];
+                            T[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+                        }
+                    for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
+                        uint32_t *rec = CR;
+                        int n = K->ck[k];
+                        CR += CEN_REC;
+                        rec[0] = (uint32_t)(base + j->nedge[c] + ncen++);
+                        rec[1] = (uint32_t)n;
+                        for (int r = 0; r < n; r++) {
+                            int e = K->ce[at + r];
+                            rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+                        }
+                        for (int r = 0; r < n; r++, T += 3) {
+                            T[0] = rec[2 + r];
+                            T[1] = rec[2 + (r + 1) % n];
+                            T[2] = rec[0];
+                        }
+                        j->cap[rec[0]] = 2;
                     }
-                    push_tri(L, v[0], v[1], v[2]);
-                }
-                for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
-                    uint32_t rec[CEN_REC];
-                    int n = K->ck[k];
-                    rec[0] = (uint32_t)(base + j->nedge[c] + ncen++);
-                    rec[1] = (uint32_t)n;
-                    for (int r = 0; r < n; r++) {
-                        int e = K->ce[at + r];
-                        rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
-                    }
-                    for (int r = 0; r < n; r++)
-                        push_tri(L, rec[2 + r], rec[2 + (r + 1) % n], rec[0]);
-                    j->cap[rec[0]] = 2;
-                    push_cen(&j->cens[c], rec);
                 }
             }
         }
-        unsigned char *tmp = ins[0];
-        ins[0] = ins[1];
-        ins[1] = ins[2];
-        ins[2] = tmp;
-        uint32_t *ti2 = ids[0];
+        uint32_t *t = ids[0];
         ids[0] = ids[1];
-        ids[1] = ti2;
+        ids[1] = t;
     }
-done:
-    rt_free(ins[0]);
-    rt_free(ins[1]);
-    rt_free(ins[2]);
-    rt_free(ids[0]);
-    rt_free(ids[1]);
-}
-
-/* Concatenate the chunks' triangle lists (in chunk order, at fixed offsets). */
-static void pass_concat(void *ctx, size_t c, int worker)
-{
-    (void)worker;
-    iso_job *j = ctx;
-    if (j->lists[c].n)
-        memcpy(j->tri_out + 3 * j->tri_at[c], j->lists[c].t, j->lists[c].n * 3 * sizeof(uint32_t));
-    rt_free(j->lists[c].t);
-    j->lists[c].t = NULL;
 }
 
 /* Pass 3: callback gradients (for field input) and vertex colours. */
@@ -964,14 +1022,22 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         return rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
     j->vol = vol;
     j->level = sdf ? 0 : o->level; /* with an sdf, vol holds -g: inside is -g >= 0 */
+    j->flevel = (float)j->level;
+    if ((double)j->flevel < j->level)
+        j->flevel = nextafterf(j->flevel, INFINITY);
     j->want_normals = o->normals != 0;
     for (int a = 0; a < 3; a++) {
         j->n[a] = nn[a];
         j->cell[a] = (vol->hi[a] - vol->lo[a]) / nn[a];
+        j->den2[a] = 2 * j->cell[a];
     }
+    j->stride[0] = 1;
+    j->stride[1] = (ptrdiff_t)nn[0];
+    j->stride[2] = (ptrdiff_t)nn[0] * (ptrdiff_t)nn[1];
     j->NXp = nn[0] + 3;
     j->NYp = nn[1] + 3;
     j->lsz = (size_t)j->NXp * (size_t)j->NYp;
+    j->W = (nn[0] + 2 + 63) / 64;
     for (int d = 0; d < 8; d++)
         j->doff[d] = (size_t)(d & 1) + (size_t)(d >> 1 & 1) * (size_t)j->NXp;
     int tbr = build_table(&j->tb);
@@ -984,28 +1050,49 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         int lo = j->tb.elo[k];
         j->eoff[k] = j->doff[lo & 3] * 3 + j->tb.eax[k];
     }
+    size_t nrows = (size_t)j->NYp * (size_t)(nn[2] + 3);
+    j->bits = rt_calloc(nrows * (size_t)j->W, sizeof(uint64_t));
+    j->rowany = rt_calloc(nrows, 1);
+    for (int a = 0; a < 3; a++) {
+        j->crd[a] = rt_malloc(((size_t)nn[a] + 2) * sizeof(double));
+        if (j->crd[a])
+            for (int i = -1; i <= nn[a]; i++)
+                j->crd[a][i + 1] = coord(j, a, i);
+    }
     j->nchunks = (size_t)(vol->nz + 1 + SLAB - 1) / SLAB;
     j->counts = rt_calloc(j->nchunks + 1, sizeof(size_t));
-    j->lists = rt_calloc(j->nchunks, sizeof(tri_list));
     j->nedge = rt_calloc(j->nchunks, sizeof(size_t));
-    j->cens = rt_calloc(j->nchunks, sizeof(cen_list));
-    j->failed = rt_calloc(j->nchunks, sizeof(int));
-    size_t nv = 0, nt = 0;
-    if (!j->counts || !j->lists || !j->failed || !j->nedge || !j->cens) {
+    j->ncen = rt_calloc(j->nchunks, sizeof(size_t));
+    j->cen_at = rt_calloc(j->nchunks, sizeof(size_t));
+    j->ntri = rt_calloc(j->nchunks, sizeof(size_t));
+    j->tri_at = rt_calloc(j->nchunks, sizeof(size_t));
+    j->nworkers = par_workers(run, j->nchunks);
+    j->scratch = rt_calloc((size_t)j->nworkers, sizeof(uint32_t *));
+    for (int w = 0; j->scratch && w < j->nworkers; w++)
+        j->scratch[w] = rt_malloc(j->lsz * 6 * sizeof(uint32_t));
+    int scratch_ok = j->scratch != NULL;
+    for (int w = 0; scratch_ok && w < j->nworkers; w++)
+        scratch_ok = j->scratch[w] != NULL;
+    size_t nv = 0, nt = 0, nc = 0;
+    if (!j->bits || !j->rowany || !j->crd[0] || !j->crd[1] || !j->crd[2] || !j->counts || !j->nedge ||
+        !j->ncen || !j->cen_at || !j->ntri || !j->tri_at || !scratch_ok) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
         goto done;
     }
+    rc = par_for(run, "isosurface", (size_t)nn[2], pass_classify, j);
+    if (rc)
+        goto fail_par;
     rc = par_for(run, "isosurface", j->nchunks, pass_count, j);
     if (rc)
         goto fail_par;
     for (size_t c = 0; c < j->nchunks; c++) {
-        if (j->failed[c]) {
-            rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
-            goto done;
-        }
         size_t k = j->counts[c];
         j->counts[c] = nv;
         nv += k;
+        j->tri_at[c] = nt;
+        nt += j->ntri[c];
+        j->cen_at[c] = nc;
+        nc += j->ncen[c];
     }
     if (nv >= UINT32_MAX) {
         rc = rt_fail(e, RT_EINVAL, "isosurface has %zu vertices, more than a mesh can index", nv);
@@ -1017,20 +1104,21 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
         j->nrm = rt_malloc((nv ? nv : 1) * 3 * sizeof(float));
     if (sdf)
         j->edges = rt_malloc((nv ? nv : 1) * 4 * sizeof(int32_t));
-    if (!j->pos || !j->cap || (j->want_normals && !j->nrm) || (sdf && !j->edges)) {
+    j->cen = rt_malloc((nc ? nc : 1) * CEN_REC * sizeof(uint32_t));
+    if (!j->pos || !j->cap || (j->want_normals && !j->nrm) || (sdf && !j->edges) || !j->cen) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface vertices", nv);
         goto done;
     }
+    out->tri = rt_malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
+    if (!out->tri) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface triangles", nt);
+        goto done;
+    }
+    out->nt = out->cap_t = nt;
+    j->tri = out->tri;
     rc = par_for(run, "isosurface", j->nchunks, pass_build, j);
     if (rc)
         goto fail_par;
-    for (size_t c = 0; c < j->nchunks; c++) {
-        if (j->failed[c] || j->lists[c].failed || j->cens[c].failed) {
-            rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface triangles");
-            goto done;
-        }
-        nt += j->lists[c].n;
-    }
     /* Hand the arrays to the mesh. */
     rt_free(out->pos);
     rt_free(out->nrm);
@@ -1051,30 +1139,13 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
             goto done;
         }
     }
-    out->tri = rt_malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
-    if (!out->tri) {
-        rc = rt_fail(e, RT_ENOMEM, "out of memory for %zu isosurface triangles", nt);
-        goto done;
-    }
-    out->nt = out->cap_t = nt;
-    j->tri_out = out->tri;
-    j->tri_at = rt_calloc(j->nchunks, sizeof(size_t));
-    if (!j->tri_at) {
-        rc = rt_fail(e, RT_ENOMEM, "out of memory for the isosurface");
-        goto done;
-    }
-    for (size_t c = 1; c < j->nchunks; c++)
-        j->tri_at[c] = j->tri_at[c - 1] + j->lists[c - 1].n;
-    rc = par_for(run, "isosurface", j->nchunks, pass_concat, j);
-    if (rc)
-        goto fail_par;
     if (sdf) {
         root_job R = {sdf->f, sdf->ctx, j, out};
         rc = par_for(run, "isosurface", (nv + VCHUNK - 1) / VCHUNK, pass_root, &R);
         if (rc)
             goto fail_par;
     }
-    {
+    if (nc) {
         cen_job C = {j, out};
         rc = par_for(run, "isosurface", j->nchunks, pass_centres, &C);
         if (rc)
@@ -1100,18 +1171,21 @@ static rt_code run_iso(const volume *vol, const iso_opts *o, rt_field_fn gf, con
 fail_par:
     rc = rt_fail(e, RT_ECANCEL, "isosurface interrupted");
 done:
-    if (j->lists)
-        for (size_t c = 0; c < j->nchunks; c++)
-            rt_free(j->lists[c].t);
-    rt_free(j->lists);
-    if (j->cens)
-        for (size_t c = 0; c < j->nchunks; c++)
-            rt_free(j->cens[c].r);
-    rt_free(j->cens);
-    rt_free(j->nedge);
-    rt_free(j->tri_at);
+    rt_free(j->bits);
+    rt_free(j->rowany);
+    for (int a = 0; a < 3; a++)
+        rt_free(j->crd[a]);
     rt_free(j->counts);
-    rt_free(j->failed);
+    rt_free(j->nedge);
+    rt_free(j->ncen);
+    rt_free(j->cen_at);
+    rt_free(j->ntri);
+    rt_free(j->tri_at);
+    rt_free(j->cen);
+    if (j->scratch)
+        for (int w = 0; w < j->nworkers; w++)
+            rt_free(j->scratch[w]);
+    rt_free(j->scratch);
     rt_free(j->pos);
     rt_free(j->nrm);
     rt_free(j->cap);
@@ -1120,7 +1194,6 @@ done:
     rt_free(j);
     return rc;
 }
-
 rt_code iso_from_volume(const volume *vol, const iso_opts *opts, const rt_run *run, mesh *out,
                         rt_error *e)
 {

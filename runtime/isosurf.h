@@ -80,6 +80,14 @@
  * positions (after root finding, with an sdf) and normals; with a callback,
  * their normal is the callback's gradient like any other vertex.
  *
+ * Cost (flying-edges style passes, see isosurf.c): each sample is read once
+ * and classified into bits, 64 nodes per word; after that only crossing
+ * lattice edges and cells with corners on both sides are visited, found a
+ * word at a time, and the vertices and triangles are counted first and
+ * written straight into arrays of their final size (no hash, no growing
+ * list). Extra memory: (n0 + 2) / 8 bytes per row of the padded grid for the
+ * bits and two layers of vertex ids per thread.
+ *
  * Determinism: the grid is processed in slabs of 4 cell layers (a fixed
  * decomposition); each slab's edge vertices are numbered in lattice order
  * (z, y, x, axis), then its centre vertices in cell order, and triangles are
