@@ -146,36 +146,15 @@ static int fv_preview(interp *I, const void *p, image **out)
     const field_prog *prog = fv_prog(I, fv);
     if (!prog)
         return -1;
-    enum { N = 128 };
     image *im;
-    if (lang_image_new(I, N, N, &im))
+    rt_error e;
+    if (lang_image_new(I, 128, 128, &im))
         return -1;
-    double *v = mem_alloc(I, sizeof(double) * N * N);
-    if (!v) {
+    rt_code c = field_preview(prog, im, &e);
+    if (c) {
         lang_image_discard(im);
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        return lang_rt_error(I, c, &e, "show");
     }
-    double xs[N], ys[N], zs[N];
-    for (int j = 0; j < N; j++) {
-        for (int i = 0; i < N; i++) {
-            xs[i] = -1 + 2 * (i + 0.5) / N;
-            ys[i] = 1 - 2 * (j + 0.5) / N;
-            zs[i] = 0;
-        }
-        field_prog_eval(prog, N, xs, ys, zs, v + (size_t)j * N);
-    }
-    double mn = INFINITY, mx = -INFINITY;
-    for (int i = 0; i < N * N; i++)
-        if (isfinite(v[i])) {
-            mn = v[i] < mn ? v[i] : mn;
-            mx = v[i] > mx ? v[i] : mx;
-        }
-    for (int i = 0; i < N * N; i++) {
-        float g = mx > mn && isfinite(v[i]) ? (float)((v[i] - mn) / (mx - mn)) : 0.0f;
-        im->px[4 * i] = im->px[4 * i + 1] = im->px[4 * i + 2] = g;
-        im->px[4 * i + 3] = 1;
-    }
-    mem_free(I, v);
     *out = im;
     return 0;
 }

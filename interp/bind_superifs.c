@@ -180,21 +180,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
         if (lang_window_arg(I, a[3], lo, hi, "superifs_image: window"))
             return -1;
     } else {
-        /* the bounds of all buffers, so every buffer is drawn at one scale */
-        lo[0] = lo[1] = INFINITY;
-        hi[0] = hi[1] = -INFINITY;
-        size_t np = (size_t)s->st.V * s->st.points;
-        for (size_t i = 0; i < np; i++)
-            for (int k = 0; k < 2; k++) {
-                double x = s->st.pts[2 * i + (size_t)k];
-                if (!isfinite(x))
-                    continue;
-                if (x < lo[k])
-                    lo[k] = x;
-                if (x > hi[k])
-                    hi[k] = x;
-            }
-        if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1]))
+        if (superifs_bounds(&s->st, lo, hi)) /* all buffers: every buffer is drawn at one scale */
             return err_at(I, NULL, ERR_VALUE, "superifs_image: the buffers hold no finite points; give window:");
         fset_fit_aspect(lo, hi, w, h, 0.03);
     }
