@@ -40,6 +40,13 @@ static void shape_summary(const void *pp, bytebuf *out)
                    s->npoly == 1 ? "" : "s", closed, s->dim, detiter_length(s));
 }
 
+/* shape.coords[i]: vertex i as [x, y] (or [x, y, z]) */
+static int vertex_value(interp *I, const void *pp, size_t i, value *out)
+{
+    const detiter_shape *s = pp;
+    return lang_num_list_value(I, s->v + i * (size_t)s->dim, (size_t)s->dim, out);
+}
+
 static int shape_get(interp *I, const void *pp, const char *name, value *out)
 {
     const detiter_shape *s = pp;
@@ -63,18 +70,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
         if ((double)s->nverts > I->lim.max_list)
             return err_at(I, NULL, ERR_LIMIT, "shape.coords: %zu vertices exceed the list limit of %.0f (raise it with --max-list)",
                           s->nverts, I->lim.max_list);
-        value l = val_list(I, s->nverts);
-        if (l.k == V_NIL)
-            return -1;
-        for (size_t i = 0; i < s->nverts; i++) {
-            value p;
-            if (lang_num_list_value(I, s->v + i * (size_t)s->dim, (size_t)(s->dim), &p) || val_list_push(I, AS_LIST(l), p)) {
-                val_unref(I, l);
-                return -1;
-            }
-        }
-        *out = l;
-        return 0;
+        return val_list_build(I, s->nverts, vertex_value, s, out);
     } else
         return 1;
     return 0;

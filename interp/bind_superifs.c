@@ -50,6 +50,15 @@ static void superifs_summary(const void *pp, bytebuf *out)
         bytebuf_printf(out, " …");
 }
 
+/* s.ifs[v]: the IFS (1-based) buffer v took at the last step, nil if none */
+static int ifs_value(interp *I, const void *pp, size_t v, value *out)
+{
+    (void)I;
+    const lang_superifs *s = pp;
+    *out = s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1);
+    return 0;
+}
+
 static int superifs_get(interp *I, const void *pp, const char *name, value *out)
 {
     const lang_superifs *s = pp;
@@ -60,16 +69,7 @@ static int superifs_get(interp *I, const void *pp, const char *name, value *out)
     else if (strcmp(name, "steps") == 0)
         *out = val_num((double)s->steps);
     else if (strcmp(name, "ifs") == 0) {
-        value l = val_list(I, (size_t)s->st.V);
-        if (l.k == V_NIL)
-            return -1;
-        for (int v = 0; v < s->st.V; v++)
-            if (val_list_push(I, AS_LIST(l), s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1))) {
-                val_unref(I, l);
-                return -1;
-            }
-        *out = l;
-        return 0;
+        return val_list_build(I, (size_t)s->st.V, ifs_value, s, out);
     } else
         return 1;
     return 0;
