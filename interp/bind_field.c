@@ -603,8 +603,8 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     if ((a[1].k != V_NIL && lang_get_camera(I, a[1], &cam, "raymarch")) ||
         lang_get_box(I, a[3], a[4], o.lo, o.hi, "raymarch"))
         return -1;
-    if (a[1].k == V_NIL && camera_frame_box(&cam, o.lo, o.hi, w, h, 30, 20, 40)) /* the one default framing */
-        return err_at(I, NULL, ERR_VALUE, "raymarch: cannot frame the box");
+    if (a[1].k == V_NIL && lang_frame_default(I, o.lo, o.hi, w, h, &cam, "raymarch: cannot frame the box"))
+        return -1;
     /* declared: mode str{emission,solid}, sigma num>0, step num>0 */
     o.mode = strcmp(AS_STR(a[5])->s, "solid") == 0 ? RM_SOLID : RM_EMISSION;
     o.threshold = a[6].u.n;

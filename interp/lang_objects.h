@@ -50,6 +50,12 @@ int lang_opt_num(interp *I, value rec, const char *key, double *out);
  * TY_CAMERA (so its keys are already checked). */
 int lang_get_camera(interp *I, value v, camera *cam, const char *what);
 
+/* The one default framing (camera_frame_box: azimuth 30°, elevation 20°,
+ * fov 40°) of the box lo..hi for a w × h picture; -1 with the error
+ * message `fail` (ERR_VALUE) when a corner is not finite. */
+int lang_frame_default(interp *I, const double lo[3], const double hi[3], int w, int h, camera *cam,
+                       const char *fail);
+
 /* A box lo..hi from two vec3 arguments (messages "WHAT: lo", "WHAT: hi"),
  * lo < hi on every axis. */
 int lang_get_box(interp *I, value lo, value hi, double l[3], double h[3], const char *what);
