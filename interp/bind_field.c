@@ -577,13 +577,9 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         lang_field_fn_done(tmp, own);
     }
     lang_field_fn_done(ctmp, cown);
-    if (c) {
-        mesh_free(m); /* what the engine built before it failed */
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "isosurface");
-    }
-    report_work(I, "isosurface", "triangles", (double)m->nt, t0);
-    return lang_mesh_value(I, m, out);
+    if (!c)
+        report_work(I, "isosurface", "triangles", (double)m->nt, t0);
+    return lang_mesh_finish(I, m, c, &e, "isosurface", out);
 }
 
 static int b_raymarch(interp *I, value *a, int n, value *out)

@@ -776,12 +776,7 @@ static int b_points(interp *I, value *a, int n, value *out)
     rt_code c = chaos_points(&s, &o, m, &run, &e);
     if (!c)
         report_work(I, "chaos game", "points", (double)o.points, t0);
-    if (c) {
-        mesh_free(m);
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "points");
-    }
-    return lang_mesh_value(I, m, out);
+    return lang_mesh_finish(I, m, c, &e, "points", out);
 }
 
 static int b_view(interp *I, value *a, int n, value *out)

@@ -367,12 +367,9 @@ static int iterate_mesh(interp *I, const lang_fset *f, const fset_order *o, long
     rt_run run = lang_run(I);
     double t0 = report_clock();
     c = fset_iterate_mesh(&f->fs, o, (size_t)steps, copies, k0, m, &run, &e);
-    if (c) {
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "iterate");
-    }
-    report_work(I, "iterate", "triangles", (double)m->nt, t0);
-    return lang_mesh_value(I, m, out);
+    if (!c)
+        report_work(I, "iterate", "triangles", (double)m->nt, t0);
+    return lang_mesh_finish(I, m, c, &e, "iterate", out);
 }
 
 /* iterate(system, start, steps, order) */

@@ -21,6 +21,10 @@ int lang_volume_value(interp *I, volume *v, value *out); /* takes ownership */
 volume *lang_as_volume(value v);
 
 int lang_mesh_value(interp *I, mesh *m, value *out); /* takes ownership (m malloc'd) */
+/* An engine's mesh m (mem_alloc'd) as the builtin's result if c is RT_OK,
+ * else m freed with what the engine built and the error reported as `what`
+ * (lang_rt_error). Takes m. */
+int lang_mesh_finish(interp *I, mesh *m, rt_code c, const rt_error *e, const char *what, value *out);
 mesh *lang_as_mesh(value v);
 
 /* A colour ramp from a list of colours (evenly spaced stops) or a table of
