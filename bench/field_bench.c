@@ -21,18 +21,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
+
 #include "density.h"
 #include "field.h"
 #include "noise.h"
 #include "rng.h"
 #include "volume.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double sink;
 
@@ -93,11 +88,11 @@ int main(int argc, char **argv)
     rt_run run1 = {1, NULL, 0};
     double tg = 1e30, tc = 1e30;
     for (int r = 0; r < reps; r++) {
-        double t0 = now();
+        double t0 = bench_now();
         chain_c(&vb, &np);
-        double t1 = now();
+        double t1 = bench_now();
         field_sample_volume(field_prog_fn, p, &va, &run1, &e);
-        double t2 = now();
+        double t2 = bench_now();
         tc = t1 - t0 < tc ? t1 - t0 : tc;
         tg = t2 - t1 < tg ? t2 - t1 : tg;
     }
@@ -129,16 +124,16 @@ int main(int argc, char **argv)
     double tr = 1e30, tb = 1e30, ts = 1e30;
     long mismatch = 0;
     for (int r = 0; r < reps; r++) {
-        double t0 = now(), acc = 0;
+        double t0 = bench_now(), acc = 0;
         for (long i = 0; i < npts; i++)
             acc += noise_reference3(x[i], y[i], z[i]);
-        double t1 = now();
+        double t1 = bench_now();
         noise_perlin3_block(&ref, (size_t)npts, x, y, z, o);
-        double t2 = now();
+        double t2 = bench_now();
         double acc2 = 0;
         for (long i = 0; i < npts; i++)
             acc2 += noise_perlin3(&ref, x[i], y[i], z[i]);
-        double t3 = now();
+        double t3 = bench_now();
         sink += acc + acc2;
         tr = t1 - t0 < tr ? t1 - t0 : tr;
         tb = t2 - t1 < tb ? t2 - t1 : tb;

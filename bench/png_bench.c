@@ -22,6 +22,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
+
 #include "deflate.h"
 #include "noise.h"
 #include "png.h"
@@ -30,13 +32,6 @@
 #define W 1024
 #define H 1024
 #define RUNS 5
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static unsigned char clamp8(double v)
 {
@@ -117,9 +112,9 @@ static double encode_once(const unsigned char *px, int channels, int bits, int l
     bytebuf out;
     bytebuf_init(&out);
     rt_error e;
-    double t0 = now();
+    double t0 = bench_now();
     rt_code c = png_encode_samples(px, W, H, channels, bits, level, &out, filtered, &e);
-    double t1 = now();
+    double t1 = bench_now();
     if (c) {
         fprintf(stderr, "png_bench: %s\n", e.msg);
         exit(1);
@@ -148,9 +143,9 @@ static void run_image(const char *name, const unsigned char *px, int channels, i
     size_t size[4] = {0};
     unsigned sum = 0;
     for (int r = 0; r < RUNS; r++) {
-        double t0 = now();
+        double t0 = bench_now();
         memcpy(copy, px, raw);
-        double t1 = now();
+        double t1 = bench_now();
         sum += copy[(size_t)r * 7919];
         if (t1 - t0 < t_memcpy)
             t_memcpy = t1 - t0;

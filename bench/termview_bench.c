@@ -12,31 +12,26 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench.h"
+
 #include "termview.h"
 
 #define W 1920
 #define H 1080
 #define RUNS 7
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 static volatile double sink;
 
 static double baseline(const image *im)
 {
-    double t0 = now(), acc = 0;
+    double t0 = bench_now(), acc = 0;
     const float *p = im->px;
     for (size_t i = 0; i < (size_t)W * H; i++, p += 4) {
         double a = p[3];
         acc += a * p[0] + a * p[1] + a * p[2];
     }
     sink = acc;
-    return now() - t0;
+    return bench_now() - t0;
 }
 
 static double render(const image *im, int cols, int color, size_t *bytes)
@@ -44,12 +39,12 @@ static double render(const image *im, int cols, int color, size_t *bytes)
     termview_opts o = {.cols = cols, .color = color};
     bytebuf b;
     bytebuf_init(&b);
-    double t0 = now();
+    double t0 = bench_now();
     if (termview_render(im, &o, &b, NULL) != RT_OK) {
         fprintf(stderr, "render failed\n");
         exit(1);
     }
-    double t = now() - t0;
+    double t = bench_now() - t0;
     *bytes = b.len;
     bytebuf_free(&b);
     return t;

@@ -146,36 +146,15 @@ static int fv_preview(interp *I, const void *p, image **out)
     const field_prog *prog = fv_prog(I, fv);
     if (!prog)
         return -1;
-    enum { N = 128 };
     image *im;
-    if (lang_image_new(I, N, N, &im))
+    rt_error e;
+    if (lang_image_new(I, 128, 128, &im))
         return -1;
-    double *v = mem_alloc(I, sizeof(double) * N * N);
-    if (!v) {
+    rt_code c = field_preview(prog, im, &e);
+    if (c) {
         lang_image_discard(im);
-        return err_at(I, NULL, ERR_MEMORY, "out of memory");
+        return lang_rt_error(I, c, &e, "show");
     }
-    double xs[N], ys[N], zs[N];
-    for (int j = 0; j < N; j++) {
-        for (int i = 0; i < N; i++) {
-            xs[i] = -1 + 2 * (i + 0.5) / N;
-            ys[i] = 1 - 2 * (j + 0.5) / N;
-            zs[i] = 0;
-        }
-        field_prog_eval(prog, N, xs, ys, zs, v + (size_t)j * N);
-    }
-    double mn = INFINITY, mx = -INFINITY;
-    for (int i = 0; i < N * N; i++)
-        if (isfinite(v[i])) {
-            mn = v[i] < mn ? v[i] : mn;
-            mx = v[i] > mx ? v[i] : mx;
-        }
-    for (int i = 0; i < N * N; i++) {
-        float g = mx > mn && isfinite(v[i]) ? (float)((v[i] - mn) / (mx - mn)) : 0.0f;
-        im->px[4 * i] = im->px[4 * i + 1] = im->px[4 * i + 2] = g;
-        im->px[4 * i + 3] = 1;
-    }
-    mem_free(I, v);
     *out = im;
     return 0;
 }
@@ -598,13 +577,9 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         lang_field_fn_done(tmp, own);
     }
     lang_field_fn_done(ctmp, cown);
-    if (c) {
-        mesh_free(m); /* what the engine built before it failed */
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "isosurface");
-    }
-    report_work(I, "isosurface", "triangles", (double)m->nt, t0);
-    return lang_mesh_value(I, m, out);
+    if (!c)
+        report_work(I, "isosurface", "triangles", (double)m->nt, t0);
+    return lang_mesh_finish(I, m, c, &e, "isosurface", out);
 }
 
 static int b_raymarch(interp *I, value *a, int n, value *out)
@@ -624,8 +599,8 @@ static int b_raymarch(interp *I, value *a, int n, value *out)
     if ((a[1].k != V_NIL && lang_get_camera(I, a[1], &cam, "raymarch")) ||
         lang_get_box(I, a[3], a[4], o.lo, o.hi, "raymarch"))
         return -1;
-    if (a[1].k == V_NIL && camera_frame_box(&cam, o.lo, o.hi, w, h, 30, 20, 40)) /* the one default framing */
-        return err_at(I, NULL, ERR_VALUE, "raymarch: cannot frame the box");
+    if (a[1].k == V_NIL && lang_frame_default(I, o.lo, o.hi, w, h, &cam, "raymarch: cannot frame the box"))
+        return -1;
     /* declared: mode str{emission,solid}, sigma num>0, step num>0 */
     o.mode = strcmp(AS_STR(a[5])->s, "solid") == 0 ? RM_SOLID : RM_EMISSION;
     o.threshold = a[6].u.n;

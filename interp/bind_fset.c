@@ -456,8 +456,8 @@ static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, c
         double lo[3], hi[3];
         if ((c = fset_chaos_box(&f->fs, o, co, lo, hi, &e)))
             return lang_rt_error(I, c, &e, "chaos_fset");
-        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
-            return err_at(I, NULL, ERR_VALUE, "chaos_fset: cannot frame the set (its box is not finite)");
+        if (lang_frame_default(I, lo, hi, w, h, &cam, "chaos_fset: cannot frame the set (its box is not finite)"))
+            return -1;
     }
     image *im;
     if (lang_depth_image(I, w, h, 8, "chaos_fset", &im))

@@ -776,12 +776,7 @@ static int b_points(interp *I, value *a, int n, value *out)
     rt_code c = chaos_points(&s, &o, m, &run, &e);
     if (!c)
         report_work(I, "chaos game", "points", (double)o.points, t0);
-    if (c) {
-        mesh_free(m);
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "points");
-    }
-    return lang_mesh_value(I, m, out);
+    return lang_mesh_finish(I, m, c, &e, "points", out);
 }
 
 static int b_view(interp *I, value *a, int n, value *out)
@@ -807,8 +802,8 @@ static int b_view(interp *I, value *a, int n, value *out)
         double lo[3], hi[3];
         if ((c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e)))
             return lang_rt_error(I, c, &e, "view");
-        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
-            return err_at(I, NULL, ERR_VALUE, "view: cannot frame the attractor (its box is not finite)");
+        if (lang_frame_default(I, lo, hi, w, h, &cam, "view: cannot frame the attractor (its box is not finite)"))
+            return -1;
     }
     image *im;
     if (lang_depth_image(I, w, h, 16, "view", &im))

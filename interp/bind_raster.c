@@ -88,8 +88,8 @@ static int b_rasterize(interp *I, value *a, int n, value *out)
         for (int d = 0; d < 3; d++)
             if (!(hi[d] >= lo[d]))
                 lo[d] = hi[d] = 0;
-        if (camera_frame_box(&cam, lo, hi, w, h, 30, 20, 40))
-            return err_at(I, NULL, ERR_VALUE, "rasterize: cannot frame the scene");
+        if (lang_frame_default(I, lo, hi, w, h, &cam, "rasterize: cannot frame the scene"))
+            return -1;
     }
     /* one mesh to draw: a mesh as given, or the tessellations (LOD from this
      * camera) and meshes merged in order */

@@ -40,6 +40,13 @@ static void shape_summary(const void *pp, bytebuf *out)
                    s->npoly == 1 ? "" : "s", closed, s->dim, detiter_length(s));
 }
 
+/* shape.coords[i]: vertex i as [x, y] (or [x, y, z]) */
+static int vertex_value(interp *I, const void *pp, size_t i, value *out)
+{
+    const detiter_shape *s = pp;
+    return lang_num_list_value(I, s->v + i * (size_t)s->dim, (size_t)s->dim, out);
+}
+
 static int shape_get(interp *I, const void *pp, const char *name, value *out)
 {
     const detiter_shape *s = pp;
@@ -63,18 +70,7 @@ static int shape_get(interp *I, const void *pp, const char *name, value *out)
         if ((double)s->nverts > I->lim.max_list)
             return err_at(I, NULL, ERR_LIMIT, "shape.coords: %zu vertices exceed the list limit of %.0f (raise it with --max-list)",
                           s->nverts, I->lim.max_list);
-        value l = val_list(I, s->nverts);
-        if (l.k == V_NIL)
-            return -1;
-        for (size_t i = 0; i < s->nverts; i++) {
-            value p;
-            if (lang_num_list_value(I, s->v + i * (size_t)s->dim, (size_t)(s->dim), &p) || val_list_push(I, AS_LIST(l), p)) {
-                val_unref(I, l);
-                return -1;
-            }
-        }
-        *out = l;
-        return 0;
+        return val_list_build(I, s->nverts, vertex_value, s, out);
     } else
         return 1;
     return 0;
@@ -371,12 +367,9 @@ static int iterate_mesh(interp *I, const lang_fset *f, const fset_order *o, long
     rt_run run = lang_run(I);
     double t0 = report_clock();
     c = fset_iterate_mesh(&f->fs, o, (size_t)steps, copies, k0, m, &run, &e);
-    if (c) {
-        mem_free(I, m);
-        return lang_rt_error(I, c, &e, "iterate");
-    }
-    report_work(I, "iterate", "triangles", (double)m->nt, t0);
-    return lang_mesh_value(I, m, out);
+    if (!c)
+        report_work(I, "iterate", "triangles", (double)m->nt, t0);
+    return lang_mesh_finish(I, m, c, &e, "iterate", out);
 }
 
 /* iterate(system, start, steps, order) */

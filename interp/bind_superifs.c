@@ -50,6 +50,15 @@ static void superifs_summary(const void *pp, bytebuf *out)
         bytebuf_printf(out, " …");
 }
 
+/* s.ifs[v]: the IFS (1-based) buffer v took at the last step, nil if none */
+static int ifs_value(interp *I, const void *pp, size_t v, value *out)
+{
+    (void)I;
+    const lang_superifs *s = pp;
+    *out = s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1);
+    return 0;
+}
+
 static int superifs_get(interp *I, const void *pp, const char *name, value *out)
 {
     const lang_superifs *s = pp;
@@ -60,16 +69,7 @@ static int superifs_get(interp *I, const void *pp, const char *name, value *out)
     else if (strcmp(name, "steps") == 0)
         *out = val_num((double)s->steps);
     else if (strcmp(name, "ifs") == 0) {
-        value l = val_list(I, (size_t)s->st.V);
-        if (l.k == V_NIL)
-            return -1;
-        for (int v = 0; v < s->st.V; v++)
-            if (val_list_push(I, AS_LIST(l), s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1))) {
-                val_unref(I, l);
-                return -1;
-            }
-        *out = l;
-        return 0;
+        return val_list_build(I, (size_t)s->st.V, ifs_value, s, out);
     } else
         return 1;
     return 0;
@@ -180,21 +180,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
         if (lang_window_arg(I, a[3], lo, hi, "superifs_image: window"))
             return -1;
     } else {
-        /* the bounds of all buffers, so every buffer is drawn at one scale */
-        lo[0] = lo[1] = INFINITY;
-        hi[0] = hi[1] = -INFINITY;
-        size_t np = (size_t)s->st.V * s->st.points;
-        for (size_t i = 0; i < np; i++)
-            for (int k = 0; k < 2; k++) {
-                double x = s->st.pts[2 * i + (size_t)k];
-                if (!isfinite(x))
-                    continue;
-                if (x < lo[k])
-                    lo[k] = x;
-                if (x > hi[k])
-                    hi[k] = x;
-            }
-        if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1]))
+        if (superifs_bounds(&s->st, lo, hi)) /* all buffers: every buffer is drawn at one scale */
             return err_at(I, NULL, ERR_VALUE, "superifs_image: the buffers hold no finite points; give window:");
         fset_fit_aspect(lo, hi, w, h, 0.03);
     }

@@ -338,6 +338,15 @@ int lang_mesh_value(interp *I, mesh *m, value *out)
     return out->k == V_NIL ? -1 : 0;
 }
 
+int lang_mesh_finish(interp *I, mesh *m, rt_code c, const rt_error *e, const char *what, value *out)
+{
+    if (c) {
+        mesh_destroy(m);
+        return lang_rt_error(I, c, e, what);
+    }
+    return lang_mesh_value(I, m, out);
+}
+
 mesh *lang_as_mesh(value v)
 {
     return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_mesh_class ? AS_OBJ(v)->payload : NULL;

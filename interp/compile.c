@@ -205,20 +205,18 @@ static int c_field(interp *I, env *e, const cnode *c, value *out)
     return r;
 }
 
+/* element i of a list literal: compiled kid i run (eval_kids) */
+static int list_kid(interp *I, const void *ctx, size_t i, value *out)
+{
+    const eval_kids *k = ctx;
+    const cnode *c = k->of;
+    return cnode_eval(I, k->e, c->kids[i], out);
+}
+
 static int c_list(interp *I, env *e, const cnode *c, value *out)
 {
-    value l = val_list(I, (size_t)c->nkids);
-    if (l.k == V_NIL)
-        return -1;
-    for (int i = 0; i < c->nkids; i++) {
-        value v;
-        if (cnode_eval(I, e, c->kids[i], &v) || val_list_push(I, AS_LIST(l), v)) {
-            val_unref(I, l);
-            return -1;
-        }
-    }
-    *out = l;
-    return 0;
+    const eval_kids k = {e, c};
+    return val_list_build(I, (size_t)c->nkids, list_kid, &k, out);
 }
 
 /* do … end as an expression: a new scope for its statements */
@@ -353,12 +351,7 @@ static int c_exprstmt(interp *I, env *e, const cnode *c, value *last)
     value v;
     if (cnode_eval(I, e, c->a, &v))
         return -1;
-    if (last) {
-        val_unref(I, *last);
-        *last = v;
-    } else {
-        val_unref(I, v);
-    }
+    eval_keep_last(I, last, v);
     return 0;
 }
 

@@ -648,6 +648,24 @@ fail:
     return -1;
 }
 
+void eval_keep_last(interp *I, value *last, value v)
+{
+    if (last) {
+        val_unref(I, *last);
+        *last = v;
+    } else {
+        val_unref(I, v);
+    }
+}
+
+/* element i of a list literal: kid i evaluated (eval_kids) */
+static int list_kid(interp *I, const void *ctx, size_t i, value *out)
+{
+    const eval_kids *k = ctx;
+    const node *n = k->of;
+    return eval_expr(I, k->e, n->kids[i], out);
+}
+
 /* The C stack is nearly full. Inside a function the error is reported at
  * the innermost call (the recursion the reader looks for; where exactly the
  * stack ran out depends on frame sizes), else at the node. */
@@ -681,18 +699,8 @@ __attribute__((noinline)) static int eval_cold(interp *I, env *e, const node *n,
     case N_NAME:
         return eval_name(I, e, n, out);
     case N_LIST: {
-        value l = val_list(I, (size_t)n->nkids);
-        if (l.k == V_NIL)
-            return -1;
-        for (int i = 0; i < n->nkids; i++) {
-            value v;
-            if (eval_expr(I, e, n->kids[i], &v) || val_list_push(I, AS_LIST(l), v)) {
-                val_unref(I, l);
-                return -1;
-            }
-        }
-        *out = l;
-        return 0;
+        const eval_kids k = {e, n};
+        return val_list_build(I, (size_t)n->nkids, list_kid, &k, out);
     }
     case N_COMP:
         return eval_comp(I, e, n, out);
@@ -1099,12 +1107,7 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         value v;
         if (eval_expr(I, e, n->kids[0], &v))
             return -1;
-        if (last) {
-            val_unref(I, *last);
-            *last = v;
-        } else {
-            val_unref(I, v);
-        }
+        eval_keep_last(I, last, v);
         return 0;
     }
     default:

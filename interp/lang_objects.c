@@ -136,6 +136,14 @@ int lang_get_camera(interp *I, value v, camera *cam, const char *what)
     return 0;
 }
 
+int lang_frame_default(interp *I, const double lo[3], const double hi[3], int w, int h, camera *cam,
+                       const char *fail)
+{
+    if (camera_frame_box(cam, lo, hi, w, h, 30, 20, 40))
+        return err_at(I, NULL, ERR_VALUE, "%s", fail);
+    return 0;
+}
+
 int lang_depth_image(interp *I, int w, int h, double bytes_per_px, const char *what, image **out)
 {
     char m[96];

@@ -21,6 +21,10 @@ int lang_volume_value(interp *I, volume *v, value *out); /* takes ownership */
 volume *lang_as_volume(value v);
 
 int lang_mesh_value(interp *I, mesh *m, value *out); /* takes ownership (m malloc'd) */
+/* An engine's mesh m (mem_alloc'd) as the builtin's result if c is RT_OK,
+ * else m freed with what the engine built and the error reported as `what`
+ * (lang_rt_error). Takes m. */
+int lang_mesh_finish(interp *I, mesh *m, rt_code c, const rt_error *e, const char *what, value *out);
 mesh *lang_as_mesh(value v);
 
 /* A colour ramp from a list of colours (evenly spaced stops) or a table of
@@ -49,6 +53,12 @@ int lang_opt_num(interp *I, value rec, const char *key, double *out);
  * fov: 40} (what orbit() and look_at() return), an argument declared
  * TY_CAMERA (so its keys are already checked). */
 int lang_get_camera(interp *I, value v, camera *cam, const char *what);
+
+/* The one default framing (camera_frame_box: azimuth 30°, elevation 20°,
+ * fov 40°) of the box lo..hi for a w × h picture; -1 with the error
+ * message `fail` (ERR_VALUE) when a corner is not finite. */
+int lang_frame_default(interp *I, const double lo[3], const double hi[3], int w, int h, camera *cam,
+                       const char *fail);
 
 /* A box lo..hi from two vec3 arguments (messages "WHAT: lo", "WHAT: hi"),
  * lo < hi on every axis. */

@@ -226,6 +226,22 @@ int val_list_push(interp *I, vlist *l, value v)
     return 0;
 }
 
+int val_list_build(interp *I, size_t n, val_item_fn item, const void *ctx, value *out)
+{
+    value l = val_list(I, n);
+    if (l.k == V_NIL)
+        return -1;
+    for (size_t i = 0; i < n; i++) {
+        value v;
+        if (item(I, ctx, i, &v) || val_list_push(I, AS_LIST(l), v)) {
+            val_unref(I, l);
+            return -1;
+        }
+    }
+    *out = l;
+    return 0;
+}
+
 value val_rec(interp *I)
 {
     vrec *r = heap_new(I, sizeof(vrec), H_REC);

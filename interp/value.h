@@ -154,6 +154,10 @@ value val_str(struct interp *I, const char *s, size_t len);
 value val_cstr(struct interp *I, const char *s);
 value val_list(struct interp *I, size_t cap);
 int val_list_push(struct interp *I, vlist *l, value v); /* takes ownership of v */
+/* *out = [item(0), …, item(n - 1)]: item(I, ctx, i, &v) makes element i (a
+ * new reference; 0 ok, -1 error). 0 ok; -1 after an error, nothing built. */
+typedef int (*val_item_fn)(struct interp *I, const void *ctx, size_t i, value *out);
+int val_list_build(struct interp *I, size_t n, val_item_fn item, const void *ctx, value *out);
 value val_rec(struct interp *I);
 int val_rec_set(struct interp *I, vrec *r, const char *key, value v); /* key interned; takes v */
 value *val_rec_get(const vrec *r, const char *key);                 /* borrowed, or NULL */

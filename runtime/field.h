@@ -125,6 +125,11 @@
  * and v) with any rt_field_fn at the sample centres given in volume.h,
  * with par_for over z-slabs (one chunk per slice): the result does not
  * depend on run->threads.
+ *
+ * field_preview draws a program's slice z = 0 over [-1, 1]^2 (y up, one
+ * sample at each pixel centre) into an allocated image as grey, scaled so
+ * the smallest finite value is 0 and the largest 1 (0 where the value is not
+ * finite or the slice is constant), alpha 1: show(field) in the terminal.
  */
 #ifndef FIELD_H
 #define FIELD_H
@@ -257,6 +262,9 @@ rt_code field_prog_hard_support(const field_prog *p, field_prog **g, rt_error *e
 
 /* Number of instructions and of registers (for tests and the REPL). */
 void field_prog_stats(const field_prog *p, size_t *ninstr, size_t *nregs);
+
+struct image;
+rt_code field_preview(const field_prog *p, struct image *im, rt_error *e);
 
 rt_code field_sample_volume(rt_field_fn fn, const void *ctx, volume *vol, const rt_run *run,
                             rt_error *e);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "density.h"
+#include "image.h"
 #include "noise.h"
 #include "par.h"
 
@@ -191,6 +192,41 @@ double field_prog_eval1(const field_prog *p, double x, double y, double z)
     double v;
     field_prog_eval(p, 1, &x, &y, &z, &v);
     return v;
+}
+
+/* ---- the terminal preview */
+
+rt_code field_preview(const field_prog *p, image *im, rt_error *e)
+{
+    int w = im->w, h = im->h;
+    double *v = rt_mallocn((size_t)w * (size_t)h, sizeof *v);
+    if (!v)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the field preview");
+    double xs[RT_BLOCK], ys[RT_BLOCK], zs[RT_BLOCK];
+    for (int j = 0; j < h; j++)
+        for (int i0 = 0; i0 < w; i0 += RT_BLOCK) {
+            int m = w - i0 < RT_BLOCK ? w - i0 : RT_BLOCK;
+            for (int i = 0; i < m; i++) {
+                xs[i] = -1 + 2 * (i0 + i + 0.5) / w;
+                ys[i] = 1 - 2 * (j + 0.5) / h;
+                zs[i] = 0;
+            }
+            field_prog_eval(p, (size_t)m, xs, ys, zs, v + (size_t)j * (size_t)w + (size_t)i0);
+        }
+    double mn = INFINITY, mx = -INFINITY;
+    size_t np = (size_t)w * (size_t)h;
+    for (size_t i = 0; i < np; i++)
+        if (isfinite(v[i])) {
+            mn = v[i] < mn ? v[i] : mn;
+            mx = v[i] > mx ? v[i] : mx;
+        }
+    for (size_t i = 0; i < np; i++) {
+        float g = mx > mn && isfinite(v[i]) ? (float)((v[i] - mn) / (mx - mn)) : 0.0f;
+        im->px[4 * i] = im->px[4 * i + 1] = im->px[4 * i + 2] = g;
+        im->px[4 * i + 3] = 1;
+    }
+    rt_free(v);
+    return RT_OK;
 }
 
 /* ---- volumes */

@@ -321,9 +321,20 @@ typedef struct chaos_ctx {
     const fset_chaos_opts *opts;
     const hist2 *hs;
     double *cum;      /* fs->n * FSET_MAX_MAPS */
-    uint64_t **count; /* per worker */
+    uint64_t *count;  /* per worker: worker i's w × h counts at count + i w h */
     int failed;       /* a worker could not allocate */
 } chaos_ctx;
+
+/* What a parallel game ends with: interrupted, a worker out of memory, or
+ * the code par_for gave. */
+static rt_code workers_done(rt_code code, int failed, rt_error *e)
+{
+    if (code == RT_ECANCEL)
+        return rt_fail(e, code, "interrupted");
+    if (failed)
+        return rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
+    return code;
+}
 
 /* Every set's cumulative probabilities, FSET_MAX_MAPS per set (rt_free it);
  * NULL when out of memory. */
@@ -354,7 +365,7 @@ static void chaos_orbit(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
     const fset_chaos_opts *op = c->opts;
-    uint64_t *cnt = c->count[worker];
+    uint64_t *cnt = c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h;
     uint64_t first = (uint64_t)chunk * CHAOS_CHUNK;
     uint64_t npts = op->points - first < CHAOS_CHUNK ? op->points - first : CHAOS_CHUNK;
     uint64_t period = (op->plot_period && c->o->kind != FSET_RANDOM) ? (uint64_t)c->o->len : 1;
@@ -416,7 +427,7 @@ static double *walk_chunk(const fset *fs, const fset_order *o, const double *cum
 static void chaos_walk(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
-    uint64_t *cnt = c->count[worker];
+    uint64_t *cnt = c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h;
     size_t n;
     double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 2, &n);
     if (!pt) {
@@ -458,43 +469,27 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
     int nw = par_workers(run, nchunks);
     size_t nbins = (size_t)hs->w * (size_t)hs->h;
     c.cum = cumulative_tables(fs);
-    c.count = rt_calloc((size_t)nw, sizeof *c.count);
+    c.count = rt_calloc((size_t)nw * nbins, sizeof *c.count);
     if (!c.cum || !c.count) {
-        code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread histograms", nw);
         goto done;
-    }
-    for (int i = 0; i < nw; i++) {
-        c.count[i] = rt_calloc(nbins, sizeof **c.count);
-        if (!c.count[i]) {
-            code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread histograms", nw);
-            goto done;
-        }
     }
     par_part pp; /* a shard runs its chunks; counts are exact sums (par.h) */
     code = par_part_begin(&pp, run, "fset chaos", nchunks, e);
     if (code)
         goto done;
     code = par_part_for(&pp, "chaos", opts->mode == FSET_WALK ? chaos_walk : chaos_orbit, &c);
-    if (code == RT_ECANCEL) {
-        rt_fail(e, code, "interrupted");
+    if ((code = workers_done(code, c.failed, e)))
         goto done;
-    }
-    if (c.failed) {
-        code = rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
-        goto done;
-    }
     for (int i = 1; pp.mode != PAR_FULL && i < nw; i++) /* the shard's sums into worker 0's */
         for (size_t b = 0; b < nbins; b++)
-            c.count[0][b] += c.count[i][b];
-    if (pp.mode != PAR_FULL && (code = par_part_sum(&pp, c.count[0], nbins, e)))
+            c.count[b] += c.count[(size_t)i * nbins + b];
+    if (pp.mode != PAR_FULL && (code = par_part_sum(&pp, c.count, nbins, e)))
         goto done;
     for (int i = 0; i < (pp.mode != PAR_FULL ? 1 : nw); i++)
         for (size_t b = 0; b < nbins; b++)
-            hs->count[b] += c.count[i][b];
+            hs->count[b] += c.count[(size_t)i * nbins + b];
 done:
-    if (c.count)
-        for (int i = 0; i < nw; i++)
-            rt_free(c.count[i]);
     rt_free(c.count);
     rt_free(c.cum);
     return code;
@@ -604,7 +599,7 @@ typedef struct view_ctx {
     const camera *cam; /* NULL: the box pre-pass, points into pts */
     int w, h;
     double *cum;
-    double **zb;  /* per worker depth buffers */
+    double *zb;   /* per worker: worker i's w × h depths at zb + i w h */
     double *pts;  /* box pass: 3 per plotted point */
     int failed;
 } view_ctx;
@@ -621,8 +616,9 @@ static void view_plot(view_ctx *c, int worker, uint64_t idx, const double p[3])
     if (!(sx >= 0 && sx < c->w && sy >= 0 && sy < c->h))
         return;
     size_t b = (size_t)(int)sy * (size_t)c->w + (size_t)(int)sx;
-    if (z < c->zb[worker][b])
-        c->zb[worker][b] = z;
+    double *zb = c->zb + (size_t)worker * (size_t)c->w * (size_t)c->h;
+    if (z < zb[b])
+        zb[b] = z;
 }
 
 static void view_step(const view_ctx *c, uint64_t k, rng *r, double p[3])
@@ -835,35 +831,23 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
     int nw = par_workers(run, nchunks ? nchunks : 1);
     size_t nb = (size_t)im->w * (size_t)im->h;
     c.cum = cumulative_tables(fs);
-    c.zb = rt_calloc((size_t)nw, sizeof *c.zb);
+    c.zb = rt_mallocn((size_t)nw * nb, sizeof *c.zb);
     if (!c.cum || !c.zb) {
-        code = rt_fail(e, RT_ENOMEM, "out of memory for the chaos game");
+        code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread depth buffers", nw);
         goto done;
     }
-    for (int i = 0; i < nw; i++) {
-        if (!(c.zb[i] = rt_mallocn(nb, sizeof **c.zb))) {
-            code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread depth buffers", nw);
-            goto done;
-        }
-        for (size_t b = 0; b < nb; b++)
-            c.zb[i][b] = INFINITY;
-    }
+    for (size_t b = 0; b < (size_t)nw * nb; b++)
+        c.zb[b] = INFINITY;
     if (nchunks)
         code = par_for(run, "chaos", nchunks, opts->mode == FSET_WALK ? view_walk : view_orbit, &c);
-    if (code == RT_ECANCEL) {
-        rt_fail(e, code, "interrupted");
+    if ((code = workers_done(code, c.failed, e)))
         goto done;
-    }
-    if (c.failed) {
-        code = rt_fail(e, RT_ENOMEM, "out of memory in the chaos game");
-        goto done;
-    }
     double zmin = INFINITY, zmax = -INFINITY;
     for (size_t b = 0; b < nb; b++) {
         for (int i = 1; i < nw; i++)
-            if (c.zb[i][b] < c.zb[0][b])
-                c.zb[0][b] = c.zb[i][b];
-        double z = c.zb[0][b];
+            if (c.zb[(size_t)i * nb + b] < c.zb[b])
+                c.zb[b] = c.zb[(size_t)i * nb + b];
+        double z = c.zb[b];
         if (z < INFINITY) {
             zmin = z < zmin ? z : zmin;
             zmax = z > zmax ? z : zmax;
@@ -872,7 +856,7 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
     double span = zmax > zmin ? zmax - zmin : 1;
     for (size_t b = 0; b < nb; b++) {
         float *px = im->px + 4 * b;
-        double z = c.zb[0][b];
+        double z = c.zb[b];
         if (!(z < INFINITY)) {
             memcpy(px, bg, 4 * sizeof(float));
             continue;
@@ -882,9 +866,6 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
         px[3] = 1;
     }
 done:
-    if (c.zb)
-        for (int i = 0; i < nw; i++)
-            rt_free(c.zb[i]);
     rt_free(c.zb);
     rt_free(c.cum);
     return code;

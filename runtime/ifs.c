@@ -80,9 +80,7 @@ void ifs_alias_free(ifs_alias *a)
 {
     rt_free(a->thresh);
     rt_free(a->sel);
-    a->thresh = NULL;
-    a->sel = NULL;
-    a->n = 0;
+    memset(a, 0, sizeof *a);
 }
 
 double ifs_alias_prob(const ifs_alias *a, int i)

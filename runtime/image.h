@@ -39,5 +39,8 @@ typedef struct image_save_opts {
 rt_code image_save(const image *im, const char *path, const image_save_opts *opts, rt_error *e);
 /* Load .png, .ppm/.pgm (P5/P6, 8 or 16 bit) and .pfm by content. */
 rt_code image_load(image *im, const char *path, rt_error *e);
+/* What a loader starts with: im emptied (0 × 0, px NULL) and the file read
+ * whole into *d (at most max bytes; rt_free it). */
+rt_code image_read_file(const char *path, size_t max, image *im, unsigned char **d, size_t *n, rt_error *e);
 
 #endif

@@ -52,13 +52,18 @@ rt_code image_save(const image *im, const char *path, const image_save_opts *opt
     return c;
 }
 
+rt_code image_read_file(const char *path, size_t max, image *im, unsigned char **d, size_t *n, rt_error *e)
+{
+    im->w = im->h = 0;
+    im->px = NULL;
+    return fileio_read_all(path, max, d, n, e);
+}
+
 rt_code image_load(image *im, const char *path, rt_error *e)
 {
     unsigned char *d;
     size_t n;
-    im->w = im->h = 0;
-    im->px = NULL;
-    rt_code c = fileio_read_all(path, IMAGE_MAX_FILE, &d, &n, e);
+    rt_code c = image_read_file(path, IMAGE_MAX_FILE, im, &d, &n, e);
     if (c)
         return c;
     if (n >= 4 && d[0] == 0x89 && d[1] == 'P' && d[2] == 'N' && d[3] == 'G')

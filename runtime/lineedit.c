@@ -417,6 +417,21 @@ static int in_key_byte(lineedit *le)
     return c < 0 ? K_NONE : c;
 }
 
+/* The final byte of an arrow, Home or End key, the same after SS3 and CSI
+ * (ESC O A, ESC [ A, ESC [ 1 ; 5 A); K_NONE for any other byte. */
+static int cursor_key(int c)
+{
+    switch (c) {
+    case 'A': return K_UP;
+    case 'B': return K_DOWN;
+    case 'C': return K_RIGHT;
+    case 'D': return K_LEFT;
+    case 'H': return K_HOME;
+    case 'F': return K_END;
+    default: return K_NONE;
+    }
+}
+
 /* After ESC: decode CSI (ESC [ params final) and SS3 (ESC O final). Unknown
  * sequences and a lone ESC (nothing follows within ESC_WAIT_MS) give K_NONE;
  * Alt+key (ESC then a plain byte) is ignored. */
@@ -427,15 +442,7 @@ static int read_escape(lineedit *le)
         return c;
     if (c == 'O') {
         c = in_key_byte(le);
-        switch (c) {
-        case 'A': return K_UP;
-        case 'B': return K_DOWN;
-        case 'C': return K_RIGHT;
-        case 'D': return K_LEFT;
-        case 'H': return K_HOME;
-        case 'F': return K_END;
-        default: return c >= 1000 ? c : K_NONE;
-        }
+        return c >= 1000 ? c : cursor_key(c);
     }
     if (c != '[')
         return K_NONE;
@@ -458,22 +465,14 @@ static int read_escape(lineedit *le)
             break;
         }
     }
-    switch (c) {
-    case 'A': return K_UP;
-    case 'B': return K_DOWN;
-    case 'C': return K_RIGHT;
-    case 'D': return K_LEFT;
-    case 'H': return K_HOME;
-    case 'F': return K_END;
-    case '~':
+    if (c == '~')
         switch (p1) {
         case 1: case 7: return K_HOME;
         case 4: case 8: return K_END;
         case 3: return K_DELETE;
         default: return K_NONE;
         }
-    default: return K_NONE;
-    }
+    return cursor_key(c);
 }
 
 /* ---- history --------------------------------------------------------------------- */

@@ -867,9 +867,7 @@ rt_code png_load(const char *path, image *im, png_info *info, rt_error *e)
 {
     unsigned char *d;
     size_t n;
-    im->w = im->h = 0;
-    im->px = NULL;
-    rt_code c = fileio_read_all(path, PNG_MAX_FILE, &d, &n, e);
+    rt_code c = image_read_file(path, PNG_MAX_FILE, im, &d, &n, e);
     if (c)
         return c;
     c = png_decode(d, n, im, info, e);

@@ -16,6 +16,8 @@ typedef struct hdr {
     const unsigned char *d;
     size_t n, pos;
     const char *what; /* "PGM", "PPM", "PFM" for messages */
+    int ch;           /* 1 grey, 3 RGB */
+    unsigned long w, ht;
 } hdr;
 
 static int is_space(unsigned char c)
@@ -79,24 +81,24 @@ static rt_code end_header(hdr *h, rt_error *e)
  * gives 1 channel, kinds[1] 3), the width and the height; im is empty until
  * start_data. */
 static rt_code read_head(image *im, const unsigned char *d, size_t n, const char kinds[2], const char *what1,
-                         const char *what3, const char *not_msg, hdr *h, int *ch, unsigned long *w,
-                         unsigned long *ht, rt_error *e)
+                         const char *what3, const char *not_msg, hdr *h, rt_error *e)
 {
     im->w = im->h = 0;
     im->px = NULL;
     if (n < 2 || d[0] != 'P' || (d[1] != kinds[0] && d[1] != kinds[1]))
         return rt_fail(e, RT_EFORMAT, "%s", not_msg);
-    *ch = d[1] == kinds[0] ? 1 : 3;
-    *h = (hdr){d, n, 2, *ch == 1 ? what1 : what3};
-    rt_code c = read_num(h, "width", INT_MAX, w, e);
-    return c ? c : read_num(h, "height", INT_MAX, ht, e);
+    int ch = d[1] == kinds[0] ? 1 : 3;
+    *h = (hdr){d, n, 2, ch == 1 ? what1 : what3, ch, 0, 0};
+    rt_code c = read_num(h, "width", INT_MAX, &h->w, e);
+    return c ? c : read_num(h, "height", INT_MAX, &h->ht, e);
 }
 
 /* The end every header shares: the one whitespace byte, then room for the
  * samples (bps bytes each) and the image. */
-static rt_code start_data(hdr *h, unsigned long w, unsigned long ht, int channels, size_t bps, image *im,
-                          rt_error *e)
+static rt_code start_data(hdr *h, size_t bps, image *im, rt_error *e)
 {
+    unsigned long w = h->w, ht = h->ht;
+    int channels = h->ch;
     rt_code c = end_header(h, e);
     if (c)
         return c;
@@ -151,17 +153,18 @@ rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
 
 rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, rt_error *e)
 {
-    int ch;
     hdr h;
-    unsigned long w, ht, maxval;
+    unsigned long maxval;
     rt_code c;
     const char *not_msg = "not a binary PGM/PPM file (expected 'P5' or 'P6')";
-    if ((c = read_head(im, d, n, "56", "PGM", "PPM", not_msg, &h, &ch, &w, &ht, e)) ||
+    if ((c = read_head(im, d, n, "56", "PGM", "PPM", not_msg, &h, e)) ||
         (c = read_num(&h, "maxval", 65535, &maxval, e)))
         return c;
     size_t bps = maxval < 256 ? 1 : 2;
-    if ((c = start_data(&h, w, ht, ch, bps, im, e)))
+    if ((c = start_data(&h, bps, im, e)))
         return c;
+    const int ch = h.ch;
+    const unsigned long w = h.w, ht = h.ht;
     const unsigned char *s = d + h.pos;
     size_t np = (size_t)w * (size_t)ht;
     double mv = (double)maxval;
@@ -211,11 +214,9 @@ rt_code pfm_encode(const image *im, int channels, bytebuf *out, rt_error *e)
 
 rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, rt_error *e)
 {
-    int ch;
     hdr h;
-    unsigned long w, ht;
     rt_code c;
-    if ((c = read_head(im, d, n, "fF", "PFM", "PFM", "not a PFM file (expected 'PF' or 'Pf')", &h, &ch, &w, &ht, e)))
+    if ((c = read_head(im, d, n, "fF", "PFM", "PFM", "not a PFM file (expected 'PF' or 'Pf')", &h, e)))
         return c;
     if (!skip_ws(&h) || h.pos >= h.n)
         return rt_fail(e, RT_EFORMAT, "PFM header is truncated (no scale)");
@@ -231,9 +232,10 @@ rt_code pfm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
     double scale = strtod(tok, &end);
     if (end == tok || *end || !(scale != 0) || !isfinite(scale))
         return rt_fail(e, RT_EFORMAT, "PFM scale '%s' is not a non-zero number", tok);
-    if ((c = start_data(&h, w, ht, ch, 4, im, e)))
+    if ((c = start_data(&h, 4, im, e)))
         return c;
-    int le = scale < 0;
+    const int ch = h.ch, le = scale < 0;
+    const unsigned long w = h.w, ht = h.ht;
     const unsigned char *s = d + h.pos;
     for (int y = (int)ht - 1; y >= 0; y--)
         for (int x = 0; x < (int)w; x++) {

@@ -2,6 +2,7 @@
 #include "superifs.h"
 #include "rt_alloc.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -129,6 +130,24 @@ rt_code superifs_render(const superifs_state *s, int v, hist2 *hs, rt_error *e)
             hs->count[b]++;
     }
     return RT_OK;
+}
+
+int superifs_bounds(const superifs_state *s, double lo[2], double hi[2])
+{
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    size_t np = (size_t)s->V * s->points;
+    for (size_t i = 0; i < np; i++)
+        for (int k = 0; k < 2; k++) {
+            double x = s->pts[2 * i + (size_t)k];
+            if (!isfinite(x))
+                continue;
+            if (x < lo[k])
+                lo[k] = x;
+            if (x > hi[k])
+                hi[k] = x;
+        }
+    return hi[0] >= lo[0] && hi[1] >= lo[1] ? 0 : -1;
 }
 
 void superifs_free(superifs_state *s)

@@ -56,6 +56,9 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
                      superifs_state *out, const rt_run *run, rt_error *e);
 /* Add buffer v's points (0-based) to a histogram's counts. */
 rt_code superifs_render(const superifs_state *s, int v, hist2 *hs, rt_error *e);
+/* The box lo..hi of the finite points of all buffers (so every buffer can be
+ * drawn at one scale); -1 if there are none. */
+int superifs_bounds(const superifs_state *s, double lo[2], double hi[2]);
 void superifs_free(superifs_state *s);
 
 #endif

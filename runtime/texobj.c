@@ -297,14 +297,7 @@ rt_code texobj_render(const texobj_shape *s, const camera *cam, const texobj_sou
         return rt_fail(e, RT_EINVAL, "ambient = %g and diffuse = %g must be >= 0", o->ambient, o->diffuse);
     if (!im->px || im->w < 1 || im->h < 1)
         return rt_fail(e, RT_EINVAL, "textured object: the image is not initialised");
-    rjob j;
-    memset(&j, 0, sizeof j);
-    j.s = s;
-    j.cam = cam;
-    j.src = src;
-    j.o = o;
-    j.im = im;
-    j.grey = ramp_grey();
+    rjob j = {.s = s, .cam = cam, .src = src, .o = o, .im = im, .grey = ramp_grey()};
     unit3(o->light, j.light);
     size_t nbands = ((size_t)im->h + TEXOBJ_BAND - 1) / TEXOBJ_BAND;
     int nw = par_workers(run, nbands);

@@ -158,14 +158,7 @@ static rt_code run_tops(const fset_ifs *f, const draw_view *screen, const fset_i
     if (opts->points == 0)
         return RT_OK;
 
-    tops_ctx c;
-    memset(&c, 0, sizeof c);
-    c.f = f;
-    c.g = g;
-    c.screen = screen;
-    c.src_view = src_view;
-    c.opts = opts;
-    c.out = out;
+    tops_ctx c = {.f = f, .g = g, .screen = screen, .src_view = src_view, .opts = opts, .out = out};
     fset_cumulative(f->p, f->n, c.cum);
     fixed_point(&f->maps[0], c.fa);
     if (g)

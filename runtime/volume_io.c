@@ -273,6 +273,33 @@ static int parse_nums(const char *s, double *v, int n)
     return *s ? -1 : 0;
 }
 
+/* The volume of dims[0] × dims[1] × dims[2] samples of a type (big-endian
+ * if big) at data over lo..hi. A huge spacing or origin (or nan/inf, which
+ * strtod reads) gives bounds no writer can store (found by the fuzzer):
+ * refused, naming the header fields `from`. */
+static rt_code volume_of_samples(volume *v, const int dims[3], const double lo[3], const double hi[3],
+                                 const unsigned char *data, int type, int big, const char *from, rt_error *e)
+{
+    for (int k = 0; k < 3; k++)
+        if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k]))
+            return rt_fail(e, RT_EFORMAT, "%s give axis %d the bounds %g .. %g (not finite and increasing)", from, k,
+                           lo[k], hi[k]);
+    rt_code rc = volume_init(v, dims[0], dims[1], dims[2], lo, hi, e);
+    if (rc)
+        return rc;
+    size_t count = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2], ts = sample_size((sample_type)type);
+    for (size_t i = 0; i < count; i++)
+        v->v[i] = decode(data + i * ts, type, big);
+    return RT_OK;
+}
+
+/* A file read whole for a loader (v->v NULL until it is filled). */
+static rt_code read_volume_file(const char *path, volume *v, unsigned char **d, size_t *n, rt_error *e)
+{
+    v->v = NULL;
+    return fileio_read_all(path, (size_t)1 << 40, d, n, e);
+}
+
 rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, volume *v, rt_error *e)
 {
     v->v = NULL;
@@ -473,30 +500,18 @@ rt_code vio_nrrd_from_mem(const unsigned char *d, size_t n, const char *dir, vol
             lo[k] = flo[k];
             hi[k] = fhi[k];
         }
-        if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k])) {
-            rt_free(file);
-            return rt_fail(e, RT_EFORMAT, "NRRD origin and spacing give axis %d the bounds %g .. %g (not finite and increasing)",
-                           k, lo[k], hi[k]);
-        }
     }
-    rt_code rc = volume_init(v, (int)sizes[0], (int)sizes[1], (int)sizes[2], lo, hi, e);
-    if (rc) {
-        rt_free(file);
-        return rc;
-    }
-    size_t ts = sample_size((sample_type)type);
-    for (size_t i = 0; i < count; i++)
-        v->v[i] = decode(data + at + i * ts, type, endian == 1);
+    const int dims[3] = {(int)sizes[0], (int)sizes[1], (int)sizes[2]};
+    rt_code rc = volume_of_samples(v, dims, lo, hi, data + at, type, endian == 1, "NRRD origin and spacing", e);
     rt_free(file);
-    return RT_OK;
+    return rc;
 }
 
 rt_code vio_load_nrrd(const char *path, volume *v, rt_error *e)
 {
     unsigned char *d;
     size_t n;
-    v->v = NULL;
-    rt_code rc = fileio_read_all(path, (size_t)1 << 40, &d, &n, e);
+    rt_code rc = read_volume_file(path, v, &d, &n, e);
     if (rc)
         return rc;
     size_t dl = dir_len(path);
@@ -574,26 +589,16 @@ rt_code vio_vtk_from_mem(const unsigned char *d, size_t n, volume *v, rt_error *
     for (int k = 0; k < 3; k++) {
         lo[k] = org[k] - 0.5 * sp[k];
         hi[k] = lo[k] + sp[k] * dims[k];
-        /* a huge SPACING or ORIGIN (or nan/inf, which strtod reads) gives
-         * bounds no writer can store (found by the fuzzer) */
-        if (!(isfinite(lo[k]) && isfinite(hi[k]) && lo[k] < hi[k]))
-            return rt_fail(e, RT_EFORMAT, "VTK ORIGIN and SPACING give axis %d the bounds %g .. %g (not finite and increasing)",
-                           k, lo[k], hi[k]);
     }
-    rt_code rc = volume_init(v, (int)dims[0], (int)dims[1], (int)dims[2], lo, hi, e);
-    if (rc)
-        return rc;
-    for (size_t i = 0; i < count; i++)
-        v->v[i] = decode(d + pos + 4 * i, SAMPLE_F32, 1);
-    return RT_OK;
+    const int nd[3] = {(int)dims[0], (int)dims[1], (int)dims[2]};
+    return volume_of_samples(v, nd, lo, hi, d + pos, SAMPLE_F32, 1, "VTK ORIGIN and SPACING", e);
 }
 
 rt_code vio_load_vtk(const char *path, volume *v, rt_error *e)
 {
     unsigned char *d;
     size_t n;
-    v->v = NULL;
-    rt_code rc = fileio_read_all(path, (size_t)1 << 40, &d, &n, e);
+    rt_code rc = read_volume_file(path, v, &d, &n, e);
     if (rc)
         return rc;
     rc = vio_vtk_from_mem(d, n, v, e);

@@ -9,6 +9,7 @@
 #include "rt_alloc.h"
 #include "density.h"
 #include "field.h"
+#include "image.h"
 #include "noise.h"
 #include "rng.h"
 
@@ -431,8 +432,53 @@ static void test_volume(void)
     field_prog_free(p);
 }
 
+/* The grey of field_preview at pixel (i, j) of a w x h preview of f. */
+static int preview(field *f, int w, int h, image *im)
+{
+    rt_error e;
+    field_prog *p = field_compile(f, &e);
+    field_unref(f);
+    int ok = p && image_init(im, w, h, &e) == RT_OK && field_preview(p, im, &e) == RT_OK;
+    field_prog_free(p);
+    return ok;
+}
+
+/* field_preview against hand values: pixel centres of [-1, 1]^2 (y up),
+ * scaled from the smallest to the largest finite value. */
+static void test_preview(void)
+{
+    image im;
+    /* x + 4y on 4 x 2: x = -0.75 -0.25 0.25 0.75, y = 0.5 (top row), -0.5;
+     * values 1.25 .. 2.75 and -2.75 .. -1.25, grey (v + 2.75) / 5.5 */
+    CHECK(preview(B(FIELD_ADD, X_(), B(FIELD_MUL, K(4), Y_())), 4, 2, &im), "x + 4y");
+    const double want[8] = {4 / 5.5, 4.5 / 5.5, 5 / 5.5, 1, 0, 0.5 / 5.5, 1 / 5.5, 1.5 / 5.5};
+    int bad = 0;
+    for (int i = 0; i < 8; i++)
+        bad += fabs(im.px[4 * i] - want[i]) > 1e-6 || im.px[4 * i + 1] != im.px[4 * i] ||
+               im.px[4 * i + 2] != im.px[4 * i] || im.px[4 * i + 3] != 1;
+    CHECK(bad == 0, "x + 4y: %d pixels off (first %g, want %g)", bad, im.px[0], want[0]);
+    image_free(&im);
+    /* a row wider than one block (RT_BLOCK = 256): x gives grey i / (w - 1) */
+    CHECK(preview(X_(), 600, 1, &im), "x on 600 x 1");
+    bad = 0;
+    for (int i = 0; i < 600; i++)
+        bad += fabs(im.px[4 * i] - i / 599.0) > 1e-6;
+    CHECK(bad == 0, "x on 600 x 1: %d pixels off", bad);
+    image_free(&im);
+    /* log x: NaN for x < 0 is 0, log 0.25 is 0, log 0.75 is 1 */
+    CHECK(preview(U(FIELD_LOG, X_()), 4, 1, &im), "log x");
+    CHECK(im.px[0] == 0 && im.px[4] == 0 && im.px[8] == 0 && im.px[12] == 1, "log x: %g %g %g %g", im.px[0],
+          im.px[4], im.px[8], im.px[12]);
+    image_free(&im);
+    /* a constant slice is black */
+    CHECK(preview(K(3), 2, 2, &im), "constant");
+    CHECK(im.px[0] == 0 && im.px[12] == 0 && im.px[15] == 1, "constant: black, opaque");
+    image_free(&im);
+}
+
 int main(void)
 {
+    test_preview();
     test_expressions();
     test_folding_and_print();
     test_depth();

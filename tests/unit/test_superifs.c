@@ -1,4 +1,5 @@
 /* test_superifs.c — V-variable super IFS (seed 004 §5). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -99,6 +100,18 @@ int main(void)
     }
     CHECK(gasket && hasx && hasy, "points on the Sierpinski gasket (binary digits disjoint)");
     superifs_free(&rs);
+
+    /* superifs_bounds: the box of the finite points of every buffer (V = 2,
+     * 3 points each; NaN and inf are passed over), by hand: x in -2 .. 4,
+     * y in -1 .. 5. */
+    double pts[12] = {1, 5, NAN, 0, 4, 2, /* buffer 1 */ -2, INFINITY, 0, -1, 3, 0.5};
+    superifs_state bs = {2, 3, pts, NULL};
+    double blo[2], bhi[2];
+    CHECK(superifs_bounds(&bs, blo, bhi) == 0 && blo[0] == -2 && bhi[0] == 4 && blo[1] == -1 && bhi[1] == 5,
+          "bounds of all buffers: [%g, %g] x [%g, %g]", blo[0], bhi[0], blo[1], bhi[1]);
+    double none[4] = {NAN, 1, -INFINITY, 2}; /* y finite, x not */
+    superifs_state ns = {1, 2, none, NULL};
+    CHECK(superifs_bounds(&ns, blo, bhi) == -1, "no finite x: no bounds");
 
     /* Errors. */
     superifs_opts bad = {0, 10, 1, 1, {0, 0}};
