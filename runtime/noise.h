@@ -13,11 +13,15 @@
  *           (0,-1,1), (0,-1,-1) exactly as the reference grad() does
  *     n(p) = lerp(w, lerp(v, lerp(u, ...)))    u, v, w = f(fractional part)
  * Values lie in about [-1.04, 1.04]; n = 0 at every integer lattice point.
- * We evaluate grad() with a 16-entry gradient table (gx*x + gy*y + gz*z)
- * instead of the reference's branches: the same value for every input (the
- * products by 0 and ±1 are exact; only the sign of a zero may differ), and
- * no data-dependent branches, which matters on scattered points (octave
- * sums are scattered): see DESIGN.md, "Facts measured".
+ * We evaluate grad() with gradient coefficients (gx*x + gy*y + gz*z, products
+ * by ±1 and 0, exact) instead of the reference's branches: the same value for
+ * every input, and no data-dependent branches, which matters on scattered
+ * points (octave sums are scattered): see DESIGN.md, "Facts measured". The
+ * per-point code (noise_impl.h) pairs the corners (i, j, 0) and (i, j, 1) in
+ * two-lane vectors, loads P[i] and P[i+1] together and the coefficients of a
+ * pair from one 256-entry table; every lane does the reference's operations
+ * in its order, so the value is bit for bit that of the plain formulation
+ * (noise_perlin_far, which also takes the far and non-finite coordinates).
  *
  * Permutation. noise_perm_init makes P from a seed by a Fisher–Yates shuffle
  * driven by rng stream (seed, 0x6e6f697365 "noise"), with unbiased bounded
@@ -51,8 +55,8 @@
  * permutation lookups), found at run time (noise_simd_best: the highest
  * level __builtin_cpu_supports allows). Every level gives bit for bit the
  * scalar values (same operations in the same order, no FMA), so a result
- * never depends on the machine. The blocks use AVX2 where present and the
- * scalar loop otherwise (the SSE2 kernel measured no faster than it; see
+ * never depends on the machine. The blocks run the per-point loop: both
+ * four-lane kernels measured slower than its paired lanes (see
  * bench/noise_bench.c). The *_block_at variants take the level
  * (NOISE_LEVEL_SCALAR runs the scalar loop), for tests and benchmarks.
  */
