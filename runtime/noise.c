@@ -130,9 +130,14 @@ double noise_perlin3(const noise_perm *np, double x, double y, double z)
     return perlin(np->p, x, y, z);
 }
 
-/* The level the blocks use: the per-point loop (its paired lanes measured
- * faster than the four-lane kernels of noise_simd.c; bench/noise_bench.c). */
-static int block_level(void) { return NOISE_LEVEL_SCALAR; }
+/* The level the blocks use: the best the machine has, except SSE2, whose
+ * four-lane kernel measured slower than the per-point loop's paired lanes
+ * (bench/noise_bench.c). The choice never changes a value. */
+static int block_level(void)
+{
+    int best = noise_simd_best();
+    return best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR;
+}
 
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
                             const double *y, const double *z, double *out)

@@ -50,15 +50,18 @@
  * function's values. All functions are pure and reentrant; a noise_perm is
  * read-only after init and can be shared between threads.
  *
- * SIMD (noise_simd.c). Four points at a time with GCC vector extensions,
- * on two levels: SSE2 (the x86-64 baseline) and AVX2 (with gathers for the
- * permutation lookups), found at run time (noise_simd_best: the highest
- * level __builtin_cpu_supports allows). Every level gives bit for bit the
- * scalar values (same operations in the same order, no FMA), so a result
- * never depends on the machine. The blocks run the per-point loop: both
- * four-lane kernels measured slower than its paired lanes (see
- * bench/noise_bench.c). The *_block_at variants take the level
- * (NOISE_LEVEL_SCALAR runs the scalar loop), for tests and benchmarks.
+ * SIMD (noise_simd.c). Several points at a time on three levels found at
+ * run time (noise_simd_best: the highest level __builtin_cpu_supports
+ * allows): SSE2 (the x86-64 baseline, four points), AVX2 (eight points; the
+ * hash chains in integer registers, the arithmetic on 4-double vectors) and
+ * AVX-512 (eight points in 8-double vectors, the permutation lookups as
+ * byte-lane table permutes, vpermi2b). No level gathers from memory: the
+ * gradient coefficients come from the hash by register table lookups. Every
+ * level gives bit for bit the scalar values (same operations in the same
+ * order, no FMA), so a result never depends on the machine. The blocks use
+ * the best level except SSE2, which measured slower than the per-point loop
+ * (bench/noise_bench.c). The *_block_at variants take the level
+ * (NOISE_LEVEL_SCALAR runs the per-point loop), for tests and benchmarks.
  */
 #ifndef NOISE_H
 #define NOISE_H
@@ -86,7 +89,7 @@ double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, 
 void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
                              const double *y, const double *z, double *out);
 
-enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2 };
+enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2, NOISE_LEVEL_AVX512 };
 int noise_simd_best(void);
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
                             const double *y, const double *z, double *out);
