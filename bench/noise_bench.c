@@ -119,7 +119,7 @@ int main(int argc, char **argv)
     noise_perm np;
     noise_perm_init(&np, 9);
     volatile float fsink = 0;
-    double t_fnl, t_fnl_fbm, t[4], t_fbm[4];
+    double t_fnl, t_fnl_fbm, t[4] = {0}, t_fbm[4] = {0};
     BEST3(t_fnl, {
         float s = 0;
         for (size_t i = 0; i < n; i++)
