@@ -92,10 +92,19 @@ double noise_perlin_far(const uint8_t *p, double x, double y, double z)
                      lerp(u, grad(p[AB + 1], x, y1, z1), grad(p[BB + 1], x1, y1, z1))));
 }
 
+/* p[512..1023] from p[0..511] (noise.h) */
+static void perm_pairs(noise_perm *np)
+{
+    for (int i = 0; i < 511; i++)
+        np->p[512 + i] = (uint8_t)((np->p[i] & 15) | (np->p[i + 1] & 15) << 4);
+    np->p[1023] = np->p[511] & 15;
+}
+
 void noise_perm_reference(noise_perm *np)
 {
     for (int i = 0; i < 256; i++)
         np->p[i] = np->p[i + 256] = ref_perm[i];
+    perm_pairs(np);
 }
 
 /* Uniform integer in [0, n), n >= 1, without modulo bias. */
@@ -123,6 +132,7 @@ void noise_perm_init(noise_perm *np, uint64_t seed)
     }
     for (int i = 0; i < 256; i++)
         np->p[i + 256] = np->p[i];
+    perm_pairs(np);
 }
 
 double noise_perlin3(const noise_perm *np, double x, double y, double z)

@@ -18,8 +18,10 @@
  * every input, and no data-dependent branches, which matters on scattered
  * points (octave sums are scattered): see DESIGN.md, "Facts measured". The
  * per-point code (noise_impl.h) pairs the corners (i, j, 0) and (i, j, 1) in
- * two-lane vectors, loads P[i] and P[i+1] together and the coefficients of a
- * pair from one 256-entry table; every lane does the reference's operations
+ * two-lane vectors, loads P[i] and P[i+1] together, takes the last level of
+ * the hash chain from a second table of the pairs' gradient numbers (kept
+ * after P in noise_perm) and the coefficients of a pair from one 256-entry
+ * table; every lane does the reference's operations
  * in its order, so the value is bit for bit that of the plain formulation
  * (noise_perlin_far, which also takes the far and non-finite coordinates).
  *
@@ -70,7 +72,9 @@
 #include <stdint.h>
 
 typedef struct noise_perm {
-    uint8_t p[512]; /* p[i + 256] == p[i] */
+    /* p[i + 256] == p[i] (i < 256); p[512 + i] = (p[i] & 15) | (p[i + 1] & 15) << 4
+     * (i < 511), the gradient numbers of a pair of corners (noise_impl.h) */
+    uint8_t p[1024];
 } noise_perm;
 
 void noise_perm_init(noise_perm *np, uint64_t seed);

@@ -26,7 +26,8 @@ typedef int32_t noise_v2i __attribute__((vector_size(8)));
 #define NOISE_GZ(h) (((h) >= 4 && (h) != 12 && (h) != 14) ? NOISE_S2(h) : 0)
 
 /* The coefficients of a pair of corners (i, j, 0) and (i, j, 1), indexed by
- * (h0 & 15) | (h1 & 15) << 4: one 16-byte load per axis for both (noise.c). */
+ * (h0 & 15) | (h1 & 15) << 4 (as noise_perm keeps them at p[512 + i]): one
+ * 16-byte load per axis for both (noise.c). */
 typedef struct noise_gpair {
     noise_v2d gx, gy, gz;
 } noise_gpair;
@@ -47,11 +48,11 @@ static inline unsigned perm_pair(const uint8_t *p, unsigned i)
 static inline double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 static inline noise_v2d fade2(noise_v2d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
-/* grad() of the two corners (i, j, 0), (i, j, 1): hp = perm_pair at the
- * pair's index, xc, yc their x and y offsets, zz = {z, z - 1}. */
-static inline noise_v2d grad_pair(unsigned hp, double xc, double yc, noise_v2d zz)
+/* grad() of the two corners (i, j, 0), (i, j, 1): gi = the pair's entry
+ * p[512 + index] (noise.h), xc, yc their x and y offsets, zz = {z, z - 1}. */
+static inline noise_v2d grad_pair(unsigned gi, double xc, double yc, noise_v2d zz)
 {
-    const noise_gpair *g = &noise_gpairs[(hp & 15u) | ((hp >> 4) & 0xf0u)];
+    const noise_gpair *g = &noise_gpairs[gi];
     noise_v2d xv = {xc, xc}, yv = {yc, yc};
     return g->gx * xv + g->gy * yv + g->gz * zz;
 }
@@ -65,7 +66,8 @@ double noise_perlin_far(const uint8_t *p, double x, double y, double z);
  * lane does exactly the reference's operations in its order, so the value
  * is the same for every input (bit for bit what noise_perlin_far gives).
  * The lattice index is an inline floor (libm's floor is a call without
- * SSE4.1): truncate, step down where that went up. */
+ * SSE4.1): truncate, step down where that went up. p is noise_perm.p (all
+ * 1024 bytes: the last level reads the gradient numbers at p + 512). */
 static inline double perlin(const uint8_t *p, double x, double y, double z)
 {
     if (!(fabs(x) < 1073741824.0 && fabs(y) < 1073741824.0 && fabs(z) < 1073741824.0))
@@ -87,8 +89,9 @@ static inline double perlin(const uint8_t *p, double x, double y, double z)
     double w = fade(z);
     unsigned hx = perm_pair(p, X);
     unsigned hA = perm_pair(p, (hx & 255u) + Y), hB = perm_pair(p, (hx >> 8) + Y);
-    unsigned hAA = perm_pair(p, (hA & 255u) + Z), hAB = perm_pair(p, (hA >> 8) + Z);
-    unsigned hBA = perm_pair(p, (hB & 255u) + Z), hBB = perm_pair(p, (hB >> 8) + Z);
+    const uint8_t *pg = p + 512; /* the pairs' gradient numbers */
+    unsigned hAA = pg[(hA & 255u) + Z], hAB = pg[(hA >> 8) + Z];
+    unsigned hBA = pg[(hB & 255u) + Z], hBB = pg[(hB >> 8) + Z];
     double x0 = xy[0], y0 = xy[1], x1 = xy1[0], y1 = xy1[1];
     noise_v2d zz = {z, z - 1};
     noise_v2d uu = {uv[0], uv[0]}, vv = {uv[1], uv[1]};

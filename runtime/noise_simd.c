@@ -100,19 +100,19 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
 }
 
 /* The gradient coefficients of the 64 corners of eight points from their
- * hash pairs: hq[c][j] = the pair (corner c at z, at z + 1) of point j,
- * c = AA, BA, AB, BB; cf[c][axis][l]: lanes l = 0..7 at z, 8..15 at z + 1. */
-ALWAYS_INLINE void coef8_avx2(const uint16_t hq[4][8], int8_t cf[4][3][16])
+ * pairs' gradient numbers: hq[c][j] = p[512 + the pair index] (noise.h) of
+ * corner pair c (AA, BA, AB, BB) of point j; cf[c][axis][l]: lanes l = 0..7
+ * at z, 8..15 at z + 1. */
+ALWAYS_INLINE void coef8_avx2(const uint8_t hq[4][8], int8_t cf[4][3][16])
 {
-    const __m128i deint = _mm_setr_epi8(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15);
     const __m128i low4 = _mm_set1_epi8(15);
 #define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
                              G(11), G(12), G(13), G(14), G(15))
     const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
 #undef T16
     for (int c = 0; c < 4; c++) {
-        __m128i h = _mm_loadu_si128((const __m128i *)(const void *)hq[c]);
-        h = _mm_and_si128(_mm_shuffle_epi8(h, deint), low4);
+        __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)hq[c]);
+        __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
         _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
@@ -132,7 +132,8 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
     const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     int8_t cf[CHUNK][4][3][16];
-    uint16_t hq[CHUNK][4][8];
+    uint8_t hq[CHUNK][4][8];
+    const uint8_t *pg = p + 512;
     int32_t X[CHUNK * 8], Y[CHUNK * 8], Z[CHUNK * 8];
     size_t i = 0;
     while (i + 8 <= n) {
@@ -165,10 +166,10 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
                 unsigned hx = perm_pair(p, (unsigned)X[j]);
                 unsigned hA = perm_pair(p, (hx & 255u) + (unsigned)Y[j]);
                 unsigned hB = perm_pair(p, (hx >> 8) + (unsigned)Y[j]);
-                hq[g][0][l] = (uint16_t)perm_pair(p, (hA & 255u) + (unsigned)Z[j]);
-                hq[g][1][l] = (uint16_t)perm_pair(p, (hB & 255u) + (unsigned)Z[j]);
-                hq[g][2][l] = (uint16_t)perm_pair(p, (hA >> 8) + (unsigned)Z[j]);
-                hq[g][3][l] = (uint16_t)perm_pair(p, (hB >> 8) + (unsigned)Z[j]);
+                hq[g][0][l] = pg[(hA & 255u) + (unsigned)Z[j]];
+                hq[g][1][l] = pg[(hB & 255u) + (unsigned)Z[j]];
+                hq[g][2][l] = pg[(hA >> 8) + (unsigned)Z[j]];
+                hq[g][3][l] = pg[(hB >> 8) + (unsigned)Z[j]];
             }
         }
         for (size_t g = 0; g < ng; g++)
