@@ -27,10 +27,84 @@ static const uint8_t ref_perm[256] = {
     215, 61,  156, 180,
 };
 
+/* noise_impl.h's pair table: entry h0 | h1 << 4 holds the coefficients of
+ * gradients h0 and h1, lane 0 and lane 1. */
+#define GP(i)                                                                                    \
+    {{NOISE_GX((i) & 15), NOISE_GX((i) >> 4)},                                                   \
+     {NOISE_GY((i) & 15), NOISE_GY((i) >> 4)},                                                   \
+     {NOISE_GZ((i) & 15), NOISE_GZ((i) >> 4)}}
+#define GP16(hi)                                                                                 \
+    GP(16 * (hi) + 0), GP(16 * (hi) + 1), GP(16 * (hi) + 2), GP(16 * (hi) + 3),                  \
+        GP(16 * (hi) + 4), GP(16 * (hi) + 5), GP(16 * (hi) + 6), GP(16 * (hi) + 7),              \
+        GP(16 * (hi) + 8), GP(16 * (hi) + 9), GP(16 * (hi) + 10), GP(16 * (hi) + 11),            \
+        GP(16 * (hi) + 12), GP(16 * (hi) + 13), GP(16 * (hi) + 14), GP(16 * (hi) + 15)
+const noise_gpair noise_gpairs[256] = {GP16(0), GP16(1),  GP16(2),  GP16(3),  GP16(4),  GP16(5),
+                                       GP16(6), GP16(7),  GP16(8),  GP16(9),  GP16(10), GP16(11),
+                                       GP16(12), GP16(13), GP16(14), GP16(15)};
+#undef GP
+#undef GP16
+
+/* floor(v) and its lattice index mod 256 for any v, never converting an
+ * out-of-range double to int (the fmod is exact on the integral double). */
+static double lattice(double v, unsigned *ix)
+{
+    if (fabs(v) < 1073741824.0) {
+        int i = (int)v;
+        i -= v < (double)i;
+        *ix = (unsigned)i & 255u;
+        return (double)i;
+    }
+    double f = floor(v);
+    if (isfinite(f))
+        *ix = (unsigned)(int)fmod(f, 256.0) & 255u;
+    else
+        *ix = 0;
+    return f;
+}
+
+static double grad(unsigned h, double x, double y, double z)
+{
+    static const double gx[16] = {1, -1, 1, -1, 1, -1, 1, -1, 0, 0, 0, 0, 1, 0, -1, 0};
+    static const double gy[16] = {1, 1, -1, -1, 0, 0, 0, 0, 1, -1, 1, -1, 1, -1, 1, -1};
+    static const double gz[16] = {0, 0, 0, 0, 1, 1, -1, -1, 1, 1, -1, -1, 0, 1, 0, -1};
+    h &= 15u;
+    return gx[h] * x + gy[h] * y + gz[h] * z;
+}
+
+static double lerp(double t, double a, double b) { return a + t * (b - a); }
+
+/* The reference noise() point by point, for the coordinates perlin() does
+ * not take (|v| >= 2^30, NaN, infinity): same operations, same order. */
+double noise_perlin_far(const uint8_t *p, double x, double y, double z)
+{
+    unsigned X, Y, Z;
+    x -= lattice(x, &X);
+    y -= lattice(y, &Y);
+    z -= lattice(z, &Z);
+    double u = fade(x), v = fade(y), w = fade(z);
+    unsigned A = p[X] + Y, AA = p[A] + Z, AB = p[A + 1] + Z;
+    unsigned B = p[X + 1] + Y, BA = p[B] + Z, BB = p[B + 1] + Z;
+    double x1 = x - 1, y1 = y - 1, z1 = z - 1;
+    return lerp(w,
+                lerp(v, lerp(u, grad(p[AA], x, y, z), grad(p[BA], x1, y, z)),
+                     lerp(u, grad(p[AB], x, y1, z), grad(p[BB], x1, y1, z))),
+                lerp(v, lerp(u, grad(p[AA + 1], x, y, z1), grad(p[BA + 1], x1, y, z1)),
+                     lerp(u, grad(p[AB + 1], x, y1, z1), grad(p[BB + 1], x1, y1, z1))));
+}
+
+/* p[512..1023] from p[0..511] (noise.h) */
+static void perm_pairs(noise_perm *np)
+{
+    for (int i = 0; i < 511; i++)
+        np->p[512 + i] = (uint8_t)((np->p[i] & 15) | (np->p[i + 1] & 15) << 4);
+    np->p[1023] = np->p[511] & 15;
+}
+
 void noise_perm_reference(noise_perm *np)
 {
     for (int i = 0; i < 256; i++)
         np->p[i] = np->p[i + 256] = ref_perm[i];
+    perm_pairs(np);
 }
 
 /* Uniform integer in [0, n), n >= 1, without modulo bias. */
@@ -58,6 +132,7 @@ void noise_perm_init(noise_perm *np, uint64_t seed)
     }
     for (int i = 0; i < 256; i++)
         np->p[i + 256] = np->p[i];
+    perm_pairs(np);
 }
 
 double noise_perlin3(const noise_perm *np, double x, double y, double z)
@@ -65,12 +140,13 @@ double noise_perlin3(const noise_perm *np, double x, double y, double z)
     return perlin(np->p, x, y, z);
 }
 
-/* The level the blocks use: AVX2 where the machine has it; the SSE2 kernel
- * (4-double vectors split in halves, the hash lane by lane) measured no
- * faster than the scalar loop, so without AVX2 the scalar loop runs. */
+/* The level the blocks use: the best the machine has, except SSE2, whose
+ * four-lane kernel measured slower than the per-point loop's paired lanes
+ * (bench/noise_bench.c). The choice never changes a value. */
 static int block_level(void)
 {
-    return noise_simd_best() == NOISE_LEVEL_AVX2 ? NOISE_LEVEL_AVX2 : NOISE_LEVEL_SCALAR;
+    int best = noise_simd_best();
+    return best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR;
 }
 
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,

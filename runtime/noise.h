@@ -13,11 +13,17 @@
  *           (0,-1,1), (0,-1,-1) exactly as the reference grad() does
  *     n(p) = lerp(w, lerp(v, lerp(u, ...)))    u, v, w = f(fractional part)
  * Values lie in about [-1.04, 1.04]; n = 0 at every integer lattice point.
- * We evaluate grad() with a 16-entry gradient table (gx*x + gy*y + gz*z)
- * instead of the reference's branches: the same value for every input (the
- * products by 0 and ±1 are exact; only the sign of a zero may differ), and
- * no data-dependent branches, which matters on scattered points (octave
- * sums are scattered): see DESIGN.md, "Facts measured".
+ * We evaluate grad() with gradient coefficients (gx*x + gy*y + gz*z, products
+ * by ±1 and 0, exact) instead of the reference's branches: the same value for
+ * every input, and no data-dependent branches, which matters on scattered
+ * points (octave sums are scattered): see DESIGN.md, "Facts measured". The
+ * per-point code (noise_impl.h) pairs the corners (i, j, 0) and (i, j, 1) in
+ * two-lane vectors, loads P[i] and P[i+1] together, takes the last level of
+ * the hash chain from a second table of the pairs' gradient numbers (kept
+ * after P in noise_perm) and the coefficients of a pair from one 256-entry
+ * table; every lane does the reference's operations
+ * in its order, so the value is bit for bit that of the plain formulation
+ * (noise_perlin_far, which also takes the far and non-finite coordinates).
  *
  * Permutation. noise_perm_init makes P from a seed by a Fisher–Yates shuffle
  * driven by rng stream (seed, 0x6e6f697365 "noise"), with unbiased bounded
@@ -46,15 +52,18 @@
  * function's values. All functions are pure and reentrant; a noise_perm is
  * read-only after init and can be shared between threads.
  *
- * SIMD (noise_simd.c). Four points at a time with GCC vector extensions,
- * on two levels: SSE2 (the x86-64 baseline) and AVX2 (with gathers for the
- * permutation lookups), found at run time (noise_simd_best: the highest
- * level __builtin_cpu_supports allows). Every level gives bit for bit the
- * scalar values (same operations in the same order, no FMA), so a result
- * never depends on the machine. The blocks use AVX2 where present and the
- * scalar loop otherwise (the SSE2 kernel measured no faster than it; see
- * bench/noise_bench.c). The *_block_at variants take the level
- * (NOISE_LEVEL_SCALAR runs the scalar loop), for tests and benchmarks.
+ * SIMD (noise_simd.c). Several points at a time on three levels found at
+ * run time (noise_simd_best: the highest level __builtin_cpu_supports
+ * allows): SSE2 (the x86-64 baseline, four points), AVX2 (eight points; the
+ * hash chains in integer registers, the arithmetic on 4-double vectors) and
+ * AVX-512 (eight points in 8-double vectors, the permutation lookups as
+ * byte-lane table permutes, vpermi2b). No level gathers from memory: the
+ * gradient coefficients come from the hash by register table lookups. Every
+ * level gives bit for bit the scalar values (same operations in the same
+ * order, no FMA), so a result never depends on the machine. The blocks use
+ * the best level except SSE2, which measured slower than the per-point loop
+ * (bench/noise_bench.c). The *_block_at variants take the level
+ * (NOISE_LEVEL_SCALAR runs the per-point loop), for tests and benchmarks.
  */
 #ifndef NOISE_H
 #define NOISE_H
@@ -63,7 +72,9 @@
 #include <stdint.h>
 
 typedef struct noise_perm {
-    uint8_t p[512]; /* p[i + 256] == p[i] */
+    /* p[i + 256] == p[i] (i < 256); p[512 + i] = (p[i] & 15) | (p[i + 1] & 15) << 4
+     * (i < 511), the gradient numbers of a pair of corners (noise_impl.h) */
+    uint8_t p[1024];
 } noise_perm;
 
 void noise_perm_init(noise_perm *np, uint64_t seed);
@@ -82,7 +93,7 @@ double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, 
 void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
                              const double *y, const double *z, double *out);
 
-enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2 };
+enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2, NOISE_LEVEL_AVX512 };
 int noise_simd_best(void);
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
                             const double *y, const double *z, double *out);

@@ -1,14 +1,20 @@
-/* noise_simd.c — Perlin noise four points at a time (GCC vector extensions;
- * noise.h, "SIMD"). One kernel, compiled twice: for the x86-64 baseline
- * (SSE2: the compiler splits each 4-double vector into two 128-bit halves)
- * and with target("avx2") (256-bit), chosen at run time with
- * __builtin_cpu_supports. Every lane performs exactly the scalar perlin()'s
- * operations in the same order — IEEE +, −, × are the same in a vector
- * lane, the build has -ffp-contract=off so nothing fuses into an FMA, and
- * the gradient coefficients are the same exact values ±1, 0 — so the result
- * is bit-identical to the scalar path on every level. Points the fast
- * lattice path cannot take (|coordinate| >= 2^30, NaN, infinity) go through
- * the scalar perlin(), four at a time. */
+/* noise_simd.c — Perlin noise several points at a time (noise.h, "SIMD"),
+ * on three levels chosen at run time with __builtin_cpu_supports:
+ *   SSE2    four points (GCC/Clang vector extensions, each 4-double vector
+ *           split into two 128-bit halves; noise_kernel.inc), hash lane by
+ *           lane; the x86-64 baseline;
+ *   AVX2    eight points, the hash chains in the integer registers, the
+ *           arithmetic on 4-double vectors (target("avx2"));
+ *   AVX-512 eight points in 8-double vectors, the hash chains as byte-lane
+ *           table lookups (vpermi2b; F, BW, VL, DQ, VBMI).
+ * Every lane performs exactly the scalar perlin()'s operations in the same
+ * order — IEEE +, −, × are the same in a vector lane, the build has
+ * -ffp-contract=off so nothing fuses into an FMA (FMA is available inside
+ * the AVX2 and AVX-512 regions), the floors are exact, and the gradient
+ * coefficients are the same exact values ±1, 0 — so the result is
+ * bit-identical to the scalar path on every level. A group with a point the
+ * fast lattice path cannot take (|coordinate| >= 2^30, NaN, infinity) goes
+ * through the scalar perlin() point by point. */
 #include "noise.h"
 #include "noise_impl.h"
 
@@ -33,10 +39,8 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 #define ALWAYS_INLINE static inline __attribute__((always_inline))
 
 #define K(name) name##_sse2
-#define KHASH K(hash_lanes)
 #include "noise_kernel.inc"
 #undef K
-#undef KHASH
 
 #ifdef NOISE_X86
 /* every function from here to the pop is compiled for AVX2 (clang spells
@@ -47,29 +51,166 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 #pragma GCC push_options
 #pragma GCC target("avx2")
 #endif
-/* The same with AVX2 gathers: p32 is the permutation widened to int32
- * (512 entries), so each step of the chain is one 4-lane gather. */
-ALWAYS_INLINE v4i gather(const int32_t *p32, v4i i)
+/* Eight points at a time: the hash chain of each point runs in the integer
+ * registers (perm_pair, as perlin() does it; those ports are otherwise
+ * idle) while the floors, fades, gradients and lerps run on two 4-double
+ * vectors per quantity. The gradient coefficients come from the hash bytes
+ * by a 16-entry byte table lookup (pshufb) and exact int8 -> int32 -> double
+ * conversions: the values ±1 and 0 of noise_gpairs, no memory gather. */
+ALWAYS_INLINE v4d cvt4(const int8_t *c)
 {
-    return (v4i)_mm_i32gather_epi32(p32, (__m128i)i, 4);
+    int32_t w;
+    memcpy(&w, c, 4);
+    return (v4d)_mm256_cvtepi32_pd(_mm_cvtepi8_epi32(_mm_cvtsi32_si128(w)));
 }
 
-ALWAYS_INLINE void hash_gather(const uint8_t *p, const int32_t *p32, v4i X, v4i Y, v4i Z, v4i h[8])
+/* floor of each lane (|v| < 2^30) as perlin() computes it: +0 for -0 */
+ALWAYS_INLINE v4d floor4(v4d v)
 {
-    (void)p;
-    v4i A = gather(p32, X) + Y, B = gather(p32, X + 1) + Y;
-    v4i AA = gather(p32, A) + Z, AB = gather(p32, A + 1) + Z;
-    v4i BA = gather(p32, B) + Z, BB = gather(p32, B + 1) + Z;
-    h[0] = gather(p32, AA), h[1] = gather(p32, BA), h[2] = gather(p32, AB), h[3] = gather(p32, BB);
-    h[4] = gather(p32, AA + 1), h[5] = gather(p32, BA + 1), h[6] = gather(p32, AB + 1);
-    h[7] = gather(p32, BB + 1);
+    const v4d zero = {0, 0, 0, 0};
+    return (v4d)_mm256_floor_pd((__m256d)v) + zero;
 }
 
-#define K(name) name##_avx2
-#define KHASH hash_gather
-#include "noise_kernel.inc"
-#undef K
-#undef KHASH
+ALWAYS_INLINE void index4(v4d f, int32_t *ix)
+{
+    __m128i i = _mm_and_si128(_mm256_cvttpd_epi32((__m256d)f), _mm_set1_epi32(255));
+    _mm_storeu_si128((__m128i *)(void *)ix, i);
+}
+
+ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+
+/* the lerps of four points (lanes 4k..4k+3 of the eight) */
+ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0)
+{
+    const v4d one = {1, 1, 1, 1};
+    v4d u = fade4(x0), v = fade4(y0), w = fade4(z0);
+    v4d x1 = x0 - one, y1 = y0 - one, z1 = z0 - one;
+#define G(c, xc, yc, zc, o) (cvt4(&cf[c][0][o]) * (xc) + cvt4(&cf[c][1][o]) * (yc) + cvt4(&cf[c][2][o]) * (zc))
+    int o0 = 4 * k, o1 = 4 * k + 8;
+    v4d g00 = G(0, x0, y0, z0, o0), g10 = G(1, x1, y0, z0, o0);
+    v4d g01 = G(2, x0, y1, z0, o0), g11 = G(3, x1, y1, z0, o0);
+    v4d a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
+    v4d c0 = a + v * (b - a);
+    g00 = G(0, x0, y0, z1, o1), g10 = G(1, x1, y0, z1, o1);
+    g01 = G(2, x0, y1, z1, o1), g11 = G(3, x1, y1, z1, o1);
+    a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
+    v4d c1 = a + v * (b - a);
+#undef G
+    return c0 + w * (c1 - c0);
+}
+
+/* The gradient coefficients of the 64 corners of eight points from their
+ * pairs' gradient numbers: hq[c][j] = p[512 + the pair index] (noise.h) of
+ * corner pair c (AA, BA, AB, BB) of point j; cf[c][axis][l]: lanes l = 0..7
+ * at z, 8..15 at z + 1. */
+ALWAYS_INLINE void coef8_avx2(const uint8_t hq[4][8], int8_t cf[4][3][16])
+{
+    const __m128i low4 = _mm_set1_epi8(15);
+#define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
+                             G(11), G(12), G(13), G(14), G(15))
+    const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
+#undef T16
+    for (int c = 0; c < 4; c++) {
+        __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)hq[c]);
+        __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
+        _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
+        _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
+        _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
+    }
+}
+
+ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
+ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
+
+/* Chunks of up to CHUNK groups of eight: stage one hashes every group, stage
+ * two does the arithmetic, so the second never waits on the first's stores. */
+enum { CHUNK = 8 };
+
+ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, const double *ys,
+                                const double *zs, double s, double a, int mode, double *out)
+{
+    const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
+    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+    int8_t cf[CHUNK][4][3][16];
+    uint8_t hq[CHUNK][4][8];
+    const uint8_t *pg = p + 512;
+    int32_t X[CHUNK * 8], Y[CHUNK * 8], Z[CHUNK * 8];
+    size_t i = 0;
+    while (i + 8 <= n) {
+        size_t ng = (n - i) / 8;
+        ng = ng < CHUNK ? ng : CHUNK;
+        unsigned okm = 0;
+        /* the passes are separate so that no load waits on a recent store */
+        for (size_t g = 0; g < ng; g++) {
+            size_t j = i + 8 * g;
+            v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
+            v4d za = ld4(zs + j), zb = ld4(zs + j + 4);
+            if (mode != NOISE_SET) {
+                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+            }
+#define IN(v) ((v4d)((v4l)(v) & ~sign) < big) /* |v| < 2^30, false for NaN */
+            v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
+#undef IN
+            if (_mm256_movemask_pd((__m256d)ok) == 15) {
+                index4(floor4(xa), X + 8 * g), index4(floor4(xb), X + 8 * g + 4);
+                index4(floor4(ya), Y + 8 * g), index4(floor4(yb), Y + 8 * g + 4);
+                index4(floor4(za), Z + 8 * g), index4(floor4(zb), Z + 8 * g + 4);
+                okm |= 1u << g;
+            }
+        }
+        for (size_t g = 0; g < ng; g++) {
+            if (!(okm >> g & 1))
+                continue;
+            for (int l = 0; l < 8; l++) {
+                size_t j = 8 * g + (size_t)l;
+                unsigned hx = perm_pair(p, (unsigned)X[j]);
+                unsigned hA = perm_pair(p, (hx & 255u) + (unsigned)Y[j]);
+                unsigned hB = perm_pair(p, (hx >> 8) + (unsigned)Y[j]);
+                hq[g][0][l] = pg[(hA & 255u) + (unsigned)Z[j]];
+                hq[g][1][l] = pg[(hB & 255u) + (unsigned)Z[j]];
+                hq[g][2][l] = pg[(hA >> 8) + (unsigned)Z[j]];
+                hq[g][3][l] = pg[(hB >> 8) + (unsigned)Z[j]];
+            }
+        }
+        for (size_t g = 0; g < ng; g++)
+            if (okm >> g & 1)
+                coef8_avx2(hq[g], cf[g]);
+        for (size_t g = 0; g < ng; g++, i += 8) {
+            v4d xa = ld4(xs + i), xb = ld4(xs + i + 4), ya = ld4(ys + i), yb = ld4(ys + i + 4);
+            v4d za = ld4(zs + i), zb = ld4(zs + i + 4), ra, rb;
+            if (mode != NOISE_SET) {
+                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+            }
+            if (okm >> g & 1) {
+                ra = half4(cf[g], 0, xa - floor4(xa), ya - floor4(ya), za - floor4(za));
+                rb = half4(cf[g], 1, xb - floor4(xb), yb - floor4(yb), zb - floor4(zb));
+            } else {
+                for (int l = 0; l < 4; l++) {
+                    ra[l] = perlin(p, xa[l], ya[l], za[l]);
+                    rb[l] = perlin(p, xb[l], yb[l], zb[l]);
+                }
+            }
+            if (mode == NOISE_SET) {
+                st4(out + i, ra), st4(out + i + 4, rb);
+                continue;
+            }
+            if (mode == NOISE_ADD_ABS) {
+                ra = (v4d)((v4l)ra & ~sign), rb = (v4d)((v4l)rb & ~sign); /* fabs */
+            }
+            st4(out + i, ld4(out + i) + a * ra);
+            st4(out + i + 4, ld4(out + i + 4) + a * rb);
+        }
+    }
+    for (; i < n; i++) { /* the last 0..7 points */
+        if (mode == NOISE_SET)
+            out[i] = perlin(p, xs[i], ys[i], zs[i]);
+        else if (mode == NOISE_ADD)
+            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
+        else
+            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
+    }
+}
+
 #if defined(__clang__)
 #pragma clang attribute pop
 #else
@@ -93,7 +234,7 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
 static void kernel_sse2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                         const double *zs, double s, double a, int mode, double *out)
 {
-    kernel4_sse2(p, NULL, n, xs, ys, zs, s, a, mode, out);
+    kernel4_sse2(p, n, xs, ys, zs, s, a, mode, out);
 }
 
 #ifdef NOISE_X86
@@ -101,16 +242,154 @@ __attribute__((target("avx2"))) static void kernel_avx2(const uint8_t *p, size_t
                                                         const double *ys, const double *zs, double s,
                                                         double a, int mode, double *out)
 {
-    int32_t p32[512];
-    for (int i = 0; i < 512; i++)
-        p32[i] = p[i];
-    kernel4_avx2(p, p32, n, xs, ys, zs, s, a, mode, out);
+    kernel8_avx2(p, n, xs, ys, zs, s, a, mode, out);
 }
+#endif
+
+#ifdef NOISE_X86
+/* AVX-512 (F, BW, VL, DQ, VBMI): eight points in one 8-double vector per
+ * quantity, and the whole hash chain in byte lanes, where arithmetic is
+ * mod 256 by itself (P[i + 256] = P[i]): one 256-entry table lookup is two
+ * vpermi2b over the four 64-byte quarters of P and a blend on bit 7, and
+ * each level of the chain is one lookup for all its corners — [X, X+1],
+ * then [A, B, A+1, B+1], then the 64 corner hashes. The coefficients come
+ * from a 16-entry double table (vpermi2pd on the hash's low four bits). */
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512vl,avx512dq,avx512vbmi"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512bw,avx512vl,avx512dq,avx512vbmi")
+#endif
+typedef double v8d __attribute__((vector_size(64)));
+typedef int64_t v8l __attribute__((vector_size(64)));
+
+typedef struct perm512 {
+    __m512i q[4]; /* P[0..63], P[64..127], P[128..191], P[192..255] */
+} perm512;
+
+ALWAYS_INLINE __m512i lookup512(const perm512 *t, __m512i i)
+{
+    __m512i lo = _mm512_permutex2var_epi8(t->q[0], i, t->q[1]);
+    __m512i hi = _mm512_permutex2var_epi8(t->q[2], i, t->q[3]);
+    return _mm512_mask_blend_epi8(_mm512_movepi8_mask(i), lo, hi);
+}
+
+/* floor as perlin() computes it (+0 for -0) and the lattice index bytes */
+ALWAYS_INLINE v8d floor8(v8d v)
+{
+    const v8d zero = {0, 0, 0, 0, 0, 0, 0, 0};
+    return (v8d)_mm512_roundscale_pd((__m512d)v, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC) + zero;
+}
+
+ALWAYS_INLINE __m128i cell8(v8d f) /* 8 bytes: (int)f & 255 */
+{
+    return _mm256_cvtepi32_epi8(_mm512_cvttpd_epi32((__m512d)f));
+}
+
+ALWAYS_INLINE v8d fade8(v8d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+
+ALWAYS_INLINE v8d perlin8_avx512(const perm512 *t, v8d x, v8d y, v8d z)
+{
+    const v8d one = {1, 1, 1, 1, 1, 1, 1, 1};
+    v8d fxv = floor8(x), fyv = floor8(y), fzv = floor8(z);
+    __m128i X = cell8(fxv), Y = cell8(fyv), Z = cell8(fzv);
+    x -= fxv, y -= fyv, z -= fzv;
+    const __m128i one8 = _mm_set1_epi8(1);
+    /* [P[X] | P[X+1]] + [Y | Y] = [A | B] */
+    __m128i i1 = _mm_unpacklo_epi64(X, _mm_add_epi8(X, one8));
+    __m128i ab = _mm_add_epi8(_mm512_castsi512_si128(lookup512(t, _mm512_zextsi128_si512(i1))),
+                              _mm_unpacklo_epi64(Y, Y));
+    /* [P[A] | P[B] | P[A+1] | P[B+1]] + Z = [AA | BA | AB | BB] */
+    __m256i i2 = _mm256_inserti128_si256(_mm256_castsi128_si256(ab), _mm_add_epi8(ab, one8), 1);
+    __m256i l2 = _mm256_add_epi8(_mm512_castsi512_si256(lookup512(t, _mm512_zextsi256_si512(i2))),
+                                 _mm256_broadcastq_epi64(Z));
+    /* the 64 corner hashes: 8 bytes per corner slot, AA BA AB BB at z, then at z + 1 */
+    __m512i i3 = _mm512_inserti64x4(_mm512_castsi256_si512(l2),
+                                    _mm256_add_epi8(l2, _mm256_set1_epi8(1)), 1);
+    __m512i h = lookup512(t, i3);
+#define GD(G, o) G(o + 0), G(o + 1), G(o + 2), G(o + 3), G(o + 4), G(o + 5), G(o + 6), G(o + 7)
+    const v8d gxl = {GD(NOISE_GX, 0)}, gxh = {GD(NOISE_GX, 8)};
+    const v8d gyl = {GD(NOISE_GY, 0)}, gyh = {GD(NOISE_GY, 8)};
+    const v8d gzl = {GD(NOISE_GZ, 0)}, gzh = {GD(NOISE_GZ, 8)};
+#undef GD
+    v8d u = fade8(x), v = fade8(y), w = fade8(z);
+    v8d x1 = x - one, y1 = y - one, z1 = z - one;
+    v8d g[8];
+    for (int q = 0; q < 8; q++) {
+        /* every byte of qword j = the hash of slot q, point j */
+        __m512i sel = _mm512_add_epi8(_mm512_set1_epi8((char)(8 * q)),
+                                      _mm512_set_epi64(0x0707070707070707, 0x0606060606060606,
+                                                       0x0505050505050505, 0x0404040404040404,
+                                                       0x0303030303030303, 0x0202020202020202,
+                                                       0x0101010101010101, 0));
+        __m512i hq = _mm512_permutexvar_epi8(sel, h);
+        v8d cx = (v8d)_mm512_permutex2var_pd((__m512d)gxl, hq, (__m512d)gxh);
+        v8d cy = (v8d)_mm512_permutex2var_pd((__m512d)gyl, hq, (__m512d)gyh);
+        v8d cz = (v8d)_mm512_permutex2var_pd((__m512d)gzl, hq, (__m512d)gzh);
+        v8d xc = q & 1 ? x1 : x, yc = q & 2 ? y1 : y, zc = q & 4 ? z1 : z;
+        g[q] = cx * xc + cy * yc + cz * zc;
+    }
+    v8d a0 = g[0] + u * (g[1] - g[0]), b0 = g[2] + u * (g[3] - g[2]);
+    v8d c0 = a0 + v * (b0 - a0);
+    v8d a1 = g[4] + u * (g[5] - g[4]), b1 = g[6] + u * (g[7] - g[6]);
+    v8d c1 = a1 + v * (b1 - a1);
+    return c0 + w * (c1 - c0);
+}
+
+static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const double *ys,
+                          const double *zs, double s, double a, int mode, double *out)
+{
+    perm512 t;
+    for (int k = 0; k < 4; k++)
+        t.q[k] = _mm512_loadu_si512((const void *)(p + 64 * k));
+    const v8d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0,
+                     1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        v8d x = (v8d)_mm512_loadu_pd(xs + i), y = (v8d)_mm512_loadu_pd(ys + i);
+        v8d z = (v8d)_mm512_loadu_pd(zs + i), r;
+        if (mode != NOISE_SET)
+            x *= s, y *= s, z *= s;
+        __mmask8 ok = _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)x), (__m512d)big, _CMP_LT_OQ) &
+                      _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)y), (__m512d)big, _CMP_LT_OQ) &
+                      _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)z), (__m512d)big, _CMP_LT_OQ);
+        if (ok == 0xff) {
+            r = perlin8_avx512(&t, x, y, z);
+        } else {
+            for (int l = 0; l < 8; l++)
+                r[l] = perlin(p, x[l], y[l], z[l]);
+        }
+        if (mode == NOISE_SET) {
+            _mm512_storeu_pd(out + i, (__m512d)r);
+            continue;
+        }
+        if (mode == NOISE_ADD_ABS)
+            r = (v8d)_mm512_abs_pd((__m512d)r);
+        _mm512_storeu_pd(out + i, (__m512d)((v8d)_mm512_loadu_pd(out + i) + a * r));
+    }
+    for (; i < n; i++) { /* the last 0..7 points */
+        if (mode == NOISE_SET)
+            out[i] = perlin(p, xs[i], ys[i], zs[i]);
+        else if (mode == NOISE_ADD)
+            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
+        else
+            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
+    }
+}
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
 #endif
 
 int noise_simd_best(void)
 {
 #ifdef NOISE_X86
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512vbmi"))
+        return NOISE_LEVEL_AVX512;
     if (__builtin_cpu_supports("avx2"))
         return NOISE_LEVEL_AVX2;
 #endif
@@ -123,6 +402,8 @@ void noise_kernel(int level, const uint8_t *p, size_t n, const double *x, const 
     if (level == NOISE_LEVEL_SCALAR)
         kernel_scalar(p, n, x, y, z, s, a, mode, out);
 #ifdef NOISE_X86
+    else if (level == NOISE_LEVEL_AVX512)
+        kernel_avx512(p, n, x, y, z, s, a, mode, out);
     else if (level == NOISE_LEVEL_AVX2)
         kernel_avx2(p, n, x, y, z, s, a, mode, out);
 #endif

@@ -5,6 +5,7 @@
 
 #include "check.h"
 #include "noise.h"
+#include "noise_impl.h"
 #include "rng.h"
 
 #define NPTS 20000
@@ -192,8 +193,9 @@ static void test_blocks(void)
 /* Every SIMD level this machine runs (noise_simd_best and below) against the
  * scalar functions, bit for bit: coherent and scattered points, negative
  * ones, lattice points and half-integers, values near ±2^30 (the fast
- * lattice path's bound), huge, infinite and NaN coordinates mixed into the
- * same groups of four, block lengths that leave a tail of 1..3. */
+ * lattice path's bound), huge, infinite and NaN coordinates, in runs of one
+ * kind and mixed into the same groups, block lengths that leave a tail of
+ * 1..7. */
 static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 static void test_simd_levels(void)
@@ -204,7 +206,9 @@ static void test_simd_levels(void)
     rng_init(&r, 77, 1);
     for (size_t i = 0; i < N; i++) {
         double u = rng_uniform(&r), v = rng_uniform(&r), w = rng_uniform(&r);
-        switch (i % 8) {
+        /* the first half in runs of 16 of one kind (whole groups of the 8-point
+         * kernels take the vector path), the second half mixed point by point */
+        switch (i < N / 2 ? i / 16 % 8 : i % 8) {
         case 0: x[i] = u * 10, y[i] = v * 10, z[i] = w * 10; break;           /* coherent-ish */
         case 1: x[i] = (u - .5) * 1e6, y[i] = (v - .5) * 1e6, z[i] = w * -3e5; break; /* scattered */
         case 2: x[i] = floor(u * 40) - 20, y[i] = floor(v * 40) * 0.5, z[i] = -0.0; break; /* lattice */
@@ -219,8 +223,8 @@ static void test_simd_levels(void)
     int best = noise_simd_best();
     CHECK(best >= NOISE_LEVEL_SSE2, "an x86-64 machine has at least SSE2 (level %d)", best);
     for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
-        size_t lens[4] = {N, N - 1, N - 2, 5};
-        for (int li = 0; li < 4; li++) {
+        size_t lens[5] = {N, N - 1, N - 2, N - 5, 5};
+        for (int li = 0; li < 5; li++) {
             size_t n = lens[li];
             long bad = 0;
             noise_perlin3_block_at(level, &np, n, x, y, z, out);
@@ -254,12 +258,58 @@ static void test_simd_levels(void)
     }
 }
 
+/* The fast path of perlin() (paired lanes, pair loads, the coefficient pair
+ * table) against noise_perlin_far, the point-by-point reference order with
+ * 16-entry gradient tables and the general floor, bit for bit, including
+ * the signs of zeros: integers, -0, half-integers, negatives, values just
+ * below the 2^30 bound of the fast path. */
+static void test_fast_path(void)
+{
+    noise_perm np;
+    noise_perm_init(&np, 4242);
+    rng r;
+    rng_init(&r, 31, 2);
+    long bad = 0, n = 0;
+    for (int i = 0; i < 200000; i++) {
+        double c[3];
+        for (int k = 0; k < 3; k++) {
+            double u = rng_uniform(&r), v = rng_uniform(&r);
+            switch ((i + k) % 7) {
+            case 0: c[k] = (u - .5) * 600; break;
+            case 1: c[k] = floor((u - .5) * 600); break;
+            case 2: c[k] = u < .5 ? -0.0 : 0.0; break;
+            case 3: c[k] = floor((u - .5) * 80) * 0.5; break;
+            case 4: c[k] = (u < .5 ? -1 : 1) * (1073741824.0 - v * 3); break;
+            case 5: c[k] = (u - .5) * 1e-300; break;
+            default: c[k] = (u - .5) * 2e7; break;
+            }
+        }
+        double a = noise_perlin3(&np, c[0], c[1], c[2]), b = noise_perlin_far(np.p, c[0], c[1], c[2]);
+        bad += memcmp(&a, &b, sizeof a) != 0;
+        n++;
+    }
+    CHECK(bad == 0, "%ld of %ld fast-path values differ from noise_perlin_far", bad, n);
+    /* the pair table holds the reference coefficients (noise.h) */
+    static const double gx[16] = {1, -1, 1, -1, 1, -1, 1, -1, 0, 0, 0, 0, 1, 0, -1, 0};
+    static const double gy[16] = {1, 1, -1, -1, 0, 0, 0, 0, 1, -1, 1, -1, 1, -1, 1, -1};
+    static const double gz[16] = {0, 0, 0, 0, 1, 1, -1, -1, 1, 1, -1, -1, 0, 1, 0, -1};
+    int tbad = 0;
+    for (int i = 0; i < 256; i++) {
+        const noise_gpair *g = &noise_gpairs[i];
+        int lo = i & 15, hi = i >> 4;
+        tbad += g->gx[0] != gx[lo] || g->gx[1] != gx[hi] || g->gy[0] != gy[lo] ||
+                g->gy[1] != gy[hi] || g->gz[0] != gz[lo] || g->gz[1] != gz[hi];
+    }
+    CHECK(tbad == 0, "%d pair-table entries differ from the gradient table", tbad);
+}
+
 int main(void)
 {
     test_reference();
     test_properties();
     test_octaves();
     test_blocks();
+    test_fast_path();
     test_simd_levels();
     return check_done("test_noise");
 }
