@@ -25,6 +25,7 @@ typedef struct parser {
     const token *construct; /* innermost 'if', 'fn' or 'for' being parsed */
     int failed;
     int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
+    const struct oprow *row[2][T_COUNT]; /* ops[] indexed by fix and token (op_index) */
 } parser;
 
 /* ---- token access ---------------------------------------------------------- */
@@ -214,15 +215,12 @@ static int expect_close(parser *p, tok_type t, const token *open)
 
 static node *mk(parser *p, node_kind k, const token *at)
 {
-    node *n = mem_arena_alloc(p->I, sizeof(node));
+    node *n = mem_arena_raw(p->I, sizeof(node));
     if (!n) {
         p->failed = 1;
         return NULL;
     }
-    n->kind = k;
-    n->src = at->src;
-    n->line = at->line;
-    n->col = at->col;
+    *n = (node){.kind = k, .src = at->src, .line = at->line, .col = at->col};
     return n;
 }
 
@@ -230,7 +228,7 @@ static node *mk(parser *p, node_kind k, const token *at)
 static node *mk1(parser *p, node_kind k, const token *at, node *a)
 {
     node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_alloc(p->I, sizeof(node *))))
+    if (!n || !(n->kids = mem_arena_raw(p->I, sizeof(node *))))
         return NULL;
     n->nkids = 1;
     n->kids[0] = a;
@@ -240,7 +238,7 @@ static node *mk1(parser *p, node_kind k, const token *at, node *a)
 static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
 {
     node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_alloc(p->I, 2 * sizeof(node *))))
+    if (!n || !(n->kids = mem_arena_raw(p->I, 2 * sizeof(node *))))
         return NULL;
     n->nkids = 2;
     n->kids[0] = a;
@@ -258,8 +256,8 @@ static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
     if (nv->n == nv->cap) {
         int nc = nv->cap ? nv->cap * 2 : 8;
-        node **a = mem_arena_alloc(p->I, (size_t)nc * sizeof *a);
-        const char **b = mem_arena_alloc(p->I, (size_t)nc * sizeof *b);
+        node **a = mem_arena_raw(p->I, (size_t)nc * sizeof *a); /* items past n are never read */
+        const char **b = mem_arena_raw(p->I, (size_t)nc * sizeof *b);
         if (!a || !b) {
             p->failed = 1;
             return -1;
@@ -292,7 +290,7 @@ static node *string_node(parser *p, const token *t)
     node *n = mk(p, N_STR, t);
     if (!n)
         return NULL;
-    char *s = mem_arena_alloc(p->I, (size_t)t->len + 1);
+    char *s = mem_arena_raw(p->I, (size_t)t->len + 1);
     if (!s)
         return NULL;
     size_t k = 0;
@@ -377,13 +375,15 @@ static const oprow ops[] = {
 /* the only non-associative operators are the comparisons */
 #define CHAIN_ERROR "comparisons cannot be chained; use 'and'"
 
-static const oprow *op_row(tok_type t, int fix)
+/* ops[] by fix and token, so finding an operator is one load, not a search
+ * of the table at every operand (filled once per parse, from ops[]). */
+static void op_index(parser *p)
 {
     for (size_t i = 0; i < sizeof ops / sizeof ops[0]; i++)
-        if (ops[i].tok == t && ops[i].fix == fix)
-            return &ops[i];
-    return NULL;
+        p->row[ops[i].fix][ops[i].tok] = &ops[i];
 }
+
+static const oprow *op_row(const parser *p, tok_type t, int fix) { return p->row[fix][t]; }
 
 /* The level of the right operand of row r. */
 static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : r->prec + 1; }
@@ -392,7 +392,7 @@ static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : 
  * before it and none after starts a new entry instead (`1 -2`). */
 static const oprow *infix_at(parser *p, const token *t)
 {
-    const oprow *r = op_row(t->type, INFIX);
+    const oprow *r = op_row(p, t->type, INFIX);
     if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
         const token *after = t + 1;
         if (!after->space_before && after->type != T_NEWLINE)
@@ -410,7 +410,7 @@ static void skip_to_leading_op(parser *p)
     size_t i = p->pos;
     while (p->tl.toks[i].type == T_NEWLINE)
         i++;
-    const oprow *r = op_row(p->tl.toks[i].type, INFIX);
+    const oprow *r = op_row(p, p->tl.toks[i].type, INFIX);
     if (r && r->leads)
         p->pos = i;
 }
@@ -517,11 +517,12 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(node *));
-    c->names = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(char *));
+    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * sizeof(node *));
+    c->names = mem_arena_raw(p->I, (size_t)c->nkids * sizeof(char *));
     if (!c->kids || !c->names)
         return NULL;
     c->kids[0] = callee;
+    c->names[0] = NULL;
     for (int i = 0; i < args->n; i++) {
         c->kids[i + 1] = args->v[i];
         c->names[i + 1] = args->names[i];
@@ -1016,7 +1017,7 @@ static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 static node *parse_operand(parser *p, int level)
 {
     token *t = peek(p);
-    const oprow *r = op_row(t->type, PREFIX);
+    const oprow *r = op_row(p, t->type, PREFIX);
     if (!r || r->prec < level) /* `a * not b`: the primary reports 'not' */
         {
         node *e = parse_primary(p);
@@ -1293,6 +1294,7 @@ int parse_source(interp *I, int src, node **out)
     parser p;
     memset(&p, 0, sizeof p);
     p.I = I;
+    op_index(&p);
     *out = NULL;
     if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl)) {
         /* the token array goes through the hook: say why it was refused (the

@@ -363,6 +363,12 @@ static int resolve_slots(interp *I, node *prog, env *globals);
 
 int resolve_program(interp *I, node *prog, env *globals)
 {
+    int rc = resolve_check(I, prog, globals);
+    return rc ? rc : resolve_slots(I, prog, globals);
+}
+
+int resolve_check(interp *I, node *prog, env *globals)
+{
     resolver r;
     memset(&r, 0, sizeof r);
     r.I = I;
@@ -373,8 +379,6 @@ int resolve_program(interp *I, node *prog, env *globals)
         rc = resolve_block(&r, &top, prog);
     scope_free(I, &top);
     check_names_free(I, &r.bound);
-    if (rc == 0)
-        rc = resolve_slots(I, prog, globals);
     return rc;
 }
 

@@ -175,7 +175,7 @@ typedef struct arena_block {
     max_align_t data[];
 } arena_block;
 
-void *mem_arena_alloc(interp *I, size_t n)
+void *mem_arena_raw(interp *I, size_t n)
 {
     n = (n + 15) & ~(size_t)15;
     arena_block *b = I->arena;
@@ -191,7 +191,14 @@ void *mem_arena_alloc(interp *I, size_t n)
     }
     void *p = (char *)b->data + b->used;
     b->used += n;
-    memset(p, 0, n);
+    return p;
+}
+
+void *mem_arena_alloc(interp *I, size_t n)
+{
+    void *p = mem_arena_raw(I, n);
+    if (p)
+        memset(p, 0, n);
     return p;
 }
 

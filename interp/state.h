@@ -203,6 +203,9 @@ void interp_free(interp *I);
 int interp_add_source(interp *I, const char *name, const char *text, size_t len);
 const char *interp_intern(interp *I, const char *s, size_t len);
 void *mem_arena_alloc(interp *I, size_t n);
+/* The same piece of the arena, not zeroed: for the parser's nodes and arrays,
+ * which it fills entirely. */
+void *mem_arena_raw(interp *I, size_t n);
 
 /* Record an error at a node's position (or at I->cur when at is NULL). */
 int err_at(interp *I, const node *at, err_kind k, const char *fmt, ...)
