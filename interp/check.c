@@ -63,9 +63,12 @@ static int collect(interp *I, check_names *b, const node *n, int top)
     default:
         break;
     }
-    for (int i = 0; i < n->nkids; i++)
-        if (collect(I, b, n->kids[i], 0))
+    for (int i = 0; i < n->nkids; i++) {
+        const node *k = n->kids[i];
+        /* literals and names bind nothing and have no children: no call */
+        if (k && k->kind != N_NAME && k->kind != N_NUM && k->kind != N_STR && collect(I, b, k, 0))
             return -1;
+    }
     return 0;
 }
 
@@ -162,8 +165,14 @@ static int check_builtin(interp *I, const builtin *b, const node *call)
         }
         int rc = 0;
         if (!(v.k == V_NIL && cp->def_nil)) {
+            /* "argument 'NAME'", built without snprintf: one per constant argument */
             char what[160];
-            snprintf(what, sizeof what, "argument '%s'", cp->name);
+            size_t nl = strlen(cp->name);
+            if (nl > sizeof what - 13)
+                nl = sizeof what - 13;
+            memcpy(what, "argument '", 10);
+            memcpy(what + 10, cp->name, nl);
+            memcpy(what + 10 + nl, "'", 2);
             cpos at = {anodes[i], -1, 0, 0};
             rc = contract_check_value(I, cp->type, v, b->name, what, at);
         }

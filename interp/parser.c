@@ -213,23 +213,38 @@ static int expect_close(parser *p, tok_type t, const token *open)
 
 /* ---- node construction --------------------------------------------------- */
 
-static node *mk(parser *p, node_kind k, const token *at)
+/* A node, and room for `extra` bytes after it in the same piece of the arena
+ * (a node's size is a multiple of 16, so what follows is aligned). */
+static node *mk_extra(parser *p, node_kind k, const token *at, size_t extra)
 {
-    node *n = mem_arena_raw(p->I, sizeof(node));
+    node *n = mem_arena_raw(p->I, sizeof(node) + extra);
     if (!n) {
         p->failed = 1;
         return NULL;
     }
-    *n = (node){.kind = k, .src = at->src, .line = at->line, .col = at->col};
+    /* zeroed in constant pieces of at most 64 bytes, which compilers store
+     * inline (a single memset of the whole node becomes a `rep stos`) */
+    char *q = (char *)n;
+    size_t i = 0;
+    for (; i + 64 <= sizeof *n; i += 64)
+        memset(q + i, 0, 64);
+    memset(q + i, 0, sizeof *n - i);
+    n->kind = k;
+    n->src = at->src;
+    n->line = at->line;
+    n->col = at->col;
     return n;
 }
 
-/* A node with one or two children. */
+static node *mk(parser *p, node_kind k, const token *at) { return mk_extra(p, k, at, 0); }
+
+/* A node with one or two children, their array right after it. */
 static node *mk1(parser *p, node_kind k, const token *at, node *a)
 {
-    node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_raw(p->I, sizeof(node *))))
+    node *n = mk_extra(p, k, at, sizeof(node *));
+    if (!n)
         return NULL;
+    n->kids = (node **)(n + 1);
     n->nkids = 1;
     n->kids[0] = a;
     return n;
@@ -237,9 +252,10 @@ static node *mk1(parser *p, node_kind k, const token *at, node *a)
 
 static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
 {
-    node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_raw(p->I, 2 * sizeof(node *))))
+    node *n = mk_extra(p, k, at, 2 * sizeof(node *));
+    if (!n)
         return NULL;
+    n->kids = (node **)(n + 1);
     n->nkids = 2;
     n->kids[0] = a;
     n->kids[1] = b;
@@ -256,12 +272,13 @@ static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
     if (nv->n == nv->cap) {
         int nc = nv->cap ? nv->cap * 2 : 8;
-        node **a = mem_arena_raw(p->I, (size_t)nc * sizeof *a); /* items past n are never read */
-        const char **b = mem_arena_raw(p->I, (size_t)nc * sizeof *b);
-        if (!a || !b) {
+        /* the nodes, then the names, in one piece; items past n are never read */
+        node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
+        if (!a) {
             p->failed = 1;
             return -1;
         }
+        const char **b = (const char **)(a + nc);
         if (nv->n) {
             memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
             memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
@@ -517,10 +534,10 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * sizeof(node *));
-    c->names = mem_arena_raw(p->I, (size_t)c->nkids * sizeof(char *));
-    if (!c->kids || !c->names)
+    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * (sizeof(node *) + sizeof(char *)));
+    if (!c->kids)
         return NULL;
+    c->names = (const char **)(c->kids + c->nkids);
     c->kids[0] = callee;
     c->names[0] = NULL;
     for (int i = 0; i < args->n; i++) {

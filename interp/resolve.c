@@ -247,6 +247,12 @@ static int resolve_lambda(resolver *r, scope *s, const node *l)
     return rc;
 }
 
+/* A literal has nothing to resolve: its parent does not call for it. */
+static int is_literal(const node *n)
+{
+    return n->kind == N_NUM || n->kind == N_STR || n->kind == N_BOOL || n->kind == N_NIL;
+}
+
 static int resolve_node(resolver *r, scope *s, const node *n)
 {
     if (!n)
@@ -283,12 +289,12 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         return resolve_node(r, s, n->kids[0]);
     case N_CALL:
         for (int i = 0; i < n->nkids; i++)
-            if (resolve_node(r, s, n->kids[i]))
+            if (n->kids[i] && !is_literal(n->kids[i]) && resolve_node(r, s, n->kids[i]))
                 return -1;
         return check_call(r->I, &r->bound, r->mods, r->nmods, n);
     default:
         for (int i = 0; i < n->nkids; i++)
-            if (resolve_node(r, s, n->kids[i]))
+            if (n->kids[i] && !is_literal(n->kids[i]) && resolve_node(r, s, n->kids[i]))
                 return -1;
         return 0;
     }

@@ -169,29 +169,17 @@ int mem_engine_error(interp *I, const char *what, const char *msg)
 
 /* ---- arena for syntax trees --------------------------------------------- */
 
-typedef struct arena_block {
-    struct arena_block *next;
-    size_t used, cap;
-    max_align_t data[];
-} arena_block;
-
-void *mem_arena_raw(interp *I, size_t n)
+void *mem_arena_grow(interp *I, size_t n)
 {
-    n = (n + 15) & ~(size_t)15;
-    arena_block *b = I->arena;
-    if (!b || b->used + n > b->cap) {
-        size_t cap = n > 65536 ? n : 65536;
-        b = mem_alloc(I, sizeof(arena_block) + cap);
-        if (!b)
-            return NULL;
-        b->cap = cap;
-        b->used = 0;
-        b->next = I->arena;
-        I->arena = b;
-    }
-    void *p = (char *)b->data + b->used;
-    b->used += n;
-    return p;
+    size_t cap = n > 65536 ? n : 65536;
+    arena_block *b = mem_alloc(I, sizeof(arena_block) + cap);
+    if (!b)
+        return NULL;
+    b->cap = cap;
+    b->used = n;
+    b->next = I->arena;
+    I->arena = b;
+    return b->data;
 }
 
 void *mem_arena_alloc(interp *I, size_t n)
@@ -240,7 +228,7 @@ const char *interp_intern(interp *I, const char *s, size_t len)
             return e;
         j = (j + 1) & (I->intern_cap - 1);
     }
-    char *e = mem_alloc(I, len + 1);
+    char *e = mem_arena_raw(I, len + 1); /* names live as long as the session, like the trees */
     if (!e)
         return NULL;
     memcpy(e, s, len);
@@ -328,9 +316,7 @@ void interp_free(interp *I)
         mem_free(I, I->srcs[i].dir);
     }
     mem_free(I, I->srcs);
-    for (size_t i = 0; i < I->intern_cap; i++)
-        mem_free(I, I->intern_tab[i]);
-    mem_free(I, I->intern_tab);
+    mem_free(I, I->intern_tab); /* the names are in the arena */
     while (I->arena) {
         arena_block *b = I->arena;
         I->arena = b->next;
