@@ -97,19 +97,17 @@ const char *lex_name(tok_type t)
 
 /* The lexer has no interpreter state: it allocates with rt_realloc, which
  * goes through the same allocation hook as mem_alloc (counted, and failed by
- * --fail-alloc); lex_all's caller reports the failure. Returns the slot for
- * the next token, or NULL. */
-static token *next_slot(token_list *tl)
+ * --fail-alloc); lex_all's caller reports the failure. Doubles the array;
+ * -1 if refused (the tokens so far stay in tl, for lex_free). */
+static int grow(token_list *tl)
 {
-    if (tl->n == tl->cap) {
-        size_t nc = tl->cap ? tl->cap * 2 : 1024;
-        token *nt = rt_realloc(tl->toks, nc * sizeof *nt);
-        if (!nt)
-            return NULL;
-        tl->toks = nt;
-        tl->cap = nc;
-    }
-    return &tl->toks[tl->n++];
+    size_t nc = tl->cap ? tl->cap * 2 : 1024;
+    token *nt = rt_realloc(tl->toks, nc * sizeof *nt);
+    if (!nt)
+        return -1;
+    tl->toks = nt;
+    tl->cap = nc;
+    return 0;
 }
 
 void lex_free(token_list *tl)
@@ -202,6 +200,8 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
     int space = 1;
     out->toks = NULL;
     out->n = out->cap = 0;
+    token *toks = NULL;
+    size_t n = 0, cap = 0;
     /* A shebang line is a comment. */
     if (p[0] == '#' && p[1] == '!')
         while (*p && *p != '\n')
@@ -226,9 +226,16 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             }
             space = 1;
         }
-        token *t = next_slot(out);
-        if (!t)
-            return -1;
+        /* the list is read through locals, since stores into a token may
+         * alias it for the compiler (-fno-strict-aliasing) */
+        if (n == cap) {
+            out->n = n;
+            if (grow(out))
+                return -1;
+            toks = out->toks;
+            cap = out->cap;
+        }
+        token *t = &toks[n++];
         t->src = (unsigned short)src;
         t->line = line;
         t->col = (int)(p - line_start) + 1;
@@ -281,6 +288,7 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             }
             t->type = T_EOF;
             t->len = 0;
+            out->n = n;
             return 0;
         } else if (c == '"') {
             p++;

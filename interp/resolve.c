@@ -11,8 +11,9 @@
 #include "stdlib_embed.h"
 
 typedef struct scope {
-    const char **names;
+    const char **names; /* `small` until it holds more */
     int n, cap;
+    const char *small[8]; /* most scopes (parameters, loop variables) are small: no allocation */
     const char **set; /* pointer hash set of names, for large scopes */
     size_t set_cap;
     struct scope *parent;
@@ -20,7 +21,8 @@ typedef struct scope {
 
 static void scope_free(interp *I, scope *s)
 {
-    mem_free(I, s->names);
+    if (s->names != s->small)
+        mem_free(I, s->names);
     mem_free(I, s->set);
 }
 
@@ -93,11 +95,17 @@ typedef struct resolver {
 
 static int declare(resolver *r, scope *s, const char *name)
 {
-    if (s->n == s->cap) {
-        int nc = s->cap ? s->cap * 2 : 16;
-        const char **nn = mem_realloc(r->I, s->names, (size_t)nc * sizeof *nn);
+    if (!s->cap) {
+        s->names = s->small;
+        s->cap = (int)(sizeof s->small / sizeof s->small[0]);
+    } else if (s->n == s->cap) {
+        int nc = s->cap * 2;
+        const char **nn = mem_alloc(r->I, (size_t)nc * sizeof *nn);
         if (!nn)
             return -1;
+        memcpy(nn, s->names, (size_t)s->n * sizeof *nn);
+        if (s->names != s->small)
+            mem_free(r->I, s->names);
         s->names = nn;
         s->cap = nc;
     }
