@@ -30,9 +30,9 @@ typedef struct parser {
 
 /* ---- token access ---------------------------------------------------------- */
 
-static token *peek_raw(parser *p) { return &p->tl.toks[p->pos]; }
+static inline token *peek_raw(parser *p) { return &p->tl.toks[p->pos]; }
 
-static token *peek(parser *p)
+static inline token *peek(parser *p)
 {
     if (p->skip_nl)
         while (p->tl.toks[p->pos].type == T_NEWLINE)
@@ -54,7 +54,7 @@ static token *peek2(parser *p) /* the token after peek(), skipping newlines if s
     return &p->tl.toks[i];
 }
 
-static token *next(parser *p)
+static inline token *next(parser *p)
 {
     token *t = peek(p);
     if (t->type != T_EOF)
@@ -168,8 +168,10 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
  * REPL asks for more). Callers that succeed must leave with p->depth--. */
 static int enter_level(parser *p)
 {
+    if (++p->depth <= PARSE_MAX_NESTING)
+        return 0;
     token *t = peek(p);
-    if (++p->depth <= PARSE_MAX_NESTING || t->type == T_EOF)
+    if (t->type == T_EOF)
         return 0;
     p->depth--;
     if (!p->failed) {
@@ -215,7 +217,7 @@ static int expect_close(parser *p, tok_type t, const token *open)
 
 /* A node, and room for `extra` bytes after it in the same piece of the arena
  * (a node's size is a multiple of 16, so what follows is aligned). */
-static node *mk_extra(parser *p, node_kind k, const token *at, size_t extra)
+static inline node *mk_extra(parser *p, node_kind k, const token *at, size_t extra)
 {
     node *n = mem_arena_raw(p->I, sizeof(node) + extra);
     if (!n) {
@@ -268,28 +270,36 @@ typedef struct nodevec {
     int n, cap;
 } nodevec;
 
-static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
+static int nv_grow(parser *p, nodevec *nv);
+
+static inline int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
-    if (nv->n == nv->cap) {
-        int nc = nv->cap ? nv->cap * 2 : 8;
-        /* the nodes, then the names, in one piece; items past n are never read */
-        node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
-        if (!a) {
-            p->failed = 1;
-            return -1;
-        }
-        const char **b = (const char **)(a + nc);
-        if (nv->n) {
-            memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
-            memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
-        }
-        nv->v = a;
-        nv->names = b;
-        nv->cap = nc;
-    }
+    if (nv->n == nv->cap && nv_grow(p, nv))
+        return -1;
     nv->v[nv->n] = n;
     nv->names[nv->n] = name;
     nv->n++;
+    return 0;
+}
+
+/* Double a nodevec's room (the old arrays stay in the arena). */
+static int nv_grow(parser *p, nodevec *nv)
+{
+    int nc = nv->cap ? nv->cap * 2 : 8;
+    /* the nodes, then the names, in one piece; items past n are never read */
+    node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
+    if (!a) {
+        p->failed = 1;
+        return -1;
+    }
+    const char **b = (const char **)(a + nc);
+    if (nv->n) {
+        memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
+        memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
+    }
+    nv->v = a;
+    nv->names = b;
+    nv->cap = nc;
     return 0;
 }
 
