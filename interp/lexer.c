@@ -240,7 +240,6 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
         t->line = line;
         t->col = (int)(p - line_start) + 1;
         t->start = p;
-        t->num = 0;
         t->space_before = (unsigned char)space;
         space = 0;
         char c = *p;

@@ -18,7 +18,7 @@
 typedef struct parser {
     interp *I;
     token_list tl;
-    size_t pos;
+    token *cur;     /* the next token, in tl */
     int skip_nl;    /* newlines are insignificant here */
     int table_mode; /* parsing an entry of a table row */
     int closing;    /* the error being reported is a missing closer */
@@ -30,22 +30,22 @@ typedef struct parser {
 
 /* ---- token access ---------------------------------------------------------- */
 
-static inline token *peek_raw(parser *p) { return &p->tl.toks[p->pos]; }
+static inline token *peek_raw(parser *p) { return p->cur; }
 
 static inline token *peek(parser *p)
 {
     if (p->skip_nl)
-        while (p->tl.toks[p->pos].type == T_NEWLINE)
-            p->pos++;
-    return &p->tl.toks[p->pos];
+        while (p->cur->type == T_NEWLINE)
+            p->cur++;
+    return p->cur;
 }
 
 static token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
 {
-    size_t save = p->pos;
+    token *save = p->cur;
     peek(p);
-    size_t i = p->pos + 1;
-    p->pos = save;
+    size_t i = (size_t)(p->cur - p->tl.toks) + 1;
+    p->cur = save;
     if (p->tl.toks[i - 1].type == T_EOF)
         return &p->tl.toks[i - 1];
     if (p->skip_nl)
@@ -58,7 +58,7 @@ static inline token *next(parser *p)
 {
     token *t = peek(p);
     if (t->type != T_EOF)
-        p->pos++;
+        p->cur++;
     return t;
 }
 
@@ -76,7 +76,7 @@ static int match(parser *p, tok_type t)
 static void skip_newlines(parser *p)
 {
     while (peek_raw(p)->type == T_NEWLINE || peek_raw(p)->type == T_SEMI)
-        p->pos++;
+        p->cur++;
 }
 
 /* The innermost bracket or 'do' still open before token index `upto`
@@ -183,27 +183,42 @@ static int enter_level(parser *p)
     return -1;
 }
 
-/* Expect token type t; `what` describes the context for the message. */
-static int expect(parser *p, tok_type t, const char *what)
+/* Expect token type t; `what` describes the context for the message. The
+ * test is inline, the message out of line. */
+static int expected(parser *p, tok_type t, const char *what);
+
+static inline int expect(parser *p, tok_type t, const char *what)
 {
-    token *k = peek(p);
-    if (k->type == t) {
+    if (peek(p)->type == t) {
         next(p);
         return 0;
     }
+    return expected(p, t, what);
+}
+
+static int expected(parser *p, tok_type t, const char *what)
+{
+    token *k = peek(p);
     char buf[64], msg[256];
     snprintf(msg, sizeof msg, "expected %s %s, found %%s", lex_name(t), what);
     return syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
 }
 
 /* Expect a closing bracket; on failure note where it was opened. */
-static int expect_close(parser *p, tok_type t, const token *open)
+static int expected_close(parser *p, tok_type t, const token *open);
+
+static inline int expect_close(parser *p, tok_type t, const token *open)
 {
-    token *k = peek(p);
-    if (k->type == t) {
+    if (peek(p)->type == t) {
         next(p);
         return 0;
     }
+    return expected_close(p, t, open);
+}
+
+static int expected_close(parser *p, tok_type t, const token *open)
+{
+    token *k = peek(p);
     char buf[64], msg[256];
     snprintf(msg, sizeof msg, "expected %s to close %s opened at line %d, found %%s", lex_name(t),
              lex_name(open->type), open->line);
@@ -434,12 +449,12 @@ static void skip_to_leading_op(parser *p)
 {
     if (p->table_mode || peek_raw(p)->type != T_NEWLINE)
         return;
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     while (p->tl.toks[i].type == T_NEWLINE)
         i++;
     const oprow *r = op_row(p, p->tl.toks[i].type, INFIX);
     if (r && r->leads)
-        p->pos = i;
+        p->cur = &p->tl.toks[i];
 }
 
 
@@ -697,7 +712,7 @@ static node *parse_lambda_rest(parser *p, const token *at, const char *name)
 /* Is the '(' at pos the start of `(a, b) => …`? */
 static int is_paren_lambda(parser *p)
 {
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     int depth = 0;
     for (;; i++) {
         tok_type t = p->tl.toks[i].type;
@@ -752,7 +767,7 @@ static node *parse_brace(parser *p)
     token *open = next(p);
     parse_mode m = enter_mode(p, p->skip_nl);
     /* look past newlines to decide between record and table */
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     while (p->tl.toks[i].type == T_NEWLINE)
         i++;
     tok_type first = p->tl.toks[i].type;
@@ -888,9 +903,9 @@ static node *parse_if(parser *p)
         if (!n->kids[1])
             return NULL;
         /* 'else' may start the next line */
-        size_t save = p->pos;
+        token *save = p->cur;
         while (peek_raw(p)->type == T_NEWLINE)
-            p->pos++;
+            p->cur++;
         token *t = peek_raw(p);
         if (t->type == T_ELIF) {
             next(p);
@@ -904,7 +919,7 @@ static node *parse_if(parser *p)
             if (!n->kids[2])
                 return NULL;
         } else {
-            p->pos = save;
+            p->cur = save;
         }
         break;
     }
@@ -1075,7 +1090,7 @@ static node *parse_subexpr(parser *p, int level)
             break;
         next(p);
         while (peek_raw(p)->type == T_NEWLINE) /* the operand may start the next line */
-            p->pos++;
+            p->cur++;
         node *rhs = parse_subexpr(p, operand_level(r));
         if (!rhs) {
             left = NULL;
@@ -1331,6 +1346,7 @@ int parse_source(interp *I, int src, node **out)
         I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
         return -1;
     }
+    p.cur = p.tl.toks;
     node *b = parse_block_until(&p, NULL);
     lex_free(&p.tl);
     if (!b || p.failed) {

@@ -200,6 +200,18 @@ static uint64_t hash_bytes(const char *s, size_t n)
     return h;
 }
 
+/* strncmp(e, s, len) == 0 && e[len] == 0, without the call (names are short) */
+static int same_name(const char *e, const char *s, size_t len)
+{
+    for (size_t i = 0; i < len; i++) {
+        if (e[i] != s[i])
+            return 0;
+        if (!e[i])
+            break;
+    }
+    return e[len] == 0;
+}
+
 const char *interp_intern(interp *I, const char *s, size_t len)
 {
     if (I->intern_n * 2 >= I->intern_cap) {
@@ -224,7 +236,7 @@ const char *interp_intern(interp *I, const char *s, size_t len)
     size_t j = hash_bytes(s, len) & (I->intern_cap - 1);
     while (I->intern_tab[j]) {
         char *e = I->intern_tab[j];
-        if (strncmp(e, s, len) == 0 && e[len] == 0)
+        if (same_name(e, s, len))
             return e;
         j = (j + 1) & (I->intern_cap - 1);
     }
