@@ -14,7 +14,7 @@
 #include "contract.h"
 #include "eval.h"
 
-static int bound_push(interp *I, check_names *b, const char *name, const node *def)
+int check_bind(interp *I, check_names *b, const char *name, const node *def)
 {
     if (b->n == b->cap) {
         int nc = b->cap ? b->cap * 2 : 64;
@@ -42,22 +42,22 @@ static int collect(interp *I, check_names *b, const node *n, int top)
     case N_PARAM:
     case N_FOR:
     case N_COMP:
-        if (bound_push(I, b, n->str, NULL))
+        if (check_bind(I, b, n->str, NULL))
             return -1;
         break;
     case N_FNDEF:
-        if (bound_push(I, b, n->str, top ? n : NULL))
+        if (check_bind(I, b, n->str, top ? n : NULL))
             return -1;
         break;
     case N_LAMBDA:
         for (int i = 0; i < n->nparams; i++)
-            if (bound_push(I, b, n->names[i], NULL))
+            if (check_bind(I, b, n->names[i], NULL))
                 return -1;
         if (collect(I, b, n->body, 0))
             return -1;
         break;
     case N_IMPORT:
-        if (n->names && n->names[0] && bound_push(I, b, n->names[0], NULL))
+        if (n->names && n->names[0] && check_bind(I, b, n->names[0], NULL))
             return -1;
         return 0;
     default:
@@ -78,6 +78,11 @@ int check_collect(interp *I, const node *prog, check_names *out)
     for (int i = 0; i < prog->nkids; i++)
         if (collect(I, out, prog->kids[i], 1))
             return -1;
+    return check_index(I, out);
+}
+
+int check_index(interp *I, check_names *out)
+{
     /* check_call looks every call's name up here: hashed, not scanned */
     size_t cap = 16;
     while (cap < (size_t)out->n * 2 + 2)
