@@ -166,10 +166,17 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
  * so the recursion of every walk over the tree is bounded. At the end of
  * the input the usual "expected …, found end of input" follows instead (the
  * REPL asks for more). Callers that succeed must leave with p->depth--. */
-static int enter_level(parser *p)
+static int too_deep(parser *p);
+
+static inline int enter_level(parser *p)
 {
     if (++p->depth <= PARSE_MAX_NESTING)
         return 0;
+    return too_deep(p);
+}
+
+static int too_deep(parser *p)
+{
     token *t = peek(p);
     if (t->type == T_EOF)
         return 0;

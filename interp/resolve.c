@@ -320,10 +320,14 @@ static int resolve_lambda(resolver *r, scope *s, const node *l)
 }
 
 /* A literal has nothing to resolve: its parent does not call for it. */
+_Static_assert(N_NUM == 0 && N_STR == 1 && N_BOOL == 2 && N_NIL == 3,
+               "is_literal takes the literals to be the first node kinds");
 static int is_literal(const node *n)
 {
-    return n->kind == N_NUM || n->kind == N_STR || n->kind == N_BOOL || n->kind == N_NIL;
+    return n->kind <= N_NIL; /* N_NUM, N_STR, N_BOOL, N_NIL come first in node_kind */
 }
+
+static int resolve_kid(resolver *r, scope *s, const node *k);
 
 static int resolve_node(resolver *r, scope *s, const node *n)
 {
@@ -363,15 +367,25 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         return resolve_node(r, s, n->kids[0]);
     case N_CALL:
         for (int i = 0; i < n->nkids; i++)
-            if (n->kids[i] && !is_literal(n->kids[i]) && resolve_node(r, s, n->kids[i]))
+            if (resolve_kid(r, s, n->kids[i]))
                 return -1;
         return call_check(r, n);
     default:
         for (int i = 0; i < n->nkids; i++)
-            if (n->kids[i] && !is_literal(n->kids[i]) && resolve_node(r, s, n->kids[i]))
+            if (resolve_kid(r, s, n->kids[i]))
                 return -1;
         return 0;
     }
+}
+
+/* resolve_node for a child, with the leaves (most children) done here */
+static inline int resolve_kid(resolver *r, scope *s, const node *k)
+{
+    if (!k || is_literal(k))
+        return 0;
+    if (k->kind == N_NAME)
+        return visible(r, s, k->str) ? 0 : unknown(r, s, k, k->str);
+    return resolve_node(r, s, k);
 }
 
 static int resolve_block(resolver *r, scope *s, const node *b)

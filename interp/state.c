@@ -169,9 +169,18 @@ int mem_engine_error(interp *I, const char *what, const char *msg)
 
 /* ---- arena for syntax trees --------------------------------------------- */
 
+/* Blocks double from 64 KiB up to 8 MiB, so a large script's tree takes a
+ * few big blocks (which the runtime's allocator asks the kernel to back with
+ * huge pages: far fewer page faults on first touch) and a small one wastes
+ * little; at most the newest block is partly unused. */
+#define ARENA_MIN ((size_t)64 << 10)
+#define ARENA_MAX ((size_t)8 << 20)
 void *mem_arena_grow(interp *I, size_t n)
 {
-    size_t cap = n > 65536 ? n : 65536;
+    size_t cap = I->arena ? I->arena->cap * 2 : ARENA_MIN;
+    cap = cap < ARENA_MIN ? ARENA_MIN : cap > ARENA_MAX ? ARENA_MAX : cap;
+    if (n > cap)
+        cap = n;
     arena_block *b = mem_alloc(I, sizeof(arena_block) + cap);
     if (!b)
         return NULL;
@@ -224,7 +233,10 @@ const char *interp_intern(interp *I, const char *s, size_t len)
             char *e = I->intern_tab[i];
             if (!e)
                 continue;
-            size_t j = hash_bytes(e, strlen(e)) & (nc - 1);
+            uint64_t h = 1469598103934665603ull; /* hash_bytes(e, strlen(e)) in one pass */
+            for (const char *q = e; *q; q++)
+                h = (h ^ (unsigned char)*q) * 1099511628211ull;
+            size_t j = h & (nc - 1);
             while (nt[j])
                 j = (j + 1) & (nc - 1);
             nt[j] = e;
