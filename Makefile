@@ -62,6 +62,9 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libfracrt.a tests/unit/check.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
 
+# test_lexer compiles interp/lexer.c into itself (the scanner needs only rt_alloc)
+$(BUILD)/tests/test_lexer: interp/lexer.c interp/lexer.h
+
 # The runner is the harness, not the product: built without sanitizers.
 $(BUILD)/runner: tests/runner.c
 	@mkdir -p $(dir $@)

@@ -2,11 +2,16 @@
 # Interpreter start-up and front-end speed:
 #   1. `frac -e '1+1'` process time (target ≤ 5 ms)
 #   2. `frac check` on a generated 10,000-line script (target ≤ 50 ms)
+# Times are best of several runs: wall clock, and CPU (user + system, from
+# /usr/bin/time, 10 ms steps) where it is installed. With valgrind, the
+# instructions of one run of each (callgrind; independent of the load: the
+# figure to compare across days, ~50 M being ~50 ms on a quiet core).
 # Usage: bash bench/interp.sh [build/frac]
 set -eu
 frac=${1:-build/frac}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+load() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || uptime; }
 gen() {
     local i
     for ((i = 0; i < 2500; i++)); do
@@ -17,6 +22,7 @@ gen() {
     done
 }
 gen > "$tmp/big.frac"
+echo "load average before: $(load)"
 now() { date +%s%N; }
 best_e=999999999
 for run in 1 2 3; do
@@ -36,3 +42,17 @@ for run in 1 2 3 4 5; do
 done
 printf 'frac -e 1+1            %6.2f ms per process (target <= 5)\n' "$(awk "BEGIN{print $best_e/1e6}")"
 printf 'frac check 10k lines   %6.2f ms (target <= 50)\n' "$(awk "BEGIN{print $best_c/1e6}")"
+if [ -x /usr/bin/time ]; then
+    cpu=$(for run in 1 2 3 4 5; do
+        /usr/bin/time -f '%U %S %R' "$frac" check "$tmp/big.frac" 2>&1 >/dev/null | tail -1
+    done | awk '{t = ($1 + $2) * 1000; if (!n++ || t < b) { b = t; f = $3 } } END { printf "%.0f ms CPU (user + system), %d page faults", b, f }')
+    echo "frac check 10k lines   $cpu"
+fi
+if command -v valgrind > /dev/null; then
+    ins() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$@" 2>&1 >/dev/null |
+                awk '/Collected/ { printf "%.2f M", $NF / 1e6 }'; }
+    echo "instructions (callgrind): frac -e 1+1 $(ins "$frac" -e '1+1'), frac check 10k lines $(ins "$frac" check "$tmp/big.frac") (target <= 50 M)"
+else
+    echo "instructions: skipped (valgrind is not installed)"
+fi
+echo "load average after: $(load)"

@@ -14,7 +14,7 @@
 #include "contract.h"
 #include "eval.h"
 
-static int bound_push(interp *I, check_names *b, const char *name, const node *def)
+int check_bind(interp *I, check_names *b, const char *name, const node *def)
 {
     if (b->n == b->cap) {
         int nc = b->cap ? b->cap * 2 : 64;
@@ -42,30 +42,33 @@ static int collect(interp *I, check_names *b, const node *n, int top)
     case N_PARAM:
     case N_FOR:
     case N_COMP:
-        if (bound_push(I, b, n->str, NULL))
+        if (check_bind(I, b, n->str, NULL))
             return -1;
         break;
     case N_FNDEF:
-        if (bound_push(I, b, n->str, top ? n : NULL))
+        if (check_bind(I, b, n->str, top ? n : NULL))
             return -1;
         break;
     case N_LAMBDA:
         for (int i = 0; i < n->nparams; i++)
-            if (bound_push(I, b, n->names[i], NULL))
+            if (check_bind(I, b, n->names[i], NULL))
                 return -1;
         if (collect(I, b, n->body, 0))
             return -1;
         break;
     case N_IMPORT:
-        if (n->names && n->names[0] && bound_push(I, b, n->names[0], NULL))
+        if (n->names && n->names[0] && check_bind(I, b, n->names[0], NULL))
             return -1;
         return 0;
     default:
         break;
     }
-    for (int i = 0; i < n->nkids; i++)
-        if (collect(I, b, n->kids[i], 0))
+    for (int i = 0; i < n->nkids; i++) {
+        const node *k = n->kids[i];
+        /* literals and names bind nothing and have no children: no call */
+        if (k && k->kind != N_NAME && k->kind != N_NUM && k->kind != N_STR && collect(I, b, k, 0))
             return -1;
+    }
     return 0;
 }
 
@@ -75,6 +78,11 @@ int check_collect(interp *I, const node *prog, check_names *out)
     for (int i = 0; i < prog->nkids; i++)
         if (collect(I, out, prog->kids[i], 1))
             return -1;
+    return check_index(I, out);
+}
+
+int check_index(interp *I, check_names *out)
+{
     /* check_call looks every call's name up here: hashed, not scanned */
     size_t cap = 16;
     while (cap < (size_t)out->n * 2 + 2)
@@ -162,8 +170,14 @@ static int check_builtin(interp *I, const builtin *b, const node *call)
         }
         int rc = 0;
         if (!(v.k == V_NIL && cp->def_nil)) {
+            /* "argument 'NAME'", built without snprintf: one per constant argument */
             char what[160];
-            snprintf(what, sizeof what, "argument '%s'", cp->name);
+            size_t nl = strlen(cp->name);
+            if (nl > sizeof what - 13)
+                nl = sizeof what - 13;
+            memcpy(what, "argument '", 10);
+            memcpy(what + 10, cp->name, nl);
+            memcpy(what + 10 + nl, "'", 2);
             cpos at = {anodes[i], -1, 0, 0};
             rc = contract_check_value(I, cp->type, v, b->name, what, at);
         }

@@ -21,6 +21,12 @@ typedef struct check_names {
 
 /* Collect every name the program binds (anywhere). */
 int check_collect(interp *I, const node *prog, check_names *out);
+/* The same piece by piece, for a walk that visits every binding itself (the
+ * resolver): check_bind for each name bound (def: the N_FNDEF of a top-level
+ * `fn`, else NULL), in any order, then check_index once, before check_call.
+ * Starts from a zeroed check_names. */
+int check_bind(interp *I, check_names *b, const char *name, const node *def);
+int check_index(interp *I, check_names *b);
 void check_names_free(interp *I, check_names *b);
 /* Check one N_CALL; mods are the scopes of the modules imported so far. */
 int check_call(interp *I, const check_names *bound, env *const *mods, int nmods, const node *call);

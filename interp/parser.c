@@ -18,33 +18,34 @@
 typedef struct parser {
     interp *I;
     token_list tl;
-    size_t pos;
+    token *cur;     /* the next token, in tl */
     int skip_nl;    /* newlines are insignificant here */
     int table_mode; /* parsing an entry of a table row */
     int closing;    /* the error being reported is a missing closer */
     const token *construct; /* innermost 'if', 'fn' or 'for' being parsed */
     int failed;
     int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
+    const struct oprow *row[2][T_COUNT]; /* ops[] indexed by fix and token (op_index) */
 } parser;
 
 /* ---- token access ---------------------------------------------------------- */
 
-static token *peek_raw(parser *p) { return &p->tl.toks[p->pos]; }
+static inline token *peek_raw(parser *p) { return p->cur; }
 
-static token *peek(parser *p)
+static inline token *peek(parser *p)
 {
     if (p->skip_nl)
-        while (p->tl.toks[p->pos].type == T_NEWLINE)
-            p->pos++;
-    return &p->tl.toks[p->pos];
+        while (p->cur->type == T_NEWLINE)
+            p->cur++;
+    return p->cur;
 }
 
 static token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
 {
-    size_t save = p->pos;
+    token *save = p->cur;
     peek(p);
-    size_t i = p->pos + 1;
-    p->pos = save;
+    size_t i = (size_t)(p->cur - p->tl.toks) + 1;
+    p->cur = save;
     if (p->tl.toks[i - 1].type == T_EOF)
         return &p->tl.toks[i - 1];
     if (p->skip_nl)
@@ -53,11 +54,11 @@ static token *peek2(parser *p) /* the token after peek(), skipping newlines if s
     return &p->tl.toks[i];
 }
 
-static token *next(parser *p)
+static inline token *next(parser *p)
 {
     token *t = peek(p);
     if (t->type != T_EOF)
-        p->pos++;
+        p->cur++;
     return t;
 }
 
@@ -75,7 +76,7 @@ static int match(parser *p, tok_type t)
 static void skip_newlines(parser *p)
 {
     while (peek_raw(p)->type == T_NEWLINE || peek_raw(p)->type == T_SEMI)
-        p->pos++;
+        p->cur++;
 }
 
 /* The innermost bracket or 'do' still open before token index `upto`
@@ -165,10 +166,19 @@ static const char *tok_desc(const token *t, char *buf, size_t n)
  * so the recursion of every walk over the tree is bounded. At the end of
  * the input the usual "expected …, found end of input" follows instead (the
  * REPL asks for more). Callers that succeed must leave with p->depth--. */
-static int enter_level(parser *p)
+static int too_deep(parser *p);
+
+static inline int enter_level(parser *p)
+{
+    if (++p->depth <= PARSE_MAX_NESTING)
+        return 0;
+    return too_deep(p);
+}
+
+static int too_deep(parser *p)
 {
     token *t = peek(p);
-    if (++p->depth <= PARSE_MAX_NESTING || t->type == T_EOF)
+    if (t->type == T_EOF)
         return 0;
     p->depth--;
     if (!p->failed) {
@@ -180,27 +190,42 @@ static int enter_level(parser *p)
     return -1;
 }
 
-/* Expect token type t; `what` describes the context for the message. */
-static int expect(parser *p, tok_type t, const char *what)
+/* Expect token type t; `what` describes the context for the message. The
+ * test is inline, the message out of line. */
+static int expected(parser *p, tok_type t, const char *what);
+
+static inline int expect(parser *p, tok_type t, const char *what)
 {
-    token *k = peek(p);
-    if (k->type == t) {
+    if (peek(p)->type == t) {
         next(p);
         return 0;
     }
+    return expected(p, t, what);
+}
+
+static int expected(parser *p, tok_type t, const char *what)
+{
+    token *k = peek(p);
     char buf[64], msg[256];
     snprintf(msg, sizeof msg, "expected %s %s, found %%s", lex_name(t), what);
     return syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
 }
 
 /* Expect a closing bracket; on failure note where it was opened. */
-static int expect_close(parser *p, tok_type t, const token *open)
+static int expected_close(parser *p, tok_type t, const token *open);
+
+static inline int expect_close(parser *p, tok_type t, const token *open)
 {
-    token *k = peek(p);
-    if (k->type == t) {
+    if (peek(p)->type == t) {
         next(p);
         return 0;
     }
+    return expected_close(p, t, open);
+}
+
+static int expected_close(parser *p, tok_type t, const token *open)
+{
+    token *k = peek(p);
     char buf[64], msg[256];
     snprintf(msg, sizeof msg, "expected %s to close %s opened at line %d, found %%s", lex_name(t),
              lex_name(open->type), open->line);
@@ -212,13 +237,22 @@ static int expect_close(parser *p, tok_type t, const token *open)
 
 /* ---- node construction --------------------------------------------------- */
 
-static node *mk(parser *p, node_kind k, const token *at)
+/* A node, and room for `extra` bytes after it in the same piece of the arena
+ * (a node's size is a multiple of 16, so what follows is aligned). */
+static inline node *mk_extra(parser *p, node_kind k, const token *at, size_t extra)
 {
-    node *n = mem_arena_alloc(p->I, sizeof(node));
+    node *n = mem_arena_raw(p->I, sizeof(node) + extra);
     if (!n) {
         p->failed = 1;
         return NULL;
     }
+    /* zeroed in constant pieces of at most 64 bytes, which compilers store
+     * inline (a single memset of the whole node becomes a `rep stos`) */
+    char *q = (char *)n;
+    size_t i = 0;
+    for (; i + 64 <= sizeof *n; i += 64)
+        memset(q + i, 0, 64);
+    memset(q + i, 0, sizeof *n - i);
     n->kind = k;
     n->src = at->src;
     n->line = at->line;
@@ -226,12 +260,15 @@ static node *mk(parser *p, node_kind k, const token *at)
     return n;
 }
 
-/* A node with one or two children. */
+static node *mk(parser *p, node_kind k, const token *at) { return mk_extra(p, k, at, 0); }
+
+/* A node with one or two children, their array right after it. */
 static node *mk1(parser *p, node_kind k, const token *at, node *a)
 {
-    node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_alloc(p->I, sizeof(node *))))
+    node *n = mk_extra(p, k, at, sizeof(node *));
+    if (!n)
         return NULL;
+    n->kids = (node **)(n + 1);
     n->nkids = 1;
     n->kids[0] = a;
     return n;
@@ -239,9 +276,10 @@ static node *mk1(parser *p, node_kind k, const token *at, node *a)
 
 static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
 {
-    node *n = mk(p, k, at);
-    if (!n || !(n->kids = mem_arena_alloc(p->I, 2 * sizeof(node *))))
+    node *n = mk_extra(p, k, at, 2 * sizeof(node *));
+    if (!n)
         return NULL;
+    n->kids = (node **)(n + 1);
     n->nkids = 2;
     n->kids[0] = a;
     n->kids[1] = b;
@@ -254,27 +292,36 @@ typedef struct nodevec {
     int n, cap;
 } nodevec;
 
-static int nv_push(parser *p, nodevec *nv, node *n, const char *name)
+static int nv_grow(parser *p, nodevec *nv);
+
+static inline int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
-    if (nv->n == nv->cap) {
-        int nc = nv->cap ? nv->cap * 2 : 8;
-        node **a = mem_arena_alloc(p->I, (size_t)nc * sizeof *a);
-        const char **b = mem_arena_alloc(p->I, (size_t)nc * sizeof *b);
-        if (!a || !b) {
-            p->failed = 1;
-            return -1;
-        }
-        if (nv->n) {
-            memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
-            memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
-        }
-        nv->v = a;
-        nv->names = b;
-        nv->cap = nc;
-    }
+    if (nv->n == nv->cap && nv_grow(p, nv))
+        return -1;
     nv->v[nv->n] = n;
     nv->names[nv->n] = name;
     nv->n++;
+    return 0;
+}
+
+/* Double a nodevec's room (the old arrays stay in the arena). */
+static int nv_grow(parser *p, nodevec *nv)
+{
+    int nc = nv->cap ? nv->cap * 2 : 8;
+    /* the nodes, then the names, in one piece; items past n are never read */
+    node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
+    if (!a) {
+        p->failed = 1;
+        return -1;
+    }
+    const char **b = (const char **)(a + nc);
+    if (nv->n) {
+        memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
+        memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
+    }
+    nv->v = a;
+    nv->names = b;
+    nv->cap = nc;
     return 0;
 }
 
@@ -292,7 +339,7 @@ static node *string_node(parser *p, const token *t)
     node *n = mk(p, N_STR, t);
     if (!n)
         return NULL;
-    char *s = mem_arena_alloc(p->I, (size_t)t->len + 1);
+    char *s = mem_arena_raw(p->I, (size_t)t->len + 1);
     if (!s)
         return NULL;
     size_t k = 0;
@@ -377,13 +424,15 @@ static const oprow ops[] = {
 /* the only non-associative operators are the comparisons */
 #define CHAIN_ERROR "comparisons cannot be chained; use 'and'"
 
-static const oprow *op_row(tok_type t, int fix)
+/* ops[] by fix and token, so finding an operator is one load, not a search
+ * of the table at every operand (filled once per parse, from ops[]). */
+static void op_index(parser *p)
 {
     for (size_t i = 0; i < sizeof ops / sizeof ops[0]; i++)
-        if (ops[i].tok == t && ops[i].fix == fix)
-            return &ops[i];
-    return NULL;
+        p->row[ops[i].fix][ops[i].tok] = &ops[i];
 }
+
+static const oprow *op_row(const parser *p, tok_type t, int fix) { return p->row[fix][t]; }
 
 /* The level of the right operand of row r. */
 static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : r->prec + 1; }
@@ -392,7 +441,7 @@ static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : 
  * before it and none after starts a new entry instead (`1 -2`). */
 static const oprow *infix_at(parser *p, const token *t)
 {
-    const oprow *r = op_row(t->type, INFIX);
+    const oprow *r = op_row(p, t->type, INFIX);
     if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
         const token *after = t + 1;
         if (!after->space_before && after->type != T_NEWLINE)
@@ -407,12 +456,12 @@ static void skip_to_leading_op(parser *p)
 {
     if (p->table_mode || peek_raw(p)->type != T_NEWLINE)
         return;
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     while (p->tl.toks[i].type == T_NEWLINE)
         i++;
-    const oprow *r = op_row(p->tl.toks[i].type, INFIX);
+    const oprow *r = op_row(p, p->tl.toks[i].type, INFIX);
     if (r && r->leads)
-        p->pos = i;
+        p->cur = &p->tl.toks[i];
 }
 
 
@@ -517,11 +566,12 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(node *));
-    c->names = mem_arena_alloc(p->I, (size_t)c->nkids * sizeof(char *));
-    if (!c->kids || !c->names)
+    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * (sizeof(node *) + sizeof(char *)));
+    if (!c->kids)
         return NULL;
+    c->names = (const char **)(c->kids + c->nkids);
     c->kids[0] = callee;
+    c->names[0] = NULL;
     for (int i = 0; i < args->n; i++) {
         c->kids[i + 1] = args->v[i];
         c->names[i + 1] = args->names[i];
@@ -669,7 +719,7 @@ static node *parse_lambda_rest(parser *p, const token *at, const char *name)
 /* Is the '(' at pos the start of `(a, b) => …`? */
 static int is_paren_lambda(parser *p)
 {
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     int depth = 0;
     for (;; i++) {
         tok_type t = p->tl.toks[i].type;
@@ -724,7 +774,7 @@ static node *parse_brace(parser *p)
     token *open = next(p);
     parse_mode m = enter_mode(p, p->skip_nl);
     /* look past newlines to decide between record and table */
-    size_t i = p->pos;
+    size_t i = (size_t)(p->cur - p->tl.toks);
     while (p->tl.toks[i].type == T_NEWLINE)
         i++;
     tok_type first = p->tl.toks[i].type;
@@ -860,9 +910,9 @@ static node *parse_if(parser *p)
         if (!n->kids[1])
             return NULL;
         /* 'else' may start the next line */
-        size_t save = p->pos;
+        token *save = p->cur;
         while (peek_raw(p)->type == T_NEWLINE)
-            p->pos++;
+            p->cur++;
         token *t = peek_raw(p);
         if (t->type == T_ELIF) {
             next(p);
@@ -876,7 +926,7 @@ static node *parse_if(parser *p)
             if (!n->kids[2])
                 return NULL;
         } else {
-            p->pos = save;
+            p->cur = save;
         }
         break;
     }
@@ -1016,7 +1066,7 @@ static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 static node *parse_operand(parser *p, int level)
 {
     token *t = peek(p);
-    const oprow *r = op_row(t->type, PREFIX);
+    const oprow *r = op_row(p, t->type, PREFIX);
     if (!r || r->prec < level) /* `a * not b`: the primary reports 'not' */
         {
         node *e = parse_primary(p);
@@ -1047,7 +1097,7 @@ static node *parse_subexpr(parser *p, int level)
             break;
         next(p);
         while (peek_raw(p)->type == T_NEWLINE) /* the operand may start the next line */
-            p->pos++;
+            p->cur++;
         node *rhs = parse_subexpr(p, operand_level(r));
         if (!rhs) {
             left = NULL;
@@ -1293,6 +1343,7 @@ int parse_source(interp *I, int src, node **out)
     parser p;
     memset(&p, 0, sizeof p);
     p.I = I;
+    op_index(&p);
     *out = NULL;
     if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl)) {
         /* the token array goes through the hook: say why it was refused (the
@@ -1302,6 +1353,7 @@ int parse_source(interp *I, int src, node **out)
         I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
         return -1;
     }
+    p.cur = p.tl.toks;
     node *b = parse_block_until(&p, NULL);
     lex_free(&p.tl);
     if (!b || p.failed) {

@@ -11,8 +11,9 @@
 #include "stdlib_embed.h"
 
 typedef struct scope {
-    const char **names;
+    const char **names; /* `small` until it holds more */
     int n, cap;
+    const char *small[8]; /* most scopes (parameters, loop variables) are small: no allocation */
     const char **set; /* pointer hash set of names, for large scopes */
     size_t set_cap;
     struct scope *parent;
@@ -20,7 +21,8 @@ typedef struct scope {
 
 static void scope_free(interp *I, scope *s)
 {
-    mem_free(I, s->names);
+    if (s->names != s->small)
+        mem_free(I, s->names);
     mem_free(I, s->set);
 }
 
@@ -81,23 +83,89 @@ static int scope_has(const scope *s, const char *name)
     return 0;
 }
 
+/* The call checks (check.c) need every name the program binds, the whole
+ * program's, before the first call is checked. The walk below visits every
+ * binding anyway, so it collects them itself and puts the calls off until
+ * its end, then checks them in the order it met them: one walk instead of
+ * two. What a reader sees stays as if each call were checked where the walk
+ * meets it: when the walk stops at an error, or reaches an import (which
+ * loads a module: its effects must not come before an earlier call's
+ * error), the resolver settles: it collects the names with check_collect,
+ * checks the calls put off so far (the first failing one is the error
+ * reported, as it came first), and from then on checks each call at once. */
+typedef struct pending_call {
+    const node *call;
+    int nmods;
+} pending_call;
+
 typedef struct resolver {
     interp *I;
     env *globals;
+    const node *prog;
     const char *visiting[64]; /* modules being scanned (cycle guard) */
     int nvisiting;
     check_names bound;        /* names the program binds, for the call checks */
+    int settled;              /* bound is complete: check calls at once */
+    pending_call *pend;       /* calls met before then, in order */
+    int npend, cap_pend;
     env *mods[64];            /* scopes of the modules imported without an alias */
     int nmods;
 } resolver;
 
+/* A name bound (for the call checks), while the walk collects them. */
+static int bind(resolver *r, const char *name, const node *def)
+{
+    return r->settled ? 0 : check_bind(r->I, &r->bound, name, def);
+}
+
+static int call_check(resolver *r, const node *call)
+{
+    if (r->settled)
+        return check_call(r->I, &r->bound, r->mods, r->nmods, call);
+    if (r->npend == r->cap_pend) {
+        int nc = r->cap_pend ? r->cap_pend * 2 : 64;
+        pending_call *np = mem_realloc(r->I, r->pend, (size_t)nc * sizeof *np);
+        if (!np)
+            return -1;
+        r->pend = np;
+        r->cap_pend = nc;
+    }
+    r->pend[r->npend++] = (pending_call){call, r->nmods};
+    return 0;
+}
+
+static int run_pending(resolver *r)
+{
+    for (int i = 0; i < r->npend; i++)
+        if (check_call(r->I, &r->bound, r->mods, r->pend[i].nmods, r->pend[i].call))
+            return -1;
+    r->npend = 0;
+    return 0;
+}
+
+/* The names from the whole program, then the calls put off so far. */
+static int settle(resolver *r)
+{
+    r->settled = 1;
+    check_names_free(r->I, &r->bound);
+    if (check_collect(r->I, r->prog, &r->bound))
+        return -1;
+    return run_pending(r);
+}
+
 static int declare(resolver *r, scope *s, const char *name)
 {
-    if (s->n == s->cap) {
-        int nc = s->cap ? s->cap * 2 : 16;
-        const char **nn = mem_realloc(r->I, s->names, (size_t)nc * sizeof *nn);
+    if (!s->cap) {
+        s->names = s->small;
+        s->cap = (int)(sizeof s->small / sizeof s->small[0]);
+    } else if (s->n == s->cap) {
+        int nc = s->cap * 2;
+        const char **nn = mem_alloc(r->I, (size_t)nc * sizeof *nn);
         if (!nn)
             return -1;
+        memcpy(nn, s->names, (size_t)s->n * sizeof *nn);
+        if (s->names != s->small)
+            mem_free(r->I, s->names);
         s->names = nn;
         s->cap = nc;
     }
@@ -212,6 +280,8 @@ static int module_names(resolver *r, scope *s, const node *imp)
     env *m;
     (void)m;
     const char *name = imp->str;
+    if (!r->settled && settle(r))
+        return -1;
     for (int i = 0; i < r->nvisiting; i++)
         if (strcmp(r->visiting[i], name) == 0)
             return err_at(r->I, imp, ERR_VALUE, "import cycle: \"%s\" is already being imported", name);
@@ -240,12 +310,24 @@ static int resolve_lambda(resolver *r, scope *s, const node *l)
             rc = resolve_node(r, &inner, l->kids[i]);
         if (rc == 0)
             rc = declare(r, &inner, l->names[i]);
+        if (rc == 0)
+            rc = bind(r, l->names[i], NULL);
     }
     if (rc == 0)
         rc = l->body->kind == N_BLOCK ? resolve_block(r, &inner, l->body) : resolve_node(r, &inner, l->body);
     scope_free(r->I, &inner);
     return rc;
 }
+
+/* A literal has nothing to resolve: its parent does not call for it. */
+_Static_assert(N_NUM == 0 && N_STR == 1 && N_BOOL == 2 && N_NIL == 3,
+               "is_literal takes the literals to be the first node kinds");
+static int is_literal(const node *n)
+{
+    return n->kind <= N_NIL; /* N_NUM, N_STR, N_BOOL, N_NIL come first in node_kind */
+}
+
+static int resolve_kid(resolver *r, scope *s, const node *k);
 
 static int resolve_node(resolver *r, scope *s, const node *n)
 {
@@ -273,6 +355,8 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         inner.parent = s;
         int rc = declare(r, &inner, n->str);
         if (rc == 0)
+            rc = bind(r, n->str, NULL);
+        if (rc == 0)
             rc = resolve_node(r, &inner, n->kids[2]);
         if (rc == 0)
             rc = resolve_node(r, &inner, n->kids[0]);
@@ -283,15 +367,25 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         return resolve_node(r, s, n->kids[0]);
     case N_CALL:
         for (int i = 0; i < n->nkids; i++)
-            if (resolve_node(r, s, n->kids[i]))
+            if (resolve_kid(r, s, n->kids[i]))
                 return -1;
-        return check_call(r->I, &r->bound, r->mods, r->nmods, n);
+        return call_check(r, n);
     default:
         for (int i = 0; i < n->nkids; i++)
-            if (resolve_node(r, s, n->kids[i]))
+            if (resolve_kid(r, s, n->kids[i]))
                 return -1;
         return 0;
     }
+}
+
+/* resolve_node for a child, with the leaves (most children) done here */
+static inline int resolve_kid(resolver *r, scope *s, const node *k)
+{
+    if (!k || is_literal(k))
+        return 0;
+    if (k->kind == N_NAME)
+        return visible(r, s, k->str) ? 0 : unknown(r, s, k, k->str);
+    return resolve_node(r, s, k);
 }
 
 static int resolve_block(resolver *r, scope *s, const node *b)
@@ -307,6 +401,8 @@ static int resolve_block(resolver *r, scope *s, const node *b)
         switch (st->kind) {
         case N_LET:
         case N_PARAM:
+            if (bind(r, st->str, NULL))
+                return -1;
             if (st->kids[0]->kind == N_LAMBDA) {
                 if (declare(r, s, st->str) || resolve_node(r, s, st->kids[0]))
                     return -1;
@@ -315,6 +411,8 @@ static int resolve_block(resolver *r, scope *s, const node *b)
             }
             break;
         case N_ASSIGN:
+            if (bind(r, st->str, NULL))
+                return -1;
             if (!visible(r, s, st->str))
                 return err_at(r->I, st, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                               st->str, st->str);
@@ -327,7 +425,7 @@ static int resolve_block(resolver *r, scope *s, const node *b)
                 return -1;
             break;
         case N_FNDEF:
-            if (resolve_lambda(r, s, st->kids[0]))
+            if (bind(r, st->str, b == r->prog ? st : NULL) || resolve_lambda(r, s, st->kids[0]))
                 return -1;
             break;
         case N_IMPORT:
@@ -340,6 +438,8 @@ static int resolve_block(resolver *r, scope *s, const node *b)
             scope inner = {0};
             inner.parent = s;
             int rc = declare(r, &inner, st->str);
+            if (rc == 0)
+                rc = bind(r, st->str, NULL);
             if (rc == 0)
                 rc = resolve_node(r, &inner, st->kids[1]);
             scope_free(r->I, &inner);
@@ -363,18 +463,36 @@ static int resolve_slots(interp *I, node *prog, env *globals);
 
 int resolve_program(interp *I, node *prog, env *globals)
 {
+    int rc = resolve_check(I, prog, globals);
+    return rc ? rc : resolve_slots(I, prog, globals);
+}
+
+int resolve_check(interp *I, node *prog, env *globals)
+{
     resolver r;
     memset(&r, 0, sizeof r);
     r.I = I;
     r.globals = globals;
+    r.prog = prog;
     scope top = {0};
-    int rc = check_collect(I, prog, &r.bound);
-    if (rc == 0)
-        rc = resolve_block(&r, &top, prog);
+    int rc = resolve_block(&r, &top, prog);
+    if (!r.settled && rc == 0) {
+        /* the walk saw every binding: index them, check the calls */
+        r.settled = 1;
+        rc = check_index(I, &r.bound);
+        if (rc == 0)
+            rc = run_pending(&r);
+    } else if (!r.settled) {
+        /* an error before any import: a call met before it may fail first */
+        err_state e = I->err;
+        err_clear(I);
+        if (settle(&r) == 0)
+            I->err = e; /* no: the walk's error stands */
+        rc = -1;
+    }
     scope_free(I, &top);
     check_names_free(I, &r.bound);
-    if (rc == 0)
-        rc = resolve_slots(I, prog, globals);
+    mem_free(I, r.pend);
     return rc;
 }
 

@@ -15,5 +15,7 @@
 /* Check a parsed program against the names visible in scope `globals`,
  * then give its names their slots (node.slot, node.hops) for the evaluator. */
 int resolve_program(interp *I, node *prog, env *globals);
+/* The checks alone, without the slots: for `frac check`, which runs nothing. */
+int resolve_check(interp *I, node *prog, env *globals);
 
 #endif

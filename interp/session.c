@@ -55,7 +55,7 @@ int session_run_lines(interp *I, const char *name, const char *text, size_t len,
     node *prog;
     if (parse_source(I, src, &prog))
         return -1;
-    if (resolve_program(I, prog, I->globals))
+    if ((check_only ? resolve_check : resolve_program)(I, prog, I->globals))
         return -1;
     {
         /* collect params (for `check --params` and to validate -D names) */

@@ -169,29 +169,33 @@ int mem_engine_error(interp *I, const char *what, const char *msg)
 
 /* ---- arena for syntax trees --------------------------------------------- */
 
-typedef struct arena_block {
-    struct arena_block *next;
-    size_t used, cap;
-    max_align_t data[];
-} arena_block;
+/* Blocks double from 64 KiB up to 8 MiB, so a large script's tree takes a
+ * few big blocks (which the runtime's allocator asks the kernel to back with
+ * huge pages: far fewer page faults on first touch) and a small one wastes
+ * little; at most the newest block is partly unused. */
+#define ARENA_MIN ((size_t)64 << 10)
+#define ARENA_MAX ((size_t)8 << 20)
+void *mem_arena_grow(interp *I, size_t n)
+{
+    size_t cap = I->arena ? I->arena->cap * 2 : ARENA_MIN;
+    cap = cap < ARENA_MIN ? ARENA_MIN : cap > ARENA_MAX ? ARENA_MAX : cap;
+    if (n > cap)
+        cap = n;
+    arena_block *b = mem_alloc(I, sizeof(arena_block) + cap);
+    if (!b)
+        return NULL;
+    b->cap = cap;
+    b->used = n;
+    b->next = I->arena;
+    I->arena = b;
+    return b->data;
+}
 
 void *mem_arena_alloc(interp *I, size_t n)
 {
-    n = (n + 15) & ~(size_t)15;
-    arena_block *b = I->arena;
-    if (!b || b->used + n > b->cap) {
-        size_t cap = n > 65536 ? n : 65536;
-        b = mem_alloc(I, sizeof(arena_block) + cap);
-        if (!b)
-            return NULL;
-        b->cap = cap;
-        b->used = 0;
-        b->next = I->arena;
-        I->arena = b;
-    }
-    void *p = (char *)b->data + b->used;
-    b->used += n;
-    memset(p, 0, n);
+    void *p = mem_arena_raw(I, n);
+    if (p)
+        memset(p, 0, n);
     return p;
 }
 
@@ -203,6 +207,18 @@ static uint64_t hash_bytes(const char *s, size_t n)
     for (size_t i = 0; i < n; i++)
         h = (h ^ (unsigned char)s[i]) * 1099511628211ull;
     return h;
+}
+
+/* strncmp(e, s, len) == 0 && e[len] == 0, without the call (names are short) */
+static int same_name(const char *e, const char *s, size_t len)
+{
+    for (size_t i = 0; i < len; i++) {
+        if (e[i] != s[i])
+            return 0;
+        if (!e[i])
+            break;
+    }
+    return e[len] == 0;
 }
 
 const char *interp_intern(interp *I, const char *s, size_t len)
@@ -217,7 +233,10 @@ const char *interp_intern(interp *I, const char *s, size_t len)
             char *e = I->intern_tab[i];
             if (!e)
                 continue;
-            size_t j = hash_bytes(e, strlen(e)) & (nc - 1);
+            uint64_t h = 1469598103934665603ull; /* hash_bytes(e, strlen(e)) in one pass */
+            for (const char *q = e; *q; q++)
+                h = (h ^ (unsigned char)*q) * 1099511628211ull;
+            size_t j = h & (nc - 1);
             while (nt[j])
                 j = (j + 1) & (nc - 1);
             nt[j] = e;
@@ -229,11 +248,11 @@ const char *interp_intern(interp *I, const char *s, size_t len)
     size_t j = hash_bytes(s, len) & (I->intern_cap - 1);
     while (I->intern_tab[j]) {
         char *e = I->intern_tab[j];
-        if (strncmp(e, s, len) == 0 && e[len] == 0)
+        if (same_name(e, s, len))
             return e;
         j = (j + 1) & (I->intern_cap - 1);
     }
-    char *e = mem_alloc(I, len + 1);
+    char *e = mem_arena_raw(I, len + 1); /* names live as long as the session, like the trees */
     if (!e)
         return NULL;
     memcpy(e, s, len);
@@ -321,9 +340,7 @@ void interp_free(interp *I)
         mem_free(I, I->srcs[i].dir);
     }
     mem_free(I, I->srcs);
-    for (size_t i = 0; i < I->intern_cap; i++)
-        mem_free(I, I->intern_tab[i]);
-    mem_free(I, I->intern_tab);
+    mem_free(I, I->intern_tab); /* the names are in the arena */
     while (I->arena) {
         arena_block *b = I->arena;
         I->arena = b->next;

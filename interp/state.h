@@ -203,6 +203,26 @@ void interp_free(interp *I);
 int interp_add_source(interp *I, const char *name, const char *text, size_t len);
 const char *interp_intern(interp *I, const char *s, size_t len);
 void *mem_arena_alloc(interp *I, size_t n);
+/* The same piece of the arena, not zeroed: for the parser's nodes and arrays,
+ * which it fills entirely. Inline, as the parser takes one per node: the
+ * arena is a list of blocks of at least 64 KiB, handed out in multiples of
+ * 16 bytes from the newest one; mem_arena_grow starts a new block. */
+typedef struct arena_block {
+    struct arena_block *next;
+    size_t used, cap;
+    max_align_t data[];
+} arena_block;
+void *mem_arena_grow(interp *I, size_t n);
+static inline void *mem_arena_raw(interp *I, size_t n)
+{
+    arena_block *b = I->arena;
+    n = (n + 15) & ~(size_t)15;
+    if (!b || n > b->cap - b->used)
+        return mem_arena_grow(I, n);
+    void *p = (char *)b->data + b->used;
+    b->used += n;
+    return p;
+}
 
 /* Record an error at a node's position (or at I->cur when at is NULL). */
 int err_at(interp *I, const node *at, err_kind k, const char *fmt, ...)
