@@ -356,6 +356,25 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t 
     unsigned shift = d->shift;
     int bad = d->bad;
     for (size_t i = 0; i < len && !bad; i++) {
+        if (!acc && shift <= 7 && len - i >= 8) {
+            /* checking only: count the bytes that end a value. With at most
+             * one byte of a value before these eight, every value ending in
+             * them has at most 9 bytes (63 bits: valid). */
+            uint64_t w;
+            memcpy(&w, p + i, 8); /* byte order does not matter: only counted */
+            uint64_t ends = ~w & high;
+            uint64_t k = ((ends >> 7) * 0x0101010101010101u) >> 56; /* how many */
+            if (ends && want - n >= k) {
+                int t = 0; /* bytes after the last end: the next value's first */
+                while (p[i + 7 - t] & 0x80)
+                    t++;
+                n += k;
+                shift = 7 * (unsigned)t;
+                v = 0;
+                i += 7;
+                continue;
+            }
+        }
         if (shift == 0 && len - i >= 8 && want - n >= 8) {
             uint64_t w;
             memcpy(&w, p + i, 8);
