@@ -16,3 +16,6 @@ for b in "$build"/bench/*; do
     "$b"
     echo "   (load after: $(load))"
 done
+# sharding overhead (issue 17's goal: 4 shards + merge <= 1.05x one run at 10^8)
+echo "== scale: 4 shards + merge vs one run, chaos 1e8 points (load before: $(load))"
+sh bench/scale.sh "$build/frac" 4 1e8

@@ -1,8 +1,9 @@
 #!/bin/sh
 # bench/scale.sh [FRAC] [N] [POINTS] — the cost of sharding (docs/scale.md):
-# CPU time (user + system, from /usr/bin/time) of one single-threaded run of
-# bench/scale.frac against the sum over N single-threaded shards plus the
-# merge, the outputs compared with cmp, and the merge's time per MiB of parts.
+# CPU time (user + system: perf stat's task-clock, or /usr/bin/time) of
+# one single-threaded run of bench/scale.frac against the sum over N
+# single-threaded shards plus the merge, the outputs compared with cmp,
+# and the merge's time per MiB of parts.
 # Run it once, not in a loop: the machine is shared.
 set -eu
 frac=${1:-build/frac}
@@ -11,11 +12,23 @@ points=${3:-1e8}
 here=$(dirname "$0")
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-scale-XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
-cpu() { # command…: prints its user+system seconds
-    /usr/bin/time -f "%U %S" -o "$tmp/t" "$@" >/dev/null 2>&1
-    awk '{ printf "%.3f", $1 + $2 }' "$tmp/t"
-}
-echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
+# CPU seconds of a command (user + system, every thread): perf stat's
+# task-clock in ms where perf works, else /usr/bin/time (10 ms steps, which
+# is ±20 ms over four shards of a 10^8 render).
+if perf stat -x, -e task-clock -o "$tmp/t" true >/dev/null 2>&1 && grep -q task-clock "$tmp/t"; then
+    clock="perf stat task-clock"
+    cpu() {
+        perf stat -x, -e task-clock -o "$tmp/t" "$@" >/dev/null 2>&1
+        awk -F, '/task-clock/ { printf "%.3f", $1 / 1000 }' "$tmp/t"
+    }
+else
+    clock="/usr/bin/time user + system"
+    cpu() {
+        /usr/bin/time -f "%U %S" -o "$tmp/t" "$@" >/dev/null 2>&1
+        awk '{ printf "%.3f", $1 + $2 }' "$tmp/t"
+    }
+fi
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg); CPU time from $clock"
 single=$(cpu "$frac" -q --threads 1 -D points="$points" -o "$tmp/single" "$here/scale.frac")
 total=0
 i=0

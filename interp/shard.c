@@ -274,23 +274,66 @@ static void rec_head(bytebuf *b, const shard_rec *r, uint64_t lo, uint64_t hi, u
     put_u64(b, payload);
 }
 
+/* Room for n more bytes at b->data + b->len (0), or b->failed (-1). */
+static int reserve(bytebuf *b, size_t n)
+{
+    if (b->failed)
+        return -1;
+    if (n <= b->cap - b->len)
+        return 0;
+    size_t ncap = b->cap ? b->cap : 256;
+    while (ncap - b->len < n) {
+        if (ncap > SIZE_MAX / 2) {
+            b->failed = 1;
+            return -1;
+        }
+        ncap *= 2;
+    }
+    unsigned char *nd = rt_realloc(b->data, ncap);
+    if (!nd) {
+        b->failed = 1;
+        return -1;
+    }
+    b->data = nd;
+    b->cap = ncap;
+    return 0;
+}
+
 /* Sums are stored as unsigned LEB128 (7 bits a byte, low group first, the
- * high bit set on every byte but a value's last); returns the bytes added. */
+ * high bit set on every byte but a value's last); returns the bytes added.
+ * Most values are below 128 (one byte each, many of them 0): eight such
+ * values are stored after one test (eight zeros by one store). */
 static uint64_t put_sums(bytebuf *b, const uint64_t *a, size_t n)
 {
-    unsigned char blk[1 << 14];
-    size_t k = 0, start = b->len;
-    for (size_t i = 0; i < n; i++) {
-        uint64_t v = a[i];
-        while (v >= 0x80) {
-            blk[k++] = (unsigned char)(v | 0x80);
-            v >>= 7;
+    size_t start = b->len;
+    if (reserve(b, n)) /* one byte a value at least */
+        return 0;
+    for (size_t i = 0; i < n;) {
+        size_t m = n - i < 4096 ? n - i : 4096; /* a block of at most ten bytes a value */
+        if (reserve(b, 10 * m))
+            return 0;
+        unsigned char *o = b->data + b->len;
+        const uint64_t *p = a + i, *end = a + i + m;
+        while (p < end) {
+            uint64_t any = end - p >= 8 ? p[0] | p[1] | p[2] | p[3] | p[4] | p[5] | p[6] | p[7] : 0x80;
+            if (any < 0x80) {
+                if (!any)
+                    memset(o, 0, 8);
+                else
+                    for (int q = 0; q < 8; q++)
+                        o[q] = (unsigned char)p[q];
+                o += 8, p += 8;
+                continue;
+            }
+            uint64_t v = *p++;
+            while (v >= 0x80) {
+                *o++ = (unsigned char)(v | 0x80);
+                v >>= 7;
+            }
+            *o++ = (unsigned char)v;
         }
-        blk[k++] = (unsigned char)v;
-        if (k > sizeof blk - 10 || i + 1 == n) {
-            bytebuf_append(b, blk, k);
-            k = 0;
-        }
+        b->len = (size_t)(o - b->data);
+        i += m;
     }
     return b->len - start;
 }
@@ -302,30 +345,69 @@ typedef struct sum_dec {
     int bad; /* more than 64 bits, or more values than expected */
 } sum_dec;
 
-/* acc: add each value into acc[n] (NULL: only check the structure). */
+/* acc: add each value into acc[n] (NULL: only check the structure). Eight
+ * bytes without a high bit between values are eight one-byte values (all
+ * zero: nothing to add). */
 static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t *acc)
 {
-    for (size_t i = 0; i < len && !d->bad; i++) {
+    const uint64_t high = 0x8080808080808080u;
+    /* locals: the stores into acc could alias d's fields */
+    uint64_t v = d->v, n = d->n, want = d->want;
+    unsigned shift = d->shift;
+    int bad = d->bad;
+    for (size_t i = 0; i < len && !bad; i++) {
+        if (!acc && shift <= 7 && len - i >= 8) {
+            /* checking only: count the bytes that end a value. With at most
+             * one byte of a value before these eight, every value ending in
+             * them has at most 9 bytes (63 bits: valid). */
+            uint64_t w;
+            memcpy(&w, p + i, 8); /* byte order does not matter: only counted */
+            uint64_t ends = ~w & high;
+            uint64_t k = ((ends >> 7) * 0x0101010101010101u) >> 56; /* how many */
+            if (ends && want - n >= k) {
+                int t = 0; /* bytes after the last end: the next value's first */
+                while (p[i + 7 - t] & 0x80)
+                    t++;
+                n += k;
+                shift = 7 * (unsigned)t;
+                v = 0;
+                i += 7;
+                continue;
+            }
+        }
+        if (shift == 0 && len - i >= 8 && want - n >= 8) {
+            uint64_t w;
+            memcpy(&w, p + i, 8);
+            if (!(w & high)) {
+                if (acc && w)
+                    for (int q = 0; q < 8; q++)
+                        acc[n + q] += p[i + q];
+                n += 8;
+                i += 7;
+                continue;
+            }
+        }
         unsigned c = p[i];
-        if (d->shift > 63 || (d->shift == 63 && (c & 0x7e))) {
-            d->bad = 1;
+        if (shift > 63 || (shift == 63 && (c & 0x7e))) {
+            bad = 1;
             break;
         }
-        d->v |= (uint64_t)(c & 0x7f) << d->shift;
+        v |= (uint64_t)(c & 0x7f) << shift;
         if (c & 0x80) {
-            d->shift += 7;
+            shift += 7;
             continue;
         }
-        if (d->n >= d->want) {
-            d->bad = 1;
+        if (n >= want) {
+            bad = 1;
             break;
         }
         if (acc)
-            acc[d->n] += d->v;
-        d->n++;
-        d->v = 0;
-        d->shift = 0;
+            acc[n] += v;
+        n++;
+        v = 0;
+        shift = 0;
     }
+    d->v = v, d->n = n, d->shift = shift, d->bad = bad;
 }
 
 static int sum_done(const sum_dec *d) { return !d->bad && d->shift == 0 && d->n == d->want; }

@@ -46,7 +46,7 @@ static void *fail(interp *I, int kind, size_t n, long count)
 /* The one allocation hook (rt_alloc_hook.alloc). Runs on any thread: the
  * budget is taken with a compare-and-swap before the block is allocated, so
  * concurrent engine workers can never overshoot lim.max_memory together. */
-static void *mem_hook(void *ud, void *p, size_t osize, size_t nsize)
+static void *mem_get(void *ud, void *p, size_t osize, size_t nsize, int zero)
 {
     interp *I = ud;
     if (nsize == 0) {
@@ -66,7 +66,7 @@ static void *mem_hook(void *ud, void *p, size_t osize, size_t nsize)
                 return fail(I, MEM_FAIL_LIMIT, nsize, count);
         } while (!atomic_compare_exchange_weak(&I->mem_used, &used, used + grow));
     }
-    void *q = realloc(p, nsize);
+    void *q = zero ? calloc(1, nsize) : realloc(p, nsize);
     if (!q) {
         atomic_fetch_sub(&I->mem_used, grow);
         return fail(I, MEM_FAIL_SYSTEM, nsize, 0);
@@ -74,6 +74,17 @@ static void *mem_hook(void *ud, void *p, size_t osize, size_t nsize)
     if (nsize < osize)
         atomic_fetch_sub(&I->mem_used, osize - nsize);
     return q;
+}
+
+static void *mem_hook(void *ud, void *p, size_t osize, size_t nsize)
+{
+    return mem_get(ud, p, osize, nsize, 0);
+}
+
+/* rt_alloc_hook.zalloc: a new zeroed block, counted like mem_hook's. */
+static void *mem_zhook(void *ud, size_t nsize)
+{
+    return mem_get(ud, NULL, 0, nsize, 1);
 }
 
 static double mem_limit(void *ud, rt_limit k, const char **flag)
@@ -314,6 +325,7 @@ void interp_init(interp *I)
     atomic_init(&I->mem_fail_n, 0);
     I->hook.alloc = mem_hook;
     I->hook.limit = mem_limit;
+    I->hook.zalloc = mem_zhook;
     I->hook.ud = I;
     rt_alloc_set_hook(&I->hook);
     I->lim.max_memory = (size_t)4096 << 20;

@@ -361,6 +361,7 @@ typedef struct tile_job {
     int tw, tiles_x, tile;
     image *im;
     const raster_opts *o;
+    size_t first; /* the first tile drawn (a shard draws its bands of tiles only) */
 } tile_job;
 
 typedef struct zsort {
@@ -437,6 +438,7 @@ static void tile_fn(void *ctx, size_t tile, int worker)
 {
     (void)worker;
     tile_job *J = ctx;
+    tile += J->first;
     int ts = J->tile, tx = (int)(tile % (size_t)J->tiles_x), ty = (int)(tile / (size_t)J->tiles_x);
     int x0 = tx * ts, y0 = ty * ts;
     int x1 = x0 + ts - 1 < J->im->w - 1 ? x0 + ts - 1 : J->im->w - 1;
@@ -494,13 +496,21 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         ts = 1024;
     int tiles_x = (im->w + ts - 1) / ts, tiles_y = (im->h + ts - 1) / ts;
     size_t ntiles = (size_t)tiles_x * (size_t)tiles_y;
+    /* Sharded (par.h): the chunks are the bands of tiles_x tiles, ts image
+     * rows each (the last one shorter); set-up and binning run in full in
+     * every shard, a merge only places the bands. */
+    par_part pp;
+    size_t band = (size_t)ts * (size_t)im->w * 4 * sizeof *im->px;
+    size_t all = (size_t)im->h * (size_t)im->w * 4 * sizeof *im->px;
+    rt_code rc = par_part_begin(&pp, run, "rasterize", (size_t)tiles_y, e);
+    if (rc || pp.mode == PAR_MERGE || pp.hi == pp.lo) /* nothing to draw here */
+        return rc ? rc : par_part_rows(&pp, im->px, all, band, e);
     rtri *t = rt_malloc(sizeof *t * (m->nt ? m->nt : 1));
     size_t *start = rt_calloc(ntiles + 1, sizeof(size_t));
     uint32_t *list = NULL;
     size_t *bins = NULL;
     chunk_extra *ex = NULL;
     size_t nch = 0;
-    rt_code rc = RT_OK;
     if (!t || !start || m->nt >= UINT32_MAX) {
         rc = rt_fail(e, RT_ENOMEM, "out of memory rasterising %zu triangles", m->nt);
         goto done;
@@ -588,11 +598,12 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         rt_fail(e, rc, "rasterising interrupted");
         goto done;
     }
-    tile_job T = {t, list, start, im->w, tiles_x, ts, im, o};
-    rc = par_for(run, "raster", ntiles, tile_fn, &T);
+    tile_job T = {t, list, start, im->w, tiles_x, ts, im, o, pp.lo * (size_t)tiles_x};
+    rc = par_for(run, "raster", (pp.hi - pp.lo) * (size_t)tiles_x, tile_fn, &T);
     if (rc)
         rt_fail(e, rc, "rasterising interrupted");
-    (void)tiles_y;
+    else
+        rc = par_part_rows(&pp, im->px, all, band, e);
 done:
     for (size_t c = 0; ex && c < nch; c++)
         rt_free(ex[c].t);

@@ -84,10 +84,24 @@ void *rt_mallocn(size_t count, size_t size)
 
 void *rt_calloc(size_t count, size_t size)
 {
-    void *p = rt_mallocn(count, size);
-    if (p)
-        memset(p, 0, count * size);
-    return p;
+    if (size && count > SIZE_MAX / size)
+        return NULL;
+    size_t n = count * size;
+    const rt_alloc_hook *h = atomic_load(&g_hook);
+    if (n > SIZE_MAX - sizeof(blkhdr) || (h && h->alloc && !h->zalloc)) {
+        void *p = rt_malloc(n);
+        if (p)
+            memset(p, 0, n);
+        return p;
+    }
+    /* zeroed by calloc (fresh pages from the kernel are not written) */
+    blkhdr *b = h ? h->zalloc(h->ud, n + sizeof(blkhdr)) : calloc(1, n + sizeof(blkhdr));
+    if (!b)
+        return NULL;
+    b->size = n;
+    if (n >= HUGE_HINT)
+        huge_hint(b, n + sizeof(blkhdr));
+    return b + 1;
 }
 
 void *rt_reallocn(void *p, size_t count, size_t size)

@@ -55,6 +55,11 @@ typedef struct rt_alloc_hook {
      * May be NULL: no limits. */
     double (*limit)(void *ud, rt_limit kind, const char **flag);
     void *ud;
+    /* May be NULL (alloc and a memset are used): allocate nsize zeroed
+     * bytes, accounted like alloc(ud, NULL, 0, nsize). calloc can hand out
+     * fresh pages from the kernel without writing them, so rt_calloc of a
+     * big buffer (an 8 MiB histogram) faults in only the pages later used. */
+    void *(*zalloc)(void *ud, size_t nsize);
 } rt_alloc_hook;
 
 /* Install h (kept by pointer; it must outlive its use) or, with NULL, go back

@@ -63,7 +63,7 @@ static inline double check_hook_limit(void *ud, rt_limit k, const char **flag)
 
 static inline void check_limits(double pixels, double voxels, double memory)
 {
-    static const rt_alloc_hook h = {check_hook_alloc, check_hook_limit, NULL};
+    static const rt_alloc_hook h = {check_hook_alloc, check_hook_limit, NULL, NULL};
     check_hs.pixels = pixels;
     check_hs.voxels = voxels;
     check_hs.memory = memory;
