@@ -20,6 +20,7 @@ typedef struct hist2 {
     double lo[2], hi[2];
     uint64_t *count; /* w * h */
     float *csum;     /* w * h * 3, or NULL */
+    void *mem_count, *mem_csum; /* the blocks they lie in (hist.c aligns big arrays) */
 } hist2;
 
 rt_code hist2_init(hist2 *hs, int w, int h, const double lo[2], const double hi[2], int with_colour,
