@@ -36,7 +36,7 @@ typedef struct sysdata {
     uint32_t start_state, start_map;
     double x0[3];
     double *mc;                      /* n colour coordinates */
-    uint32_t pal[CHAOS_PALETTE][3];  /* ramp, 16-bit fixed point */
+    uint32_t pal[CHAOS_PALETTE][4];  /* 1 (the hit) and the ramp's r, g, b in 16-bit fixed point */
     float palf[CHAOS_PALETTE][4];    /* ramp, float */
 } sysdata;
 
@@ -155,10 +155,11 @@ static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, 
     const ramp *rp = o->ramp ? o->ramp : &grey;
     for (int i = 0; i < CHAOS_PALETTE; i++) {
         ramp_eval(rp, (double)i / (CHAOS_PALETTE - 1), d->palf[i]);
+        d->pal[i][0] = 1;
         for (int ch = 0; ch < 3; ch++) {
             double v = d->palf[i][ch];
             v = v < 0 ? 0 : v > 1 ? 1 : v;
-            d->pal[i][ch] = (uint32_t)(v * 65535.0 + 0.5);
+            d->pal[i][ch + 1] = (uint32_t)(v * 65535.0 + 0.5);
         }
     }
     return d;
@@ -261,6 +262,7 @@ INLINE uint32_t orbit_colour(orbit *ob, const sysdata *d, const int colour)
 
 typedef struct worker {
     uint32_t *cnt;
+    void *mem;       /* the block cnt lies in (hist_zeroed), NULL if cnt is not ours */
     uint64_t *carry; /* lazily allocated on the first 32-bit wrap */
     double *zb;      /* projection: depth per pixel */
     uint32_t *tag;   /* projection: palette index of the nearest point */
@@ -339,25 +341,46 @@ INLINE size_t cell_of(double f)
 
 #define RING 32 /* pending increments: prefetch this many points ahead */
 
-/* One coloured hit into cell b (b = nbins: the outside cell, ignored). */
-INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t b, uint32_t pc,
-                     size_t nbins)
+/* A colour cell's 65536th hit (cold): the cell is added into the 64-bit
+ * side sums and cleared. */
+COLD void flush_cell(worker *w, const uint32_t *cnt, uint32_t *cell, size_t nbins)
 {
-    uint32_t *cell = cnt + 4 * b;
-    cell[1] += pal[pc][0];
-    cell[2] += pal[pc][1];
-    cell[3] += pal[pc][2];
-    if (!(++cell[0] & 0xffffu) && b < nbins) {
-        if (!w->carry)
-            w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
-        if (w->carry) {
-            for (int q = 0; q < 4; q++)
-                w->carry[4 * b + q] += cell[q];
-            cell[0] = cell[1] = cell[2] = cell[3] = 0;
-        } else {
-            w->oom = 1;
-        }
+    if (!w->carry)
+        w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
+    if (!w->carry) {
+        w->oom = 1;
+        return;
     }
+    size_t b = (size_t)(cell - cnt);
+    for (int q = 0; q < 4; q++)
+        w->carry[b + q] += cell[q];
+    cell[0] = cell[1] = cell[2] = cell[3] = 0;
+}
+
+#if defined(__GNUC__)
+typedef uint32_t cell4 __attribute__((vector_size(16)));
+#endif
+
+/* One coloured hit: the palette entry (1, r, g, b) added to the cell
+ * (count, r, g, b) in one 16-byte add; out is the outside cell (never
+ * flushed, never read). */
+INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint32_t *pe,
+                     const uint32_t *out, size_t nbins)
+{
+#if defined(__GNUC__)
+    cell4 a, h;
+    memcpy(&a, cell, sizeof a);
+    memcpy(&h, pe, sizeof h);
+    a += h;
+    memcpy(cell, &a, sizeof a);
+    uint32_t n = a[0];
+#else
+    for (int q = 0; q < 4; q++)
+        cell[q] += pe[q];
+    uint32_t n = cell[0];
+#endif
+    if (!(n & 0xffffu) && cell != out)
+        flush_cell(w, cnt, cell, nbins);
 }
 
 /* Both 2-D loops prefetch the hit's bin and add the hit RING points later
@@ -390,17 +413,19 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const uint32_t n = (uint32_t)d->n;
     const uint32_t *const thr = d->thr, *const sel = d->sel;
     const double *const M = d->m, *const mc = d->mc;
-    const uint32_t(*const pal)[3] = d->pal;
-    uint32_t *const cnt = w->cnt;
+    const uint32_t(*const pal)[4] = d->pal;
+    const size_t nbins = j->nbins;
+    uint32_t *const cnt = w->cnt, *const out = w->cnt + 4 * nbins; /* colour: the outside cell */
     uint64_t *const cnt64 = j->direct;
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, c = ob.c;
     uint64_t inside = 0;
     size_t ring[RING];
-    uint32_t ringc[RING];
+    uint32_t *ringp[RING];       /* colour: the cells, */
+    const uint32_t *ringe[RING]; /* and their hits' palette entries */
     for (int q = 0; q < RING; q++)
-        ring[q] = j->nbins, ringc[q] = 0;
+        ring[q] = nbins, ringp[q] = out, ringe[q] = pal[0];
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
         step_map2(M + 6 * (size_t)k, &x, &y);
@@ -435,20 +460,20 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         }
         /* colour: prefetch this hit's cell, add the hit RING points back
          * (outside points go to the extra cell nbins) */
-        size_t b = j->nbins;
+        uint32_t *cell = out;
         if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-            b = cell_of(fy) * hw + cell_of(fx);
+            cell = cnt + 4 * (cell_of(fy) * hw + cell_of(fx));
             inside++;
         }
-        PREFETCHW(cnt + 4 * b);
+        PREFETCHW(cell);
         size_t slot = (size_t)(i % RING);
-        add_cell(w, cnt, pal, ring[slot], ringc[slot], j->nbins);
-        ring[slot] = b;
-        ringc[slot] = pc;
+        add_cell(w, cnt, ringp[slot], ringe[slot], out, nbins);
+        ringp[slot] = cell;
+        ringe[slot] = pal[pc];
     }
     for (int q = 0; q < RING; q++) {
         if (colour != CHAOS_COLOUR_NONE)
-            add_cell(w, cnt, pal, ring[q], ringc[q], j->nbins);
+            add_cell(w, cnt, ringp[q], ringe[q], out, nbins);
         else if (ring[q] != j->nbins && wide)
             cnt64[ring[q]]++;
         else if (ring[q] != j->nbins)
@@ -626,7 +651,7 @@ static void free_workers(worker *w, int nw)
     if (!w)
         return;
     for (int i = 0; i < nw; i++) {
-        rt_free(w[i].cnt);
+        rt_free(w[i].mem);
         rt_free(w[i].carry);
         rt_free(w[i].zb);
         rt_free(w[i].tag);
@@ -793,7 +818,8 @@ static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int
     int bad = !w;
     for (int i = 0; !bad && i < nw; i++) {
         /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
-        if (counts && !(counts == 2 && i == 0) && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+        if (counts && !(counts == 2 && i == 0) &&
+            !(w[i].cnt = hist_zeroed(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt, &w[i].mem)))
             bad = 1;
         if (zbuf) {
             w[i].zb = rt_malloc(sizeof *w[i].zb * nbins);
@@ -960,7 +986,11 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
             }
             uint64_t t[4] = {0, 0, 0, 0};
             for (int i = 0; i < nw; i++)
-                for (int q = 0; q < 4; q++)
+                t[0] += j.w[i].cnt[4 * b] + (j.w[i].carry ? j.w[i].carry[4 * b] : 0);
+            if (!t[0]) /* no hits, so no colour: nothing to add (the sums are >= 0, never -0) */
+                continue;
+            for (int i = 0; i < nw; i++)
+                for (int q = 1; q < 4; q++)
                     t[q] += j.w[i].cnt[4 * b + q] + (j.w[i].carry ? j.w[i].carry[4 * b + q] : 0);
             hs->count[b] += t[0];
             for (int ch = 0; ch < 3; ch++)

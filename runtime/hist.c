@@ -14,7 +14,7 @@
  * the memory budget. */
 #define HUGE_ALIGN ((size_t)2 << 20)
 
-static void *zeroed(size_t n, size_t size, void **mem)
+void *hist_zeroed(size_t n, size_t size, void **mem)
 {
     size_t bytes = rt_mul_size(n, size);
     if (bytes < 2 * HUGE_ALIGN || bytes > SIZE_MAX - HUGE_ALIGN)
@@ -37,9 +37,9 @@ rt_code hist2_init(hist2 *hs, int w, int h, const double lo[2], const double hi[
     if (w < 1 || h < 1)
         return rt_fail(e, RT_EINVAL, "histogram size %d×%d is empty", w, h);
     size_t n = rt_mul_size((size_t)w, (size_t)h);
-    hs->count = zeroed(n, sizeof *hs->count, &hs->mem_count);
+    hs->count = hist_zeroed(n, sizeof *hs->count, &hs->mem_count);
     if (with_colour)
-        hs->csum = zeroed(rt_mul_size(n, 3), sizeof *hs->csum, &hs->mem_csum);
+        hs->csum = hist_zeroed(rt_mul_size(n, 3), sizeof *hs->csum, &hs->mem_csum);
     if (!hs->count || (with_colour && !hs->csum)) {
         hist2_free(hs);
         return rt_fail(e, RT_ENOMEM, "out of memory for a %d×%d histogram", w, h);

@@ -411,6 +411,15 @@ static void test_threads(void)
     CHECK(hh.count[4] == 300000 && hh.csum[12] == 300000.0f && hh.csum[14] == 300000.0f,
           "centre bin %llu hits, colour %g", (unsigned long long)hh.count[4], hh.csum[12]);
     hist2_free(&hh);
+    /* exactly 2 × 65536 hits: the cell was just flushed (its own count is 0,
+     * everything is in the side sums) and must still be merged */
+    o1.points = 2 * 65536;
+    o1.burn = -1;
+    CHECK(hist2_init(&hh, 3, 3, lo1, hi1, 1, &e) == RT_OK, "hist");
+    CHECK(chaos_hist2(&s1, &o1, &hh, NULL, NULL, &e) == RT_OK, "chaos");
+    CHECK(hh.count[4] == 131072 && hh.csum[12] == 131072.0f && hh.csum[13] == 131072.0f,
+          "flushed centre bin %llu hits, colour %g", (unsigned long long)hh.count[4], hh.csum[12]);
+    hist2_free(&hh);
     ifs_free(&f1);
 }
 
