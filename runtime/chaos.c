@@ -18,7 +18,9 @@
 #if defined(__GNUC__)
 #define INLINE static inline __attribute__((always_inline))
 #define PREFETCHW(p) __builtin_prefetch((p), 1, 0)
+#define COLD static __attribute__((noinline, cold))
 #else
+#define COLD static
 #define INLINE static inline
 #define PREFETCHW(p) ((void)(p))
 #endif
@@ -34,7 +36,7 @@ typedef struct sysdata {
     uint32_t start_state, start_map;
     double x0[3];
     double *mc;                      /* n colour coordinates */
-    uint32_t pal[CHAOS_PALETTE][3];  /* ramp, 16-bit fixed point */
+    uint32_t pal[CHAOS_PALETTE][4];  /* 1 (the hit) and the ramp's r, g, b in 16-bit fixed point */
     float palf[CHAOS_PALETTE][4];    /* ramp, float */
 } sysdata;
 
@@ -153,10 +155,11 @@ static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, 
     const ramp *rp = o->ramp ? o->ramp : &grey;
     for (int i = 0; i < CHAOS_PALETTE; i++) {
         ramp_eval(rp, (double)i / (CHAOS_PALETTE - 1), d->palf[i]);
+        d->pal[i][0] = 1;
         for (int ch = 0; ch < 3; ch++) {
             double v = d->palf[i][ch];
             v = v < 0 ? 0 : v > 1 ? 1 : v;
-            d->pal[i][ch] = (uint32_t)(v * 65535.0 + 0.5);
+            d->pal[i][ch + 1] = (uint32_t)(v * 65535.0 + 0.5);
         }
     }
     return d;
@@ -233,6 +236,18 @@ INLINE void orbit_step3(orbit *ob, const sysdata *d, const int kind)
     step_map3(d->m + 12 * (size_t)k, &ob->x, &ob->y, &ob->z);
 }
 
+/* One step of any system (kind and dimension tested at run time): for the
+ * loops that are not hot. */
+INLINE void orbit_step_any(orbit *ob, const sysdata *d)
+{
+    if (d->dim == 2)
+        d->kind == KIND_IFS ? orbit_step2(ob, d, KIND_IFS)
+        : d->kind == KIND_R1 ? orbit_step2(ob, d, KIND_R1) : orbit_step2(ob, d, KIND_R2);
+    else
+        d->kind == KIND_IFS ? orbit_step3(ob, d, KIND_IFS)
+        : d->kind == KIND_R1 ? orbit_step3(ob, d, KIND_R1) : orbit_step3(ob, d, KIND_R2);
+}
+
 /* Palette index of the current hit's colour. */
 INLINE uint32_t orbit_colour(orbit *ob, const sysdata *d, const int colour)
 {
@@ -247,10 +262,12 @@ INLINE uint32_t orbit_colour(orbit *ob, const sysdata *d, const int colour)
 
 typedef struct worker {
     uint32_t *cnt;
+    void *mem;       /* the block cnt lies in (hist_zeroed), NULL if cnt is not ours */
     uint64_t *carry; /* lazily allocated on the first 32-bit wrap */
     double *zb;      /* projection: depth per pixel */
     uint32_t *tag;   /* projection: palette index of the nearest point */
     uint64_t inside, plotted;
+    uint64_t outwrap; /* wraps of a loop's 32-bit outside cell (bump_at) */
     int oom;
 } worker;
 
@@ -283,41 +300,87 @@ static void chunk_range(const job *j, size_t chunk, uint64_t *count)
     *count = left < j->chunk ? left : j->chunk;
 }
 
+/* The 32-bit wrap of a count (cold): one more 2^32 in the 64-bit side
+ * array, or, for the outside cell (p == out, not a bin), in w->outwrap. */
+COLD void carry_wrap(worker *w, const uint32_t *cnt, const uint32_t *p, const uint32_t *out, size_t nbins)
+{
+    if (p == out) {
+        w->outwrap++;
+        return;
+    }
+    if (!w->carry)
+        w->carry = rt_calloc(nbins + 1, sizeof *w->carry);
+    if (w->carry)
+        w->carry[p - cnt]++;
+    else
+        w->oom = 1;
+}
+
 INLINE void bump(worker *w, uint32_t *cnt, size_t b, size_t nbins)
 {
-    if (!++cnt[b]) { /* exact carry on 32-bit wrap-around */
-        if (!w->carry)
-            w->carry = rt_calloc(nbins + 1, sizeof *w->carry);
-        if (w->carry)
-            w->carry[b]++;
-        else
-            w->oom = 1;
-    }
+    if (!++cnt[b]) /* exact carry on 32-bit wrap-around */
+        carry_wrap(w, cnt, cnt + b, NULL, nbins);
+}
+
+/* A pending hit by address: the bin, or the worker's outside cell *out (the
+ * ring needs no test for outside points, and *out counts them). */
+INLINE void bump_at(worker *w, uint32_t *cnt, uint32_t *p, const uint32_t *out, size_t nbins)
+{
+    if (!++*p)
+        carry_wrap(w, cnt, p, out, nbins);
 }
 
 /* ---------- 2-D histogram ---------- */
 
+/* The cell of a coordinate f already tested to be in [0, n), n an int: the
+ * same value as (size_t)(int)f, in one 64-bit conversion (no sign extension). */
+INLINE size_t cell_of(double f)
+{
+    return (size_t)(int64_t)f;
+}
+
 #define RING 32 /* pending increments: prefetch this many points ahead */
 
-/* One coloured hit into cell b (b = nbins: the outside cell, ignored). */
-INLINE void add_cell(worker *w, uint32_t *cnt, const uint32_t (*pal)[3], size_t b, uint32_t pc,
-                     size_t nbins)
+/* A colour cell's 65536th hit (cold): the cell is added into the 64-bit
+ * side sums and cleared. */
+COLD void flush_cell(worker *w, const uint32_t *cnt, uint32_t *cell, size_t nbins)
 {
-    uint32_t *cell = cnt + 4 * b;
-    cell[1] += pal[pc][0];
-    cell[2] += pal[pc][1];
-    cell[3] += pal[pc][2];
-    if (!(++cell[0] & 0xffffu) && b < nbins) {
-        if (!w->carry)
-            w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
-        if (w->carry) {
-            for (int q = 0; q < 4; q++)
-                w->carry[4 * b + q] += cell[q];
-            cell[0] = cell[1] = cell[2] = cell[3] = 0;
-        } else {
-            w->oom = 1;
-        }
+    if (!w->carry)
+        w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
+    if (!w->carry) {
+        w->oom = 1;
+        return;
     }
+    size_t b = (size_t)(cell - cnt);
+    for (int q = 0; q < 4; q++)
+        w->carry[b + q] += cell[q];
+    cell[0] = cell[1] = cell[2] = cell[3] = 0;
+}
+
+#if defined(__GNUC__)
+typedef uint32_t cell4 __attribute__((vector_size(16)));
+#endif
+
+/* One coloured hit: the palette entry (1, r, g, b) added to the cell
+ * (count, r, g, b) in one 16-byte add; out is the outside cell (never
+ * flushed, never read). */
+INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint32_t *pe,
+                     const uint32_t *out, size_t nbins)
+{
+#if defined(__GNUC__)
+    cell4 a, h;
+    memcpy(&a, cell, sizeof a);
+    memcpy(&h, pe, sizeof h);
+    a += h;
+    memcpy(cell, &a, sizeof a);
+    uint32_t n = a[0];
+#else
+    for (int q = 0; q < 4; q++)
+        cell[q] += pe[q];
+    uint32_t n = cell[0];
+#endif
+    if (!(n & 0xffffu) && cell != out)
+        flush_cell(w, cnt, cell, nbins);
 }
 
 /* Both 2-D loops prefetch the hit's bin and add the hit RING points later
@@ -350,17 +413,19 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const uint32_t n = (uint32_t)d->n;
     const uint32_t *const thr = d->thr, *const sel = d->sel;
     const double *const M = d->m, *const mc = d->mc;
-    const uint32_t(*const pal)[3] = d->pal;
-    uint32_t *const cnt = w->cnt;
+    const uint32_t(*const pal)[4] = d->pal;
+    const size_t nbins = j->nbins;
+    uint32_t *const cnt = w->cnt, *const out = w->cnt + 4 * nbins; /* colour: the outside cell */
     uint64_t *const cnt64 = j->direct;
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, c = ob.c;
     uint64_t inside = 0;
     size_t ring[RING];
-    uint32_t ringc[RING];
+    uint32_t *ringp[RING];       /* colour: the cells, */
+    const uint32_t *ringe[RING]; /* and their hits' palette entries */
     for (int q = 0; q < RING; q++)
-        ring[q] = j->nbins, ringc[q] = 0;
+        ring[q] = nbins, ringp[q] = out, ringe[q] = pal[0];
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
         step_map2(M + 6 * (size_t)k, &x, &y);
@@ -377,7 +442,7 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
              * (outside: b = nbins, one past the end, not counted) */
             size_t b = j->nbins;
             if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-                b = (size_t)(int)fy * hw + (size_t)(int)fx;
+                b = cell_of(fy) * hw + cell_of(fx);
                 inside++;
             }
             size_t slot = (size_t)(i % RING), old = ring[slot];
@@ -395,20 +460,20 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
         }
         /* colour: prefetch this hit's cell, add the hit RING points back
          * (outside points go to the extra cell nbins) */
-        size_t b = j->nbins;
+        uint32_t *cell = out;
         if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
-            b = (size_t)(int)fy * hw + (size_t)(int)fx;
+            cell = cnt + 4 * (cell_of(fy) * hw + cell_of(fx));
             inside++;
         }
-        PREFETCHW(cnt + 4 * b);
+        PREFETCHW(cell);
         size_t slot = (size_t)(i % RING);
-        add_cell(w, cnt, pal, ring[slot], ringc[slot], j->nbins);
-        ring[slot] = b;
-        ringc[slot] = pc;
+        add_cell(w, cnt, ringp[slot], ringe[slot], out, nbins);
+        ringp[slot] = cell;
+        ringe[slot] = pal[pc];
     }
     for (int q = 0; q < RING; q++) {
         if (colour != CHAOS_COLOUR_NONE)
-            add_cell(w, cnt, pal, ring[q], ringc[q], j->nbins);
+            add_cell(w, cnt, ringp[q], ringe[q], out, nbins);
         else if (ring[q] != j->nbins && wide)
             cnt64[ring[q]]++;
         else if (ring[q] != j->nbins)
@@ -463,7 +528,7 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind, const
     const double sx = j->s3[0], sy = j->s3[1], sz = j->s3[2];
     const double fx_n = j->nx, fy_n = j->ny, fz_n = j->nz;
     const size_t nx = (size_t)j->nx, nxy = (size_t)j->nx * (size_t)j->ny;
-    const size_t trash = j->nbins, nbins = j->nbins; /* outside points: an index past the end */
+    const size_t nbins = j->nbins;
     const uint32_t n = (uint32_t)d->n;
     const uint32_t *const thr = d->thr, *const sel = d->sel;
     const double *const M = d->m;
@@ -471,10 +536,12 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind, const
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, z = ob.z;
-    size_t ring[RING];
+    /* the ring holds addresses; outside points (and the empty slots at the
+     * start, RING of them) count in out, so inside = count - (out - RING) */
+    uint32_t out = 0;
+    uint32_t *ring[RING];
     for (int i = 0; i < RING; i++)
-        ring[i] = trash;
-    uint64_t inside = 0;
+        ring[i] = &out;
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
         if (diag) {
@@ -484,24 +551,20 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind, const
             step_map3(M + 12 * (size_t)k, &x, &y, &z);
         }
         double fx = (x - lx) * sx, fy = (y - ly) * sy, fz = (z - lz) * sz;
-        int in = fx >= 0 && fx < fx_n && fy >= 0 && fy < fy_n && fz >= 0 && fz < fz_n;
-        size_t b = trash;
-        if (in) {
-            b = (size_t)(int)fx + nx * (size_t)(int)fy + nxy * (size_t)(int)fz;
-            inside++;
-        }
-        /* prefetch this point's voxel, count the one RING points back
-         * (outside points: b = nbins, one past the counts, not counted) */
-        PREFETCHW(&cnt[b]);
-        size_t slot = (size_t)(i % RING), old = ring[slot];
-        if (old != trash)
-            bump(w, cnt, old, nbins);
-        ring[slot] = b;
+        uint32_t *p = &out;
+        if (fx >= 0 && fx < fx_n && fy >= 0 && fy < fy_n && fz >= 0 && fz < fz_n)
+            p = cnt + (cell_of(fx) + nx * cell_of(fy) + nxy * cell_of(fz));
+        /* prefetch this point's voxel, count the one RING points back */
+        PREFETCHW(p);
+        size_t slot = (size_t)(i % RING);
+        bump_at(w, cnt, ring[slot], &out, nbins);
+        ring[slot] = p;
     }
     for (int i = 0; i < RING; i++)
-        if (ring[i] != trash)
-            bump(w, cnt, ring[i], nbins);
-    w->inside += inside;
+        bump_at(w, cnt, ring[i], &out, nbins);
+    uint64_t outside = ((uint64_t)out | w->outwrap << 32) - RING;
+    w->outwrap = 0;
+    w->inside += count - outside;
     w->plotted += count;
 }
 
@@ -537,14 +600,9 @@ static void points_chunk(void *ctx, size_t chunk, int wid)
     chunk_range(j, chunk, &count);
     orbit ob;
     orbit_start(&ob, d, j->o->seed, chunk);
-    int kind = d->kind, colour = j->o->colour;
+    int colour = j->o->colour;
     for (uint64_t i = 0; i < j->burn + count; i++) {
-        if (d->dim == 2)
-            kind == KIND_IFS ? orbit_step2(&ob, d, KIND_IFS)
-            : kind == KIND_R1 ? orbit_step2(&ob, d, KIND_R1) : orbit_step2(&ob, d, KIND_R2);
-        else
-            kind == KIND_IFS ? orbit_step3(&ob, d, KIND_IFS)
-            : kind == KIND_R1 ? orbit_step3(&ob, d, KIND_R1) : orbit_step3(&ob, d, KIND_R2);
+        orbit_step_any(&ob, d);
         uint32_t pc = colour == CHAOS_COLOUR_BLEND ? orbit_colour(&ob, d, CHAOS_COLOUR_BLEND)
                                                    : orbit_colour(&ob, d, CHAOS_COLOUR_LAST);
         if (i < j->burn)
@@ -593,7 +651,7 @@ static void free_workers(worker *w, int nw)
     if (!w)
         return;
     for (int i = 0; i < nw; i++) {
-        rt_free(w[i].cnt);
+        rt_free(w[i].mem);
         rt_free(w[i].carry);
         rt_free(w[i].zb);
         rt_free(w[i].tag);
@@ -620,36 +678,63 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The k-th smallest of a[0..n-1] (what a[k] is after sorting; a is
- * reordered), by quickselect with a three-way partition, so runs of equal
- * values (a stem on one line) cost one pass. Finite values only. */
-static double select_kth(double *a, size_t n, size_t k)
+/* Offer v to a max-heap h of at most k values (n of them now): it keeps
+ * the k smallest values offered, the k-th smallest on top. */
+static void heap_offer(double *h, size_t n, size_t k, double v)
 {
-    size_t lo = 0, hi = n; /* the answer's index lies in [lo, hi) */
-    while (hi - lo > 1) {
-        double x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
-        double piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
-        size_t lt = lo, i = lo, gt = hi; /* [lo,lt) < piv, [lt,i) == piv, [gt,hi) > piv */
-        while (i < gt) {
-            double v = a[i];
-            if (v < piv) {
-                a[i++] = a[lt];
-                a[lt++] = v;
-            } else if (v > piv) {
-                a[i] = a[--gt];
-                a[gt] = v;
-            } else {
-                i++;
-            }
-        }
-        if (k < lt)
-            hi = lt;
-        else if (k >= gt)
-            lo = gt;
-        else
-            return piv;
+    size_t i;
+    if (n < k) {
+        for (i = n; i > 0 && h[(i - 1) / 2] < v; i = (i - 1) / 2)
+            h[i] = h[(i - 1) / 2];
+        h[i] = v;
+        return;
     }
-    return a[lo];
+    if (!(v < h[0]))
+        return;
+    for (i = 0;;) {
+        size_t c = 2 * i + 1;
+        if (c >= k)
+            break;
+        if (c + 1 < k && h[c + 1] > h[c])
+            c++;
+        if (!(h[c] > v))
+            break;
+        h[i] = h[c];
+        i = c;
+    }
+    h[i] = v;
+}
+
+enum { FIT_TAIL = CHAOS_FIT_POINTS / 1000 + 1 };
+
+/* The pre-pass without storing its points: per axis the (cut+1)-th smallest
+ * and largest coordinate (as floats, what a stored point cloud holds) in
+ * two heaps of cut+1 values — the same order statistics a selection over
+ * all the points gives (chaos.h). 0 if a coordinate is not finite (the
+ * caller then sorts the stored points). */
+static int fit_tails(const job *j, size_t cut, double *lo, double *hi)
+{
+    const sysdata *d = j->d;
+    double hl[3][FIT_TAIL], hh[3][FIT_TAIL]; /* hh holds the negated values */
+    size_t k = cut + 1;
+    orbit ob;
+    orbit_start(&ob, d, j->o->seed, 0);
+    for (uint64_t i = 0; i < j->burn; i++)
+        orbit_step_any(&ob, d);
+    for (size_t i = 0; i < j->points; i++) {
+        orbit_step_any(&ob, d);
+        float v[3] = {(float)ob.x, (float)ob.y, (float)ob.z};
+        for (int a = 0; a < d->dim; a++) {
+            double va = v[a];
+            if (!isfinite(va))
+                return 0;
+            heap_offer(hl[a], i, k, va);
+            heap_offer(hh[a], i, k, -va);
+        }
+    }
+    for (int a = 0; a < d->dim; a++)
+        lo[a] = hl[a][0], hi[a] = -hh[a][0];
+    return 1;
 }
 
 rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
@@ -666,32 +751,29 @@ rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double 
     fo.seed = rng_hash3(o->seed, 1ull << 63, 0, 0); /* independent of the chunks' streams */
     job j;
     job_init(&j, d, &fo);
-    j.pos = rt_malloc(sizeof *j.pos * 3 * np);
-    double *ax = rt_malloc(sizeof *ax * np);
-    if (!j.pos || !ax) {
-        rt_free(j.pos);
-        rt_free(ax);
-        sys_free(d);
-        return rt_fail(e, RT_ENOMEM, "out of memory fitting a window");
-    }
-    points_chunk(&j, 0, 0);
     int dim = d->dim;
-    double ext[3];
-    for (int a = 0; a < dim; a++) {
-        for (size_t i = 0; i < np; i++)
-            ax[i] = j.pos[3 * i + a];
-        size_t cut = np / 1000; /* 0.1 % each side */
-        int finite = 1;
-        for (size_t i = 0; i < np; i++)
-            finite &= isfinite(ax[i]) != 0;
-        if (finite) { /* the two quantiles without sorting everything */
-            lo[a] = select_kth(ax, np, cut);
-            hi[a] = select_kth(ax, np, np - 1 - cut);
-        } else {
+    size_t cut = np / 1000; /* 0.1 % each side */
+    double *ax = NULL;
+    if (!fit_tails(&j, cut, lo, hi)) { /* a coordinate overflowed: sort the stored points */
+        j.pos = rt_malloc(sizeof *j.pos * 3 * np);
+        ax = rt_malloc(sizeof *ax * np);
+        if (!j.pos || !ax) {
+            rt_free(j.pos);
+            rt_free(ax);
+            sys_free(d);
+            return rt_fail(e, RT_ENOMEM, "out of memory fitting a window");
+        }
+        points_chunk(&j, 0, 0);
+        for (int a = 0; a < dim; a++) {
+            for (size_t i = 0; i < np; i++)
+                ax[i] = j.pos[3 * i + a];
             qsort(ax, np, sizeof *ax, cmp_double);
             lo[a] = ax[cut];
             hi[a] = ax[np - 1 - cut];
         }
+    }
+    double ext[3];
+    for (int a = 0; a < dim; a++) {
         if (!isfinite(lo[a]) || !isfinite(hi[a]))
             lo[a] = -1, hi[a] = 1;
         ext[a] = hi[a] - lo[a];
@@ -736,7 +818,8 @@ static rt_code alloc_workers(worker **out, int nw, size_t nbins, int counts, int
     int bad = !w;
     for (int i = 0; !bad && i < nw; i++) {
         /* with colour: 4 uint32 per bin (count, r, g, b), see hist_chunk */
-        if (counts && !(counts == 2 && i == 0) && !(w[i].cnt = rt_calloc(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt)))
+        if (counts && !(counts == 2 && i == 0) &&
+            !(w[i].cnt = hist_zeroed(colour ? rt_mul_size(nbins + 1, 4) : nbins + 1, sizeof *w[i].cnt, &w[i].mem)))
             bad = 1;
         if (zbuf) {
             w[i].zb = rt_malloc(sizeof *w[i].zb * nbins);
@@ -763,6 +846,23 @@ static uint64_t total_count(const worker *w, int nw, size_t b)
         if (w[i].cnt)
             t += (uint64_t)w[i].cnt[b] + (w[i].carry ? w[i].carry[b] << 32 : 0);
     return t;
+}
+
+/* v[b] = c[b] / den in place (c and v are the same memory): blocks of 16
+ * read before they are written, so the compiler may vectorise the block. */
+static void counts_to_float(const uint32_t *c, float *v, size_t n, double den)
+{
+    size_t b = 0;
+    for (; b + 16 <= n; b += 16) {
+        uint32_t t[16];
+        memcpy(t, c + b, sizeof t);
+        for (int q = 0; q < 16; q++)
+            v[b + q] = (float)((double)t[q] / den);
+    }
+    for (; b < n; b++) {
+        uint32_t t = c[b];
+        v[b] = (float)((double)t / den);
+    }
 }
 
 static void fill_stats(chaos_stats *st, const worker *w, int nw)
@@ -886,7 +986,11 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
             }
             uint64_t t[4] = {0, 0, 0, 0};
             for (int i = 0; i < nw; i++)
-                for (int q = 0; q < 4; q++)
+                t[0] += j.w[i].cnt[4 * b] + (j.w[i].carry ? j.w[i].carry[4 * b] : 0);
+            if (!t[0]) /* no hits, so no colour: nothing to add (the sums are >= 0, never -0) */
+                continue;
+            for (int i = 0; i < nw; i++)
+                for (int q = 1; q < 4; q++)
                     t[q] += j.w[i].cnt[4 * b + q] + (j.w[i].carry ? j.w[i].carry[4 * b + q] : 0);
             hs->count[b] += t[0];
             for (int ch = 0; ch < 3; ch++)
@@ -957,23 +1061,27 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
         }
         rt_free(tot);
     } else if (!rc) {
-        uint64_t mx = 0;
-        for (size_t b = 0; b < j.nbins; b++) {
-            uint64_t t = total_count(j.w, nw, b);
-            if (t > mx)
-                mx = t;
-        }
         fill_stats(st, j.w, nw);
         uint64_t plotted = 0;
         for (int i = 0; i < nw; i++)
             plotted += j.w[i].plotted;
+        int alone = nw == 1 && !j.w[0].carry; /* the counts are the uint32 in vol->v */
+        uint64_t mx = 0;
+        for (size_t b = 0; norm == CHAOS_NORM_MAX && b < j.nbins; b++) {
+            uint64_t t = alone ? j.w[0].cnt[b] : total_count(j.w, nw, b);
+            if (t > mx)
+                mx = t;
+        }
         double den = norm == CHAOS_NORM_TOTAL ? (double)plotted : norm == CHAOS_NORM_MAX ? (double)mx : 1;
         if (!(den > 0))
             den = 1;
-        for (size_t b = 0; b < j.nbins; b++) {
-            uint64_t t = total_count(j.w, nw, b); /* read the count before the float replaces it */
-            vol->v[b] = (float)((double)t / den);
-        }
+        if (alone)
+            counts_to_float(j.w[0].cnt, vol->v, j.nbins, den);
+        else
+            for (size_t b = 0; b < j.nbins; b++) {
+                uint64_t t = total_count(j.w, nw, b); /* read the count before the float replaces it */
+                vol->v[b] = (float)((double)t / den);
+            }
     }
     j.w[0].cnt = NULL; /* the volume's memory */
     free_workers(j.w, nw);

@@ -11,6 +11,7 @@
 #ifndef HIST_H
 #define HIST_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "rt.h"
@@ -20,10 +21,16 @@ typedef struct hist2 {
     double lo[2], hi[2];
     uint64_t *count; /* w * h */
     float *csum;     /* w * h * 3, or NULL */
+    void *mem_count, *mem_csum; /* the blocks they lie in (hist.c aligns big arrays) */
 } hist2;
 
 rt_code hist2_init(hist2 *hs, int w, int h, const double lo[2], const double hi[2], int with_colour,
                    rt_error *e);
 void hist2_free(hist2 *hs);
+
+/* n × size zero bytes for a big accumulator; arrays of 4 MiB and more start
+ * on a 2 MiB boundary inside a larger block (all in huge pages, see
+ * hist.c). *mem gets the block to rt_free; NULL when out of memory. */
+void *hist_zeroed(size_t n, size_t size, void **mem);
 
 #endif

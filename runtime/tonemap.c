@@ -3,6 +3,7 @@
 #include "tonemap.h"
 
 #include <math.h>
+#include <string.h>
 
 /* The count of image pixel (x, y): the sum of its k×k bins. */
 static uint64_t pixel_count(const hist2 *hs, int k, int x, int y)
@@ -54,24 +55,50 @@ rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_erro
     int k = hs->w / im->w;
     /* No copy of the histogram: pass 1 finds M, pass 2 sums each pixel's
      * k×k bins again (integer sums, and the colour sums in the same order,
-     * so the result is the same as summing once into a buffer). */
+     * so the result is the same as summing once into a buffer). Without
+     * supersampling (k = 1) both passes run straight along the bins. */
+    size_t npx = (size_t)im->w * (size_t)im->h;
     uint64_t mx = 0;
-    for (int y = 0; y < im->h; y++)
-        for (int x = 0; x < im->w; x++) {
-            uint64_t c = pixel_count(hs, k, x, y);
-            if (c > mx)
-                mx = c;
-        }
+    if (k == 1) {
+        const uint64_t *cnt = hs->count;
+        for (size_t b = 0; b < npx; b++)
+            mx = cnt[b] > mx ? cnt[b] : mx;
+    } else {
+        for (int y = 0; y < im->h; y++)
+            for (int x = 0; x < im->w; x++) {
+                uint64_t c = pixel_count(hs, k, x, y);
+                if (c > mx)
+                    mx = c;
+            }
+    }
     ramp grey = ramp_grey();
     const ramp *rp = o->ramp ? o->ramp : &grey;
     double lmx = log1p((double)mx);
     /* v depends on the count only: small counts (most pixels) read it from
-     * a table filled with the same expression. */
+     * a table filled with the same expression, and so (ramp colours) does
+     * the pixel. */
     enum { NV = 4096 };
     double vt[NV];
+    float ct[NV][4];
     size_t nv = mx < NV ? (size_t)mx + 1 : NV;
-    for (size_t c = 1; c < nv; c++)
+    for (size_t c = 1; c < nv; c++) {
         vt[c] = density(o->curve, c, mx, lmx, gamma, bright);
+        if (o->colour == TONEMAP_RAMP)
+            ramp_eval(rp, vt[c], ct[c]);
+    }
+    if (k == 1 && o->colour == TONEMAP_RAMP) { /* the common case, straight along the bins */
+        const uint64_t *cnt = hs->count;
+        float bg[4], *px = im->px;
+        memcpy(bg, o->bg, sizeof bg);
+        for (size_t b = 0; b < npx; b++, px += 4) {
+            uint64_t c = cnt[b];
+            if (c < nv) /* c = 0 (then also when M = 0): the background */
+                memcpy(px, c ? ct[c] : bg, sizeof bg);
+            else
+                ramp_eval(rp, density(o->curve, c, mx, lmx, gamma, bright), px);
+        }
+        return RT_OK;
+    }
     for (int y = 0; y < im->h; y++)
         for (int x = 0; x < im->w; x++) {
             float *px = image_at(im, x, y);
@@ -79,6 +106,11 @@ rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_erro
             if (c == 0 || mx == 0) {
                 for (int ch = 0; ch < 4; ch++)
                     px[ch] = o->bg[ch];
+                continue;
+            }
+            if (o->colour == TONEMAP_RAMP && c < nv) {
+                for (int ch = 0; ch < 4; ch++)
+                    px[ch] = ct[c][ch];
                 continue;
             }
             double v = c < nv ? vt[c] : density(o->curve, c, mx, lmx, gamma, bright);

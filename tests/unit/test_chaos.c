@@ -411,6 +411,15 @@ static void test_threads(void)
     CHECK(hh.count[4] == 300000 && hh.csum[12] == 300000.0f && hh.csum[14] == 300000.0f,
           "centre bin %llu hits, colour %g", (unsigned long long)hh.count[4], hh.csum[12]);
     hist2_free(&hh);
+    /* exactly 2 × 65536 hits: the cell was just flushed (its own count is 0,
+     * everything is in the side sums) and must still be merged */
+    o1.points = 2 * 65536;
+    o1.burn = -1;
+    CHECK(hist2_init(&hh, 3, 3, lo1, hi1, 1, &e) == RT_OK, "hist");
+    CHECK(chaos_hist2(&s1, &o1, &hh, NULL, NULL, &e) == RT_OK, "chaos");
+    CHECK(hh.count[4] == 131072 && hh.csum[12] == 131072.0f && hh.csum[13] == 131072.0f,
+          "flushed centre bin %llu hits, colour %g", (unsigned long long)hh.count[4], hh.csum[12]);
+    hist2_free(&hh);
     ifs_free(&f1);
 }
 
@@ -468,6 +477,26 @@ static void test_tonemap(void)
         double v = pow(log(1.0 + (double)hs.count[i]) / log(70001.0), 1 / 2.2);
         CHECK_NEAR(im.px[4 * i], v, 1e-6, "log density, gamma 2.2");
     }
+    /* the ramp colours of small counts come from a table (k = 1): each
+     * channel against the ramp worked out by hand, beside the background
+     * and a count past the table. Ramp red (1, 0, 0, 1) at 0 to blue
+     * (0, 0, 1, 0.5) at 1; linear curve, M = 5000: v = C / 5000. */
+    ramp rp = ramp_grey();
+    for (int ch = 0; ch < 4; ch++)
+        rp.rgba[0][ch] = ch == 0 || ch == 3 ? 1.0f : 0.0f, rp.rgba[1][ch] = ch == 2 ? 1.0f : ch == 3 ? 0.5f : 0.0f;
+    g = (tonemap_opts){0};
+    g.curve = TONEMAP_LINEAR;
+    g.ramp = &rp;
+    g.bg[0] = 0.25f, g.bg[1] = 0.5f, g.bg[2] = 0.75f, g.bg[3] = 1;
+    hs.count[0] = 0, hs.count[1] = 1250, hs.count[2] = 5000, hs.count[3] = 4095;
+    CHECK(tonemap_apply(&hs, &g, &im, &e) == RT_OK, "ramp");
+    const float want[4][4] = {{0.25f, 0.5f, 0.75f, 1}, /* empty: the background */
+                              {0.75f, 0, 0.25f, 0.875f}, /* v = 1/4 */
+                              {0, 0, 1, 0.5f},           /* v = 1, past the table */
+                              {(float)(1 - 0.819), 0, (float)0.819, (float)(1 - 0.5 * 0.819)}}; /* v = 0.819 */
+    for (int i = 0; i < 4; i++)
+        for (int ch = 0; ch < 4; ch++)
+            CHECK_NEAR(im.px[4 * i + ch], want[i][ch], 1e-6, "ramp colour");
     image_free(&im);
     hist2_free(&hs);
 }
@@ -719,6 +748,45 @@ static void test_no_copies(void)
     ifs_free(&f);
 }
 
+/* The 3-D loop counts outside points in a spare cell and derives inside
+ * from it: inside must equal the sum of the voxel counts, and a box over
+ * the lower half z < 128 of the cube holds the points whose last map has
+ * t_z = 0 (maps 0, 1, 4, 5): the stationary share of those states of Table
+ * 1's chain is 0.50157 (π P = π by power iteration in python3), i.e. 50159
+ * of 100003 points; ±2 % is ~12 binomial standard deviations. Checked with
+ * 1 and 2 threads and a chunk shorter than the prefetch ring. */
+static void test_volume_inside(void)
+{
+    rt_error e;
+    rifs r;
+    affine m[8];
+    octant_maps(m);
+    CHECK(rifs_build(&r, m, 8, 1, T1, RIFS_NORMALISE, &e) == RT_OK, "rifs");
+    chaos_sys s3 = {NULL, &r};
+    double lo[3] = {0, 0, 0}, hi[3] = {256, 256, 128};
+    for (int t = 1; t <= 2; t++)
+        for (int ch = 0; ch < 2; ch++) {
+            chaos_opts o = {0};
+            o.points = 100003;
+            o.seed = 5;
+            o.chunk = ch ? 7 : 1 << 14; /* 7 < the ring of 32 */
+            rt_run run = {t, NULL, 0};
+            volume v;
+            CHECK(volume_init(&v, 8, 8, 4, lo, hi, &e) == RT_OK, "volume");
+            chaos_stats st;
+            CHECK(chaos_volume(&s3, &o, CHAOS_NORM_COUNT, &v, &st, &run, &e) == RT_OK, "volume: %s", e.msg);
+            double sum = 0;
+            for (size_t b = 0; b < 8 * 8 * 4; b++)
+                sum += v.v[b];
+            CHECK(st.plotted == 100003, "plotted %llu", (unsigned long long)st.plotted);
+            CHECK(sum == (double)st.inside, "%d thread(s), chunk %u: voxel counts sum to %.0f, inside %llu", t,
+                  o.chunk, sum, (unsigned long long)st.inside);
+            CHECK(st.inside > 48150 && st.inside < 52160, "inside %llu of 100003", (unsigned long long)st.inside);
+            volume_free(&v);
+        }
+    rifs_free(&r);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -731,5 +799,6 @@ int main(void)
     test_hist_adds();
     test_fit_quantiles();
     test_no_copies();
+    test_volume_inside();
     return check_done("test_chaos");
 }

@@ -73,8 +73,31 @@ static void test_choose_uniform(void)
         CHECK(n[i] > 9600 && n[i] < 10400, "index %d chosen %d times of 30000", i, n[i]);
 }
 
+/* Big arrays start on a 2 MiB boundary (hist.c: all of them in huge pages)
+ * and are zero; small ones are plain blocks. 1024² counts are 8 MiB, the
+ * colour sums 12 MiB. */
+static void test_alignment(void)
+{
+    hist2 hs;
+    rt_error e;
+    CHECK(hist2_init(&hs, 1024, 1024, (double[]){0, 0}, (double[]){1, 1}, 1, &e) == RT_OK, "init: %s", e.msg);
+    CHECK((uintptr_t)hs.count % (2u << 20) == 0, "counts at %p", (void *)hs.count);
+    CHECK((uintptr_t)hs.csum % (2u << 20) == 0, "colour sums at %p", (void *)hs.csum);
+    int nonzero = 0;
+    for (size_t b = 0; b < 1024 * 1024; b++)
+        nonzero += hs.count[b] != 0 || hs.csum[3 * b] != 0 || hs.csum[3 * b + 2] != 0;
+    CHECK(nonzero == 0, "%d bins not zero", nonzero);
+    hs.count[1024 * 1024 - 1] = 7; /* the last bin is inside the block */
+    hist2_free(&hs);
+    CHECK(hs.count == NULL && hs.csum == NULL, "freed");
+    CHECK(hist2_init(&hs, 4, 2, (double[]){0, 0}, (double[]){4, 2}, 0, &e) == RT_OK, "small: %s", e.msg);
+    CHECK(hs.count == hs.mem_count && hs.csum == NULL, "a small histogram is its block");
+    hist2_free(&hs);
+}
+
 int main(void)
 {
+    test_alignment();
     test_bins();
     test_measure();
     test_choose_uniform();
