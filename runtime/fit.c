@@ -352,9 +352,9 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
             py[npos++] = y0 + (y1 - y0) * (j + 0.5) / side;
         }
     if (variant) {
-        int stride = (L->nt + 63) / 64, t = 0;
+        int most = quick(F) ? 16 : 64, stride = (L->nt + most - 1) / most, t = 0;
         for (size_t c = 0; c < cells; c++)
-            if (L->T[c] && t++ % stride == 0 && npos < 64) {
+            if (L->T[c] && t++ % stride == 0 && npos < most) {
                 px[npos] = ((double)(c % gw) + 0.5) / gw;
                 py[npos++] = 1 - ((double)(c / gw) + 0.5) / gh;
             }
@@ -371,7 +371,7 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
         /* frames: the principal axes, and the picture's axes (the principal axis of a
          * shape with isotropic moments, like an equilateral triangle, is noise) */
         for (int ai = 0; ai < 2; ai++)
-            for (int bi = 0; bi < 12; bi++)
+            for (int bi = 0; bi < 12; bi += quick(F) ? 3 : 1) /* quick: 4 rotations, not 12 */
                 for (int refl = 0; refl < 2; refl++)
                     for (int si = 0; si < 8; si++)
                         for (int pi = 0; pi < npos; pi++) {

@@ -94,9 +94,10 @@
  * A small cap (opts.max_points > 0, --max-points). Every chaos game of the loss draws
  * min(P, max_points) points. Below FIT_MIN_POINTS — where every target's P is capped — the
  * fit is a quick one, so that a small cap bounds the whole fit and not only its chaos games:
- * collage (a) places its maps on a 4×4 grid (not 12×12), scores at most ~100 target cells
- * and polishes once, and the coarse levels run from 2 starts (the two collages as they are),
- * not FIT_STARTS. Without a cap, or with one at or above FIT_MIN_POINTS, nothing else changes.
+ * both collages try 4 rotations (steps of 90°, not 30°), collage (a) places its maps on a
+ * 4×4 grid (not 12×12), scores at most ~100 target cells and polishes once, collage (b)
+ * places them on at most 16 target cells (not 64), and the coarse levels run from 2 starts
+ * (the two collages as they are), not FIT_STARTS. Without a cap, or with one at or above FIT_MIN_POINTS, nothing else changes.
  *
  * Map counts: opts.nmin..opts.nmax (one number when equal). For a range,
  * every count is fitted with the full budget and the one with the smallest
