@@ -115,6 +115,8 @@ FUZZ_FLAGS = -timeout=10 -rss_limit_mb=1536 -malloc_limit_mb=1024 -print_final_s
 FUZZ_SCRIPT_OBJ := $(filter-out $(BUILD)/interp/main.o $(BUILD)/interp/cli_%.o,$(IN_OBJ))
 FUZZ_DIR := build-fuzz
 .PHONY: fuzz fuzz-build fuzz-bins fuzz-seeds fuzz-smoke $(FUZZ_HARNESSES:%=fuzz-%)
+# a changed ignorelist rebuilds the fuzz objects (it decides what is instrumented)
+$(RT_SRC:%.c=$(FUZZ_DIR)/%.o) $(IN_SRC:%.c=$(FUZZ_DIR)/%.o): tests/fuzz/engines.ignorelist
 
 $(BUILD)/fuzz/fuzz_script: tests/fuzz/fuzz_script.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a
 	@mkdir -p $(dir $@)

@@ -13,6 +13,7 @@
 #include "lang_ifs.h"
 #include "lang_image.h"
 #include "lang_objects.h"
+#include "report.h"
 #include "session.h"
 
 /* "2..6" -> 2, 6; one number "3" -> 3, 3. Returns -1 if malformed. */
@@ -82,7 +83,7 @@ static int mask_from_rows(interp *I, value rows, unsigned char **m, int *w, int 
 static int b_fit(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    fit_opts o = {.iterations = (long)a[A_ITER].u.n, .nmin = 3, .nmax = 3};
+    fit_opts o = {.iterations = (long)a[A_ITER].u.n, .nmin = 3, .nmax = 3, .max_points = I->lim.max_points};
     if (a[A_MAPS].k == V_NIL) {
         if (a[A_START].k != V_NIL)
             o.nmin = o.nmax = lang_as_ifs(a[A_START])->f.n;
@@ -132,10 +133,12 @@ static int b_fit(interp *I, value *a, int n, value *out)
     fit_result r;
     rt_error e;
     rt_run run = lang_run(I);
+    double t0 = report_clock();
     rt_code c = fit_run(&(fit_mask){w, h, m}, &o, &run, &r, &e);
     mem_free(I, m);
     if (c)
         return lang_rt_error(I, c, &e, "fit");
+    report_work(I, "fit", "points", r.points, t0);
     if (r.rifs) {
         lang_rifs *lr = mem_calloc(I, 1, sizeof *lr);
         if (!lr)

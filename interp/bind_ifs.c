@@ -855,8 +855,9 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
 {
     chaos_opts o;
     memset(&o, 0, sizeof o);
-    o.points = 300000;
+    o.points = I->lim.max_points < 300000 ? (uint64_t)I->lim.max_points : 300000; /* --max-points (>= 1) */
     o.seed = I->seed;
+    double t0 = report_clock();
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c;
@@ -889,6 +890,7 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
         if (c)
             goto fail;
     }
+    report_work(I, "show", "points", (double)o.points, t0);
     *out = im;
     return 0;
 fail:

@@ -114,6 +114,7 @@ static const char usage_text[] =
     "  --max-depth N         function call depth (default 1000, at most " CSTACK_STR(CSTACK_MAX_DEPTH) ")\n"
     "  --max-pixels N        pixels per image (default 64000000)\n"
     "  --max-points N        points per chaos game or sampling (default 1e10)\n"
+    "                        (also each loss evaluation of fit() and show()'s IFS preview)\n"
     "  --max-voxels N        voxels per volume (default 134217728 = 512^3)\n"
     "  --max-list N          items per list (default 1e8)\n"
     "\n"

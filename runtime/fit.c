@@ -30,6 +30,7 @@ typedef struct scratch {
     unsigned char *hit;
     double *dA, *f, *d, *z;
     int *v;
+    double drawn;      /* chaos-game points drawn by the evaluations on this scratch */
 } scratch;
 
 typedef struct fitter {
@@ -220,6 +221,7 @@ static double eval_loss(const fitter *F, const double *x, int n, const level *L,
     rng r;
     rng_init(&r, F->o->seed, 0x6669740000000000ull + (uint64_t)(L - F->lv));
     uint32_t out = 0, total = L->points;
+    s->drawn += total;
     int state = 0; /* the last map applied (a RIFS chooses the next by its row) */
     for (uint32_t i = 0; i < total + BURN; i++) {
         uint64_t r32 = rng_next(&r) >> 32;
@@ -267,6 +269,12 @@ static double eval_loss(const fitter *F, const double *x, int n, const level *L,
 /* the level the collage is searched on: the 64-cell grid (holes of a fractal show there;
  * at 32 cells they are mostly filled in) */
 static int collage_level(const fitter *F) { return F->nlv >= 2 ? 1 : 0; }
+
+/* a cap below FIT_MIN_POINTS: the quick search of fit.h ("A small cap") */
+static int quick(const fitter *F) { return F->o->max_points > 0 && F->o->max_points < FIT_MIN_POINTS; }
+
+/* starts of the coarse levels */
+static int nstarts(const fitter *F) { return F->o->start ? 1 : quick(F) ? 2 : FIT_STARTS; }
 
 /* Target cells newly covered by the image w(T) minus the distance-transform sum of the
  * image points outside T (times |s1 s2|, the image's area per mapped cell). */
@@ -336,22 +344,23 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
             double ux = ((double)(c % gw) + 0.5) / gw, uy = 1 - ((double)(c / gw) + 0.5) / gh;
             x0 = fmin(x0, ux), x1 = fmax(x1, ux), y0 = fmin(y0, uy), y1 = fmax(y1, uy);
         }
-    int npos = 0;
+    int npos = 0, side = quick(F) ? 4 : 12;
     double px[144], py[144];
-    for (int j = 0; j < 12 && !variant; j++)
-        for (int i = 0; i < 12; i++) {
-            px[npos] = x0 + (x1 - x0) * (i + 0.5) / 12;
-            py[npos++] = y0 + (y1 - y0) * (j + 0.5) / 12;
+    for (int j = 0; j < side && !variant; j++)
+        for (int i = 0; i < side; i++) {
+            px[npos] = x0 + (x1 - x0) * (i + 0.5) / side;
+            py[npos++] = y0 + (y1 - y0) * (j + 0.5) / side;
         }
     if (variant) {
-        int stride = (L->nt + 63) / 64, t = 0;
+        int most = quick(F) ? 16 : 64, stride = (L->nt + most - 1) / most, t = 0;
         for (size_t c = 0; c < cells; c++)
-            if (L->T[c] && t++ % stride == 0 && npos < 64) {
+            if (L->T[c] && t++ % stride == 0 && npos < most) {
                 px[npos] = ((double)(c % gw) + 0.5) / gw;
                 py[npos++] = 1 - ((double)(c / gw) + 0.5) / gh;
             }
     }
-    int every = variant ? 1 : (L->nt + 599) / 600; /* the search scores at most ~600 target cells */
+    int most = quick(F) ? 100 : 600; /* the search scores at most ~600 target cells (quick: ~100) */
+    int every = variant ? 1 : (L->nt + most - 1) / most;
     static const double sc[8][2] = {{0.5, 0.5},  {0.35, 0.35}, {0.65, 0.65}, {0.8, 0.8},
                                     {0.25, 0.25}, {0.6, 0.3},  {0.3, 0.6},   {0.5, 0.15}};
     memset(covered, 0, cells);
@@ -362,7 +371,7 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
         /* frames: the principal axes, and the picture's axes (the principal axis of a
          * shape with isotropic moments, like an equilateral triangle, is noise) */
         for (int ai = 0; ai < 2; ai++)
-            for (int bi = 0; bi < 12; bi++)
+            for (int bi = 0; bi < 12; bi += quick(F) ? 3 : 1) /* quick: 4 rotations, not 12 */
                 for (int refl = 0; refl < 2; refl++)
                     for (int si = 0; si < 8; si++)
                         for (int pi = 0; pi < npos; pi++) {
@@ -381,7 +390,7 @@ static void collage_init(fitter *F, int n, double *x, unsigned char *covered, ui
                         }
         best = collage_score(L, bq, covered, stamp, &gen, 1);
         /* local polish of the winner: shifts of up to 2 cells, scale ±10 %, rotation ±5° */
-        for (int round = 0; round < (variant ? 0 : 2); round++) {
+        for (int round = 0; round < (variant ? 0 : quick(F) ? 1 : 2); round++) {
             double base[NPAR];
             memcpy(base, bq, sizeof base);
             for (int dy = -2; dy <= 2; dy++)
@@ -538,7 +547,10 @@ static rt_code fitter_init(fitter *F, const fit_mask *t, rt_error *e)
         for (size_t c = 0; c < cells; c++)
             L->nt += L->T[c];
         double p = 10.0 * L->nt;
-        L->points = (uint32_t)(p < 20000 ? 20000 : p > 1048576 ? 1048576 : p);
+        p = p < FIT_MIN_POINTS ? FIT_MIN_POINTS : p > 1048576 ? 1048576 : p;
+        if (F->o->max_points > 0 && p > F->o->max_points) /* --max-points */
+            p = F->o->max_points >= 1 ? floor(F->o->max_points) : 1;
+        L->points = (uint32_t)p;
     }
     const level *fine = &F->lv[F->nlv - 1];
     int side = fine->gw > fine->gh ? fine->gw : fine->gh;
@@ -577,8 +589,9 @@ static long level_gens(const fitter *F, int li)
  * are at most two levels) */
 static int coarse_levels(const fitter *F) { return F->nlv >= 3 ? 2 : 1; }
 
-static long gens_per_count(const fitter *F, int starts)
+static long gens_per_count(const fitter *F)
 {
+    int starts = nstarts(F);
     long g = 0;
     for (int li = 0; li <= F->nlv; li++)
         g += level_gens(F, li) * (li < coarse_levels(F) ? starts : 1);
@@ -688,7 +701,7 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
     /* the coarse levels from FIT_STARTS starts (the two collages, as they are and moved, each
      * with its own offspring streams); the best on the last coarse level goes on to the fine
      * levels */
-    int hi = coarse_levels(F), starts = o->start ? 1 : FIT_STARTS, np = nparams(F, n);
+    int hi = coarse_levels(F), starts = nstarts(F), np = nparams(F, n);
     double bestx[XLEN], best = HUGE_VAL, bsigma = 0.15;
     for (int st = 0; st < starts && !*timed_out; st++) {
         double xs[XLEN];
@@ -740,13 +753,15 @@ rt_code fit_run(const fit_mask *t, const fit_opts *o, const rt_run *run, fit_res
         return rt_fail(e, RT_EINVAL, "the start IFS has %d maps but maps is %d..%d", o->nstart, o->nmin, o->nmax);
     if (o->iterations < 1)
         return rt_fail(e, RT_EINVAL, "iterations must be >= 1");
+    if (!(o->max_points >= 0))
+        return rt_fail(e, RT_EINVAL, "the points cap must be >= 0 (0: none)");
     fitter *F = rt_calloc(1, sizeof *F);
     if (!F)
         return rt_fail(e, RT_ENOMEM, "out of memory");
     F->o = o;
     rt_code c = fitter_init(F, t, e);
     progress pg;
-    long per = c ? 0 : gens_per_count(F, o->start ? 1 : FIT_STARTS);
+    long per = c ? 0 : gens_per_count(F);
     progress_begin(&pg, "fit", (size_t)per * (size_t)(o->nmax - o->nmin + 1), run ? run->progress : 0);
     double t0 = now_s(), best = HUGE_VAL;
     int timed_out = 0;
@@ -777,6 +792,8 @@ rt_code fit_run(const fit_mask *t, const fit_opts *o, const rt_run *run, fit_res
         }
     }
     progress_end(&pg);
+    for (int k = 0; k < FIT_LAMBDA; k++)
+        r->points += F->sc[k].drawn;
     fitter_free(F);
     rt_free(F);
     return c;

@@ -42,7 +42,7 @@
  *     cells. Neither wins on every target, so both start the refinement.
  *  3. Refinement against the attractor, level by level, coarse to fine. The
  *     loss of a parameter vector is computed from its attractor A rendered
- *     by a chaos game of P = clamp(10·|T|, 20000, 2^20) points (after 20
+ *     by a chaos game of P = clamp(10·|T|, 20000, 2^20) points (at most opts.max_points) (after 20
  *     burn-in steps, starting at the fixed point of map 1) into the level's
  *     grid (a cell is in A if one point falls in it):
  *         loss = mean_{t in T} d_A(t) + mean_{a in A} d_T(a) + (g/4)·f_out
@@ -91,6 +91,14 @@
  * is rejected without being drawn. The chaos game of a RIFS picks the next
  * map from the row of the last one.
  *
+ * A small cap (opts.max_points > 0, --max-points). Every chaos game of the loss draws
+ * min(P, max_points) points. Below FIT_MIN_POINTS — where every target's P is capped — the
+ * fit is a quick one, so that a small cap bounds the whole fit and not only its chaos games:
+ * both collages try 4 rotations (steps of 90°, not 30°), collage (a) places its maps on a
+ * 4×4 grid (not 12×12), scores at most ~100 target cells and polishes once, collage (b)
+ * places them on at most 16 target cells (not 64), and the coarse levels run from 2 starts
+ * (the two collages as they are), not FIT_STARTS. Without a cap, or with one at or above FIT_MIN_POINTS, nothing else changes.
+ *
  * Map counts: opts.nmin..opts.nmax (one number when equal). For a range,
  * every count is fitted with the full budget and the one with the smallest
  *     loss_256 + FIT_PENALTY · N
@@ -109,6 +117,7 @@
 #define FIT_PENALTY 0.5
 #define FIT_LAMBDA 4
 #define FIT_STARTS 8
+#define FIT_MIN_POINTS 20000 /* chaos-game points per evaluation without a smaller cap */
 
 typedef struct fit_mask {
     int w, h;                /* >= 2 each */
@@ -123,6 +132,9 @@ typedef struct fit_opts {
     const affine *start;     /* optional: nstart maps (frame coordinates) to refine */
     int nstart;
     int rifs;                /* fit a Recurrent IFS: the maps and which transitions are forbidden */
+    double max_points;       /* > 0: at most this many chaos-game points per loss evaluation
+                              * (--max-points); below FIT_MIN_POINTS also a quick search (see
+                              * "A small cap" above); 0: no cap */
 } fit_opts;
 
 typedef struct fit_result {
@@ -134,6 +146,7 @@ typedef struct fit_result {
     double loss;                /* final loss on the finest level (cells) */
     double loss256;             /* the same, rescaled to a 256-cell grid */
     long generations;           /* generations run (all map counts) */
+    double points;              /* chaos-game points drawn by all loss evaluations */
 } fit_result;
 
 /* Foreground of an image. FIT_FG_AUTO: alpha if some pixel has alpha < 1,

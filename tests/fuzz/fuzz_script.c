@@ -15,6 +15,10 @@
  * are served from it, so save() then load() round-trips inside one input
  * and every other path reads as "no such file".
  *
+ * FRAC_FUZZ_TIMES=FILE appends one line per input to FILE: the CPU time it
+ * took (user + system, microseconds), its size in bytes, and 1 if the budget
+ * interrupted it — to find the inputs that cost the most (tests/fuzz/README.md).
+ *
  * Skips of once-known crashes, now fixed (the parser's nesting limit, the
  * stack check, the declared contract): off by default, so the fuzzer
  * tests those fixes too; FRAC_FUZZ_SKIP_KNOWN=1 turns them back on (what
@@ -31,6 +35,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/time.h>
 
 #include "fileio.h"
@@ -159,6 +164,14 @@ static int known_ub(const char *t)
 
 static volatile sig_atomic_t stop_flag;
 static FILE *devnull; /* where print() goes */
+static FILE *times;   /* FRAC_FUZZ_TIMES=FILE: one line per input, "CPU-microseconds bytes interrupted" */
+
+static long cpu_us(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) * 1000000L + ru.ru_utime.tv_usec + ru.ru_stime.tv_usec;
+}
 
 static void on_vtalrm(int sig)
 {
@@ -177,6 +190,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     sa.sa_handler = on_vtalrm;
     sigaction(SIGVTALRM, &sa, NULL);
     devnull = fopen("/dev/null", "w");
+    const char *tf = getenv("FRAC_FUZZ_TIMES");
+    if (tf && *tf)
+        times = fopen(tf, "a");
     return 0;
 }
 
@@ -209,6 +225,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     stop_flag = 0;
     st.interrupt = &stop_flag;
     st.out = devnull ? devnull : stdout;
+    long t0 = times ? cpu_us() : 0;
     struct itimerval budget = {{0, 0}, {0, 500000}}, off = {{0, 0}, {0, 0}};
     setitimer(ITIMER_VIRTUAL, &budget, NULL);
     if (session_setup(&st) == 0)
@@ -217,5 +234,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     interp_free(&st);
     mfiles_clear();
     free(text);
+    if (times)
+        fprintf(times, "%ld %zu %d\n", cpu_us() - t0, size, (int)stop_flag);
     return 0;
 }
