@@ -131,8 +131,8 @@ static const double pow10_exact[] = {
  * are both exact doubles, so the one IEEE multiplication or division m·10^e
  * (m/10^-e) is the correctly rounded value, the same double strtod gives
  * (Clinger's fast path, "How to read floating point numbers accurately",
- * PLDI 1990). Anything else goes to strtod, as every literal did before,
- * with the same 127-character copy. */
+ * PLDI 1990). Anything else goes to strtod, with every digit (a literal of
+ * 128 characters or more is copied to the heap). -1: out of memory. */
 static int scan_number(const char *p, double *out)
 {
     const char *s = p;
@@ -182,13 +182,17 @@ static int scan_number(const char *p, double *out)
         return (int)(p - s);
     }
 #endif
-    char buf[128];
+    char small[128], *buf = small; /* strtod reads every digit: a long literal gets a buffer of its own */
+    if ((size_t)(p - s) >= sizeof small && !(buf = rt_malloc((size_t)(p - s) + 1)))
+        return -1;
     size_t n = 0;
-    for (const char *q = s; q < p && n + 1 < sizeof buf; q++)
+    for (const char *q = s; q < p; q++)
         if (*q != '_')
             buf[n++] = *q;
     buf[n] = 0;
     *out = strtod(buf, NULL);
+    if (buf != small)
+        rt_free(buf);
     return (int)(p - s);
 }
 
@@ -253,6 +257,10 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
         } else if (k & C_DIGIT || (c == '.' && is_digit(p[1]))) {
             t->type = T_NUMBER;
             t->len = scan_number(p, &t->num);
+            if (t->len < 0) {
+                out->n = n - 1;
+                return -1;
+            }
             p += t->len;
             if (cls[(unsigned char)*p] & C_ALPHA) {
                 t->type = T_ERROR;
