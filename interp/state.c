@@ -221,15 +221,19 @@ static uint64_t hash_bytes(const char *s, size_t n)
 }
 
 /* strncmp(e, s, len) == 0 && e[len] == 0, without the call (names are short) */
+/* An interned name is stored after its length (4 bytes), so a name with a
+ * NUL inside it (a record key made from a string) is compared and rehashed
+ * whole, and no comparison reads past a shorter stored name. */
+static size_t name_len(const char *e)
+{
+    uint32_t n;
+    memcpy(&n, e - sizeof n, sizeof n);
+    return n;
+}
+
 static int same_name(const char *e, const char *s, size_t len)
 {
-    for (size_t i = 0; i < len; i++) {
-        if (e[i] != s[i])
-            return 0;
-        if (!e[i])
-            break;
-    }
-    return e[len] == 0;
+    return name_len(e) == len && memcmp(e, s, len) == 0;
 }
 
 const char *interp_intern(interp *I, const char *s, size_t len)
@@ -244,10 +248,7 @@ const char *interp_intern(interp *I, const char *s, size_t len)
             char *e = I->intern_tab[i];
             if (!e)
                 continue;
-            uint64_t h = 1469598103934665603ull; /* hash_bytes(e, strlen(e)) in one pass */
-            for (const char *q = e; *q; q++)
-                h = (h ^ (unsigned char)*q) * 1099511628211ull;
-            size_t j = h & (nc - 1);
+            size_t j = hash_bytes(e, name_len(e)) & (nc - 1);
             while (nt[j])
                 j = (j + 1) & (nc - 1);
             nt[j] = e;
@@ -263,9 +264,14 @@ const char *interp_intern(interp *I, const char *s, size_t len)
             return e;
         j = (j + 1) & (I->intern_cap - 1);
     }
-    char *e = mem_arena_raw(I, len + 1); /* names live as long as the session, like the trees */
+    if (len > UINT32_MAX)
+        return NULL;
+    char *e = mem_arena_raw(I, sizeof(uint32_t) + len + 1); /* names live as long as the session, like the trees */
     if (!e)
         return NULL;
+    uint32_t n32 = (uint32_t)len;
+    memcpy(e, &n32, sizeof n32);
+    e += sizeof n32;
     memcpy(e, s, len);
     e[len] = 0;
     I->intern_tab[j] = e;
