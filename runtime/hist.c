@@ -19,11 +19,12 @@ void *hist_zeroed(size_t n, size_t size, void **mem)
     size_t bytes = rt_mul_size(n, size);
     if (bytes < 2 * HUGE_ALIGN || bytes > SIZE_MAX - HUGE_ALIGN)
         return *mem = rt_calloc(n, size);
-    char *p = *mem = rt_malloc(bytes + HUGE_ALIGN);
+    /* rt_calloc, not malloc + memset: a fresh block of this size comes from
+     * the kernel already zero, and calloc then skips the clearing */
+    char *p = *mem = rt_calloc(bytes + HUGE_ALIGN, 1);
     if (!p)
         return NULL;
     p += (HUGE_ALIGN - (uintptr_t)p % HUGE_ALIGN) % HUGE_ALIGN;
-    memset(p, 0, bytes);
     return p;
 }
 
