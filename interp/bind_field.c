@@ -548,6 +548,7 @@ static int b_isosurface(interp *I, value *a, int n, value *out)
         lang_field_fn_done(ctmp, cown);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
+    mesh_init(m, 0, 0); /* empty (no allocation): freed safely if the surface's set-up fails first */
     rt_run run = lang_run(I);
     rt_error e;
     rt_code c;

@@ -550,6 +550,10 @@ static int frac_main(int argc, char **argv)
         }
         mem_free(I, o.args);
         mem_free(I, o.ov);
+        long made = I->alloc_count;
+        if (I->fail_alloc_at && made < I->fail_alloc_at) /* tells the fail-alloc loop (tests/runner.c) it is past the end */
+            fprintf(stderr, "frac: note: --fail-alloc %ld was not reached: the run made %ld allocations\n",
+                    I->fail_alloc_at, made);
         interp_free(I);
     } while (again);
     return finish_output(rc);

@@ -94,7 +94,8 @@ void recipe_text(const recipe *r, bytebuf *out, size_t *header_len, char *onelin
             bytebuf_byte(&l, ' ');
             put_escaped(&l, r->params[i]);
         }
-        if (l.failed) { /* out of memory: the version at least */
+        if (l.failed) { /* out of memory: the whole recipe fails (no file is written with a shorter one) */
+            out->failed = 1;
             snprintf(oneline, n, "frac %s", r->version);
         } else {
             size_t k = l.len < n - 1 ? l.len : n - 1;

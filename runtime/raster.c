@@ -3,6 +3,7 @@
 #include "rt_alloc.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -362,6 +363,7 @@ typedef struct tile_job {
     image *im;
     const raster_opts *o;
     size_t first; /* the first tile drawn (a shard draws its bands of tiles only) */
+    atomic_int oom; /* a tile could not get its buffers: the render fails */
 } tile_job;
 
 typedef struct zsort {
@@ -448,7 +450,8 @@ static void tile_fn(void *ctx, size_t tile, int worker)
     float *cb = rt_malloc(sizeof(float) * 4 * np);
     size_t n = J->start[tile + 1] - J->start[tile];
     zsort *zs = rt_malloc(sizeof(zsort) * (n ? n : 1));
-    if (!zb || !cb || !zs) { /* cannot report from here; leave the tile as background */
+    if (!zb || !cb || !zs) { /* reported by raster_render after the tiles */
+        atomic_store(&J->oom, 1);
         rt_free(zb);
         rt_free(cb);
         rt_free(zs);
@@ -598,10 +601,12 @@ rt_code raster_render(const mesh *m, const camera *cam, const raster_opts *o, co
         rt_fail(e, rc, "rasterising interrupted");
         goto done;
     }
-    tile_job T = {t, list, start, im->w, tiles_x, ts, im, o, pp.lo * (size_t)tiles_x};
+    tile_job T = {t, list, start, im->w, tiles_x, ts, im, o, pp.lo * (size_t)tiles_x, 0};
     rc = par_for(run, "raster", (pp.hi - pp.lo) * (size_t)tiles_x, tile_fn, &T);
     if (rc)
         rt_fail(e, rc, "rasterising interrupted");
+    else if (atomic_load(&T.oom))
+        rc = rt_fail(e, RT_ENOMEM, "out of memory for the rasteriser's tile buffers");
     else
         rc = par_part_rows(&pp, im->px, all, band, e);
 done:
