@@ -24,11 +24,11 @@ static unsigned rnd(unsigned n) /* 0 … n-1, xorshift64* */
 
 static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
-/* strtod of the literal as the lexer always read it: underscores dropped,
- * at most 127 characters */
+/* strtod of the whole literal, underscores dropped (every digit counts: the
+ * lexer once cut literals to 127 characters) */
 static double reference(const char *lit)
 {
-    char buf[128];
+    char buf[512];
     size_t n = 0;
     for (const char *q = lit; *q && n + 1 < sizeof buf; q++)
         if (*q != '_')
@@ -171,7 +171,7 @@ int main(void)
         "1e-23", "123e-22", "9007199254740992e22", "9007199254740993e-22", "1234567890123456789",
         "12345678901234567890", "0.1234567890123456789", "1.5e+22", "1.5e-0", "7e0022",
         "0.000000000000000000000000000001", "1_2.3_4e5", "5_", "1e99999999999", "1e-99999999999",
-        /* longer than the 127 characters the lexer copies for strtod */
+        /* 128 characters or more: the lexer copies them to the heap for strtod */
         "0.0000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000"
         "000000000000000000000000000000000000000000000001",
         "00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000"
