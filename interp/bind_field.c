@@ -104,10 +104,12 @@ field *lang_to_field(interp *I, value v, const char *what)
     field_val *fv = as_fv(v);
     if (fv)
         return field_ref(fv->f);
-    if (v.k == V_NUM)
-        return field_const(v.u.n);
-    if (v.k == V_BOOL)
-        return field_const(v.u.b);
+    if (v.k == V_NUM || v.k == V_BOOL) {
+        field *c = field_const(v.k == V_NUM ? v.u.n : v.u.b);
+        if (!c)
+            mem_engine_error(I, what, "out of memory");
+        return c;
+    }
     volume *vol = lang_as_volume(v);
     if (vol) {
         vol_ref *r = mem_alloc(I, sizeof *r);

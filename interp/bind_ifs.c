@@ -161,6 +161,8 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
         if (!*maps || !*p) {
             mem_free(I, *maps);
             mem_free(I, *p);
+            *maps = NULL; /* the caller frees what it holds on error: nothing here */
+            *p = NULL;
             return err_at(I, NULL, ERR_MEMORY, "out of memory");
         }
         memcpy(*maps, li->f.maps, sizeof(affine) * (size_t)*n);
@@ -180,6 +182,8 @@ int lang_get_maps(interp *I, value v, affine **maps, double **p, int *n, const c
     if (!*maps || !*p) {
         mem_free(I, *maps);
         mem_free(I, *p);
+        *maps = NULL; /* the caller frees what it holds on error: nothing here */
+        *p = NULL;
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     int all_p = 1;

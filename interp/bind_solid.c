@@ -135,8 +135,12 @@ static field *warp_radial(field *base, field *kd, const double a[3], const doubl
         }
     field *r = field_unary(FIELD_SQRT, r2);
     /* s = r > 0 ? kD / r : 0 */
-    field *s = field_select(field_binary(FIELD_GT, fref(r), field_const(0)), field_binary(FIELD_DIV, kd, r),
-                            field_const(0));
+    /* in sequence: the division consumes r (and frees it if it fails), so r
+     * must be referenced for the comparison first, not in whatever order the
+     * compiler evaluates arguments */
+    field *gt = field_binary(FIELD_GT, fref(r), field_const(0));
+    field *div = field_binary(FIELD_DIV, kd, r);
+    field *s = field_select(gt, div, field_const(0));
     for (int i = 0; i < 3; i++)
         p[i] = i == j ? field_coord(i) : fadd(field_coord(i), fmul(fref(s), q[i]));
     field_unref(s);

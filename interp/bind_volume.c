@@ -362,7 +362,7 @@ static int load_vdb(interp *I, const char *path, value grid, value *out)
     rt_error e;
     rt_code c = vdb_load(path, grid.k == V_STR ? AS_STR(grid)->s : NULL, I->lim.max_voxels, tmp, &ch, &e);
     if (c)
-        return err_at(I, NULL, c == RT_EIO ? ERR_IO : ERR_VALUE, "load_volume: %s", e.msg);
+        return lang_rt_error(I, c, &e, "load_volume"); /* the one map of runtime codes to error kinds */
     value l = ch == 3 ? val_list(I, 3) : val_nil();
     int rc = ch == 3 && l.k == V_NIL ? -1 : 0;
     for (int i = 0; i < ch && !rc; i++) {

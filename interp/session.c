@@ -101,8 +101,11 @@ int session_run_lines(interp *I, const char *name, const char *text, size_t len,
 
 int session_report(interp *I)
 {
-    if (!I->err.active)
-        return 0;
+    if (!I->err.active) { /* called on a failure: one that recorded no error is still not a success */
+        fflush(stdout);
+        fprintf(stderr, "frac: internal error: an operation failed without saying why (please report this with the script)\n");
+        return err_kind_exit(ERR_MEMORY); /* 70, as for a runtime failure */
+    }
     fflush(stdout);
     diag_print(I, stderr, &I->err);
     return err_kind_exit(I->err.kind);

@@ -750,9 +750,10 @@ field_prog *field_compile(const field *root, rt_error *e)
         rt_fail(e, RT_EINVAL, "no field to compile");
         return NULL;
     }
+    int ok = 1; /* values 0, 1, 2 are x, y, z: every later index relies on them */
     for (int i = 0; i < 3; i++)
-        new_val(&c, 0, 0);
-    int f0 = frame_of(&c, 0, 1, 2);
+        ok = ok && new_val(&c, 0, 0) == i;
+    int f0 = ok ? frame_of(&c, 0, 1, 2) : -1;
     int r = f0 < 0 ? -1 : cnode(&c, root, f0, 0);
     if (r >= 0)
         p = allocate(&c, r);
