@@ -57,6 +57,14 @@ static field *fsub(field *a, field *b) { return field_binary(FIELD_SUB, a, b); }
 static field *fmul(field *a, field *b) { return field_binary(FIELD_MUL, a, b); }
 static field *fref(field *f) { return f ? field_ref(f) : NULL; }
 
+/* sum + term, the first term alone: a failed term (NULL) makes the whole sum
+ * NULL — testing `sum ? … : term` would restart the sum after a failure and
+ * silently drop its terms. */
+static field *fsum(field *sum, field *term, int *terms)
+{
+    return (*terms)++ ? fadd(sum, term) : term;
+}
+
 /* s * f, without a multiplication when s is 1. */
 static field *fscaled(double s, field *f)
 {
@@ -70,6 +78,7 @@ static field *fscaled(double s, field *f)
 static field *axis_coord(const double a[3], const double o[3])
 {
     field *s = NULL;
+    int terms = 0;
     for (int i = 0; i < 3; i++) {
         if (a[i] == 0)
             continue;
@@ -77,7 +86,7 @@ static field *axis_coord(const double a[3], const double o[3])
         if (o[i] != 0)
             c = fsub(c, field_const(o[i]));
         c = fscaled(a[i], c);
-        s = s ? fadd(s, c) : c;
+        s = fsum(s, c, &terms);
     }
     return s;
 }
@@ -118,20 +127,22 @@ static field *warp_radial(field *base, field *kd, const double a[3], const doubl
         field_unref(d[j]);
     } else {
         field *t = NULL;
+        int terms = 0;
         for (int i = 0; i < 3; i++)
             if (a[i] != 0) {
                 field *c = fscaled(a[i], fref(d[i]));
-                t = t ? fadd(t, c) : c;
+                t = fsum(t, c, &terms);
             }
         for (int i = 0; i < 3; i++)
             q[i] = a[i] != 0 ? fsub(d[i], fscaled(a[i], fref(t))) : d[i];
         field_unref(t);
     }
     field *r2 = NULL;
+    int terms2 = 0;
     for (int i = 0; i < 3; i++)
         if (i != j) {
             field *sq = fmul(fref(q[i]), fref(q[i]));
-            r2 = r2 ? fadd(r2, sq) : sq;
+            r2 = fsum(r2, sq, &terms2);
         }
     field *r = field_unary(FIELD_SQRT, r2);
     /* s = r > 0 ? kD / r : 0 */
