@@ -411,6 +411,7 @@ static int b_load_mesh(interp *I, value *a, int n, value *out)
     rt_error e;
     rt_code c = mio_load(path, m, &e);
     if (c) {
+        mesh_free(m); /* what the reader built before it failed (mesh_io.h) */
         mem_free(I, m);
         return lang_rt_error(I, c, &e, "load_mesh");
     }
