@@ -331,6 +331,20 @@ rt_code mio_ply_from_mem(const unsigned char *d, size_t n, mesh *m, rt_error *e)
                                 "reading the PLY vertices and faces", e);
     if (lc)
         return lc;
+    /* Every property of every row takes at least one byte of data (binary:
+     * its size; ASCII: a digit and a separator), so the declared rows must
+     * fit in what is left of the file. Without this a vertex element with
+     * no properties and a count of 10^9 reads nothing a billion times. */
+    double need = 0;
+    for (int i = 0; i < nel; i++) {
+        if (el[i].count > 0 && el[i].nprop == 0)
+            return rt_fail(e, RT_EFORMAT, "PLY element '%s' has %zu rows but no properties", el[i].name,
+                           el[i].count);
+        need += (double)el[i].count * el[i].nprop;
+    }
+    if (need > (double)(n - pos))
+        return rt_fail(e, RT_EFORMAT, "PLY header declares at least %.0f bytes of data, the file holds %zu", need,
+                       n - pos);
     mesh_free(m);
     mesh_init(m, have_n, have_c);
     ply_in in = {d, n, pos, fmt, 0};

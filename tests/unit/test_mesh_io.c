@@ -224,6 +224,18 @@ static void test_errors(void)
     CHECK(mio_ply_from_mem((const unsigned char *)bad3, strlen(bad3), &m, &e) == RT_EFORMAT, "type");
     CHECK(strcmp(e.msg, "PLY header line 4: unknown type 'quad'") == 0, "msg: %s", e.msg);
     mesh_free(&m);
+    /* fuzz finding F9 (ply timeout): a vertex element whose property lines
+     * were lost declared 1,844,674,407 rows; each read nothing */
+    const char *bad6 = "ply\nformat ascii 1.0\nelement vertex 1844674407\nend_header\n0 0 0\n";
+    CHECK(mio_ply_from_mem((const unsigned char *)bad6, strlen(bad6), &m, &e) == RT_EFORMAT, "no props");
+    CHECK(strcmp(e.msg, "PLY element 'vertex' has 1844674407 rows but no properties") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
+    /* 1000 rows of 3 properties need at least 3000 bytes; 6 are there */
+    const char *bad7 = "ply\nformat ascii 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
+                       "property float z\nend_header\n0 0 0\n";
+    CHECK(mio_ply_from_mem((const unsigned char *)bad7, strlen(bad7), &m, &e) == RT_EFORMAT, "rows");
+    CHECK(strcmp(e.msg, "PLY header declares at least 3000 bytes of data, the file holds 6") == 0, "msg: %s", e.msg);
+    mesh_free(&m);
     const char *bad4 = "v 0 0 0\nv 1 0 0\nf 1 2 3\n";
     CHECK(mio_obj_from_mem((const unsigned char *)bad4, strlen(bad4), &m, &e) == RT_EFORMAT, "obj");
     CHECK(strcmp(e.msg, "OBJ line 3: face index out of 1..2") == 0, "msg: %s", e.msg);
