@@ -5,6 +5,8 @@
 # the N shards `frac run --shard I/N` concurrently as separate processes (one
 # thread each), then `frac merge` (three threads) on their parts, and compares
 # every output file (cmp, byte for byte) and stdout with the single run's.
+# With --frames A..B among the options, every shard writes a part a frame and
+# the merge takes them all.
 # Prints one line "ok NAME N=…" or what differs; exits non-zero on a failure.
 # FRAC (default: frac on PATH) is the binary.
 set -u
@@ -37,8 +39,18 @@ for n in $ns; do
         [ -s "$tmp/s$n-$i.out" ] && fail "shard $i/$n printed to stdout"
         i=$((i + 1))
     done
+    # one part a shard (one a shard and frame with --frames): as many of each
+    # shard as of shard 0, and nothing else
     n_parts=$(ls "$tmp/p$n" | wc -l)
-    [ "$n_parts" -eq "$n" ] || fail "N=$n: $n_parts files in the shards' folder, expected $n parts"
+    per=$(ls "$tmp/p$n" | grep -c "\.shard-0-of-$n\.part\$")
+    i=0
+    while [ "$i" -lt "$n" ]; do
+        k=$(ls "$tmp/p$n" | grep -c "\.shard-$i-of-$n\.part\$")
+        [ "$k" -eq "$per" ] || fail "N=$n: $k parts of shard $i, $per of shard 0"
+        i=$((i + 1))
+    done
+    [ "$per" -ge 1 ] && [ "$n_parts" -eq $((n * per)) ] ||
+        fail "N=$n: $n_parts files in the shards' folder, expected $n parts (a frame)"
     "$frac" merge -q --threads 3 "$@" -o "$tmp/m$n" "$script" "$tmp/p$n"/*.part >"$tmp/m$n.out" 2>"$tmp/m$n.err" ||
         fail "merge N=$n: $(cat "$tmp/m$n.err")"
     [ -d "$tmp/m$n" ] || mkdir "$tmp/m$n"
