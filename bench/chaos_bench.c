@@ -137,11 +137,11 @@ static uint64_t plain3p(uint64_t npts, const rifs *rf, uint32_t *cnt)
 
 /* ---- fresh-process measurements: CPU seconds and peak RSS of one job ---- */
 
-typedef struct fresh { double cpu, rss_mb; } fresh;
+typedef struct fresh { double cpu, rss_mb; long faults; } fresh;
 
 static fresh run_fresh(void (*job)(void))
 {
-    fresh f = {-1, -1};
+    fresh f = {-1, -1, -1};
     fflush(stdout);
     pid_t pid = fork();
     if (pid == 0) {
@@ -154,6 +154,7 @@ static fresh run_fresh(void (*job)(void))
         return f;
     f.cpu = ru.ru_utime.tv_sec + ru.ru_utime.tv_usec * 1e-6 + ru.ru_stime.tv_sec + ru.ru_stime.tv_usec * 1e-6;
     f.rss_mb = ru.ru_maxrss / 1024.0; /* KiB on Linux */
+    f.faults = ru.ru_minflt + ru.ru_majflt;
     return f;
 }
 
@@ -243,14 +244,14 @@ static void fresh_report(void)
     };
     printf("fresh process, %d points, 1 thread (CPU s and peak RSS above an empty child: %.1f MB)\n",
            FRESH_POINTS, base.rss_mb);
-    printf("  %-46s %8s %9s %9s %8s\n", "job", "CPU s", "RSS MB", "data MB", "RSS/data");
+    printf("  %-46s %8s %9s %9s %8s %7s\n", "job", "CPU s", "RSS MB", "data MB", "RSS/data", "faults");
     double cpu[sizeof jobs / sizeof jobs[0]];
     for (size_t i = 0; i < sizeof jobs / sizeof jobs[0]; i++) {
         fresh f = run_fresh(jobs[i].job);
         double rss = f.rss_mb - base.rss_mb;
         cpu[i] = f.cpu - base.cpu;
-        printf("  %-46s %8.3f %9.1f %9.0f %7.2fx\n", jobs[i].what, cpu[i], rss, jobs[i].data_mb,
-               rss / jobs[i].data_mb);
+        printf("  %-46s %8.3f %9.1f %9.0f %7.2fx %7ld\n", jobs[i].what, cpu[i], rss, jobs[i].data_mb,
+               rss / jobs[i].data_mb, f.faults - base.faults);
     }
     printf("  (data: what the job must hold at once; 2-D render: 8 B/px counts + 16 B/px float RGBA image,\n"
            "   with colour 20 B/px histogram; 3-D: the 4 B/voxel float volume)\n");
