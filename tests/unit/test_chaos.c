@@ -787,6 +787,71 @@ static void test_volume_inside(void)
     rifs_free(&r);
 }
 
+/* Where and in which colour a coloured hit lands, against facts of the
+ * maps alone (mutation table: chaos-colour-cell, chaos-blend-order,
+ * chaos-palette-round). */
+static void test_colour_hits(void)
+{
+    rt_error e;
+    double lo[2] = {0, 0}, hi[2] = {1, 1};
+    int th[2] = {1, 3};
+    /* one map x/2 + 0.05: every point at the fixed point (0.1, 0.1), which is
+     * column 0 and, counted from the top, row 3 of a 4×4 window: bin 12 */
+    affine one[1] = {affine_from_2d(0.5, 0, 0, 0.5, 0.05, 0.05)};
+    ifs f1;
+    CHECK(ifs_build(&f1, one, 1, NULL, 0, &e) == RT_OK, "one map");
+    chaos_sys s1 = {&f1, NULL};
+    /* colour 0.0015: palette entry round(0.0015 × 1023) = 2 (truncating gives 1) */
+    double c1[1] = {0.0015};
+    for (int t = 0; t < 2; t++) {
+        rt_run run = {th[t], NULL, 0};
+        chaos_opts o = {0};
+        o.points = 40000;
+        o.chunk = 1 << 12;
+        o.colour = CHAOS_COLOUR_LAST;
+        o.map_c = c1;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 4, 4, lo, hi, 1, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s1, &o, &hh, NULL, &run, &e) == RT_OK, "chaos");
+        CHECK(hh.count[12] == 40000, "%d thread(s): bin (0, 3) has %llu of 40000 hits", th[t],
+              (unsigned long long)hh.count[12]);
+        double mean = hh.csum[3 * 12] / 40000.0;
+        CHECK(fabs(mean - 2.0 / 1023) < 2e-5, "%d thread(s): colour 0.0015 gave %.6f, not palette entry 2 (%.6f)",
+              th[t], mean, 2.0 / 1023);
+        hist2_free(&hh);
+    }
+    ifs_free(&f1);
+    /* x/2 and x/2 + 1/2 (y/2 both), colours 0 and 1, blended: a hit of the
+     * right map lands in x >= 1/2 with colour (c + 1)/2 >= 1/2, a hit of the
+     * left one in x < 1/2 with colour c/2 <= 1/2; c is 1/2 on average, so
+     * the mean colours of the two halves are 3/4 and 1/4 */
+    affine two[2] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0)};
+    ifs f2;
+    CHECK(ifs_build(&f2, two, 2, NULL, 0, &e) == RT_OK, "two maps");
+    chaos_sys s2 = {&f2, NULL};
+    double c2[2] = {0, 1}, lo2[2] = {0, -1}, hi2[2] = {1, 1};
+    for (int t = 0; t < 2; t++) {
+        rt_run run = {th[t], NULL, 0};
+        chaos_opts o = {0};
+        o.points = 200000;
+        o.seed = 3;
+        o.chunk = 1 << 12;
+        o.colour = CHAOS_COLOUR_BLEND;
+        o.map_c = c2;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 2, 1, lo2, hi2, 1, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s2, &o, &hh, NULL, &run, &e) == RT_OK, "chaos");
+        CHECK(hh.count[0] + hh.count[1] == 200000 && hh.count[0] > 90000 && hh.count[1] > 90000,
+              "%d thread(s): halves %llu, %llu", th[t], (unsigned long long)hh.count[0],
+              (unsigned long long)hh.count[1]);
+        double ml = hh.csum[0] / (double)hh.count[0], mr = hh.csum[3] / (double)hh.count[1];
+        CHECK(fabs(ml - 0.25) < 0.01 && fabs(mr - 0.75) < 0.01,
+              "%d thread(s): mean colours %.4f (left, expected 1/4) and %.4f (right, 3/4)", th[t], ml, mr);
+        hist2_free(&hh);
+    }
+    ifs_free(&f2);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -794,6 +859,7 @@ int main(void)
     test_rifs_measure();
     test_order2();
     test_threads();
+    test_colour_hits();
     test_3d_nondiagonal();
     test_tonemap();
     test_hist_adds();
