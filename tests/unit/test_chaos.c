@@ -458,6 +458,11 @@ static void test_tonemap(void)
     CHECK_NEAR(im.px[2], 0.5 - 0.5 / 7, 1e-6, "mean b toward bg");
     CHECK_NEAR(im.px[5], 5.0 / 7, 1e-6, "mean g at max");
     CHECK_NEAR(im.px[6], 4.0 / 7, 1e-6, "mean b at max");
+    /* alpha: over a half-transparent background, a + (1 - a) v */
+    o.bg[3] = 0.25f;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "mean over alpha 1/4");
+    CHECK_NEAR(im.px[3], 0.25 + 0.75 / 7, 1e-6, "alpha at v = 1/7");
+    CHECK_NEAR(im.px[7], 1.0, 1e-6, "alpha at max");
     image_free(&im);
     CHECK(image_init(&im, 3, 1, &e) == RT_OK, "image");
     CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_EINVAL &&
