@@ -826,6 +826,26 @@ static void test_colour_hits(void)
         hist2_free(&hh);
     }
     ifs_free(&f1);
+    /* a chunk starts at the fixed point of map 0 (chaos.h), so without a
+     * burn-in a one-map orbit never leaves it: a map with a shear (b, c != 0,
+     * which a wrong inverse of I - A gets wrong) and t = (I - A)(0.1, 0.1)
+     * puts all its hits in bin 12 from the first one */
+    double ax = 0.5, bx = 0.3, cx = -0.2, dx = 0.5;
+    affine sh[1] = {affine_from_2d(ax, bx, cx, dx, (1 - ax) * 0.1 - bx * 0.1, -cx * 0.1 + (1 - dx) * 0.1)};
+    CHECK(ifs_build(&f1, sh, 1, NULL, 0, &e) == RT_OK, "sheared map");
+    {
+        chaos_opts o = {0};
+        o.points = 40000;
+        o.chunk = 1 << 12;
+        o.burn = -1;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 4, 4, lo, hi, 0, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s1, &o, &hh, NULL, NULL, &e) == RT_OK, "chaos");
+        CHECK(hh.count[12] == 40000, "sheared map without burn-in: %llu of 40000 hits at its fixed point",
+              (unsigned long long)hh.count[12]);
+        hist2_free(&hh);
+    }
+    ifs_free(&f1);
     /* x/2 and x/2 + 1/2 (y/2 both), colours 0 and 1, blended: a hit of the
      * right map lands in x >= 1/2 with colour (c + 1)/2 >= 1/2, a hit of the
      * left one in x < 1/2 with colour c/2 <= 1/2; c is 1/2 on average, so
