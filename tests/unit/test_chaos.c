@@ -828,10 +828,11 @@ static void test_colour_hits(void)
     ifs_free(&f1);
     /* a chunk starts at the fixed point of map 0 (chaos.h), so without a
      * burn-in a one-map orbit never leaves it: a map with a shear (b, c != 0,
-     * which a wrong inverse of I - A gets wrong) and t = (I - A)(0.1, 0.1)
-     * puts all its hits in bin 12 from the first one */
-    double ax = 0.5, bx = 0.3, cx = -0.2, dx = 0.5;
-    affine sh[1] = {affine_from_2d(ax, bx, cx, dx, (1 - ax) * 0.1 - bx * 0.1, -cx * 0.1 + (1 - dx) * 0.1)};
+     * which a wrong inverse of I - A gets wrong) and t = (I - A) z, z the
+     * centre (6.5/64, 1 - 57.5/64) of bin (6, 57) of a 64×64 window, puts
+     * all its hits in that bin from the first one */
+    double ax = 0.5, bx = 0.3, cx = -0.2, dx = 0.5, z = 6.5 / 64;
+    affine sh[1] = {affine_from_2d(ax, bx, cx, dx, (1 - ax) * z - bx * z, -cx * z + (1 - dx) * z)};
     CHECK(ifs_build(&f1, sh, 1, NULL, 0, &e) == RT_OK, "sheared map");
     {
         chaos_opts o = {0};
@@ -839,10 +840,10 @@ static void test_colour_hits(void)
         o.chunk = 1 << 12;
         o.burn = -1;
         hist2 hh;
-        CHECK(hist2_init(&hh, 4, 4, lo, hi, 0, &e) == RT_OK, "hist");
+        CHECK(hist2_init(&hh, 64, 64, lo, hi, 0, &e) == RT_OK, "hist");
         CHECK(chaos_hist2(&s1, &o, &hh, NULL, NULL, &e) == RT_OK, "chaos");
-        CHECK(hh.count[12] == 40000, "sheared map without burn-in: %llu of 40000 hits at its fixed point",
-              (unsigned long long)hh.count[12]);
+        CHECK(hh.count[57 * 64 + 6] == 40000, "sheared map without burn-in: %llu of 40000 hits at its fixed point",
+              (unsigned long long)hh.count[57 * 64 + 6]);
         hist2_free(&hh);
     }
     ifs_free(&f1);
