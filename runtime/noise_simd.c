@@ -51,10 +51,10 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 #pragma GCC push_options
 #pragma GCC target("avx2")
 #endif
-/* Eight points at a time: the hash chain of each point runs in the integer
- * registers (perm_pair, as perlin() does it; those ports are otherwise
- * idle) while the floors, fades, gradients and lerps run on two 4-double
- * vectors per quantity. The gradient coefficients come from the hash bytes
+/* Eight points at a time: the hash chain runs in 32-bit lanes, one gather
+ * per level and corner pair (seven per eight points, instead of 56 scalar
+ * loads with their index arithmetic), while the floors, fades, gradients
+ * and lerps run on two 4-double vectors per quantity. The gradient coefficients come from the hash bytes
  * by a 16-entry byte table lookup (pshufb) and exact int8 -> int32 -> double
  * conversions: the values ±1 and 0 of noise_gpairs, no memory gather. */
 ALWAYS_INLINE v4d cvt4(const int8_t *c)
@@ -69,12 +69,6 @@ ALWAYS_INLINE v4d floor4(v4d v)
 {
     const v4d zero = {0, 0, 0, 0};
     return (v4d)_mm256_floor_pd((__m256d)v) + zero;
-}
-
-ALWAYS_INLINE void index4(v4d f, int32_t *ix)
-{
-    __m128i i = _mm_and_si128(_mm256_cvttpd_epi32((__m256d)f), _mm_set1_epi32(255));
-    _mm_storeu_si128((__m128i *)(void *)ix, i);
 }
 
 ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
@@ -100,23 +94,54 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
 }
 
 /* The gradient coefficients of the 64 corners of eight points from their
- * pairs' gradient numbers: hq[c][j] = p[512 + the pair index] (noise.h) of
- * corner pair c (AA, BA, AB, BB) of point j; cf[c][axis][l]: lanes l = 0..7
- * at z, 8..15 at z + 1. */
-ALWAYS_INLINE void coef8_avx2(const uint8_t hq[4][8], int8_t cf[4][3][16])
+ * pairs' gradient numbers: byte 3 of lane j of hq[c] = p[512 + the pair
+ * index] (noise.h) of corner pair c (AA, BA, AB, BB) of point j (as
+ * hash8_avx2 gathers them); cf[c][axis][l]: lanes l = 0..7 at z, 8..15 at
+ * z + 1. */
+ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
 {
     const __m128i low4 = _mm_set1_epi8(15);
 #define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
                              G(11), G(12), G(13), G(14), G(15))
     const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
 #undef T16
+    /* byte 3 of each lane to bytes 0..3 of its 128-bit half, the halves' low
+     * words side by side: the eight points' bytes in order */
+    const __m256i top = _mm256_setr_epi8(3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                         3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
     for (int c = 0; c < 4; c++) {
-        __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)hq[c]);
+        __m128i b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hq[c], top), join));
         __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
         _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
     }
+}
+
+/* (int)floor & 255 of eight lanes given as two 4-double halves */
+ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b)
+{
+    __m128i lo = _mm256_cvttpd_epi32((__m256d)floor4(a)), hi = _mm256_cvttpd_epi32((__m256d)floor4(b));
+    return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
+}
+
+/* perlin()'s hash chain for eight points in 32-bit lanes, each level one
+ * gather per corner pair (4-byte loads; only the low bytes count): [P[X],
+ * P[X+1]], then [P[A], P[A+1]] and [P[B], P[B+1]], then the four pair
+ * bytes p[512 + AA] ... in byte 3 (the load starts 3 bytes early so that it
+ * never reads past p[1023]; every index is <= 510). */
+ALWAYS_INLINE void hash8_avx2(const uint8_t *p, __m256i X, __m256i Y, __m256i Z, __m256i hq[4])
+{
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pp = (const int *)(const void *)p, *pg = (const int *)(const void *)(p + 512 - 3);
+    __m256i hx = _mm256_i32gather_epi32(pp, X, 1);
+    __m256i hA = _mm256_i32gather_epi32(pp, _mm256_add_epi32(_mm256_and_si256(hx, ff), Y), 1);
+    __m256i hB = _mm256_i32gather_epi32(pp, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y), 1);
+    hq[0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA, ff), Z), 1);
+    hq[1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB, ff), Z), 1);
+    hq[2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA, 8), ff), Z), 1);
+    hq[3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB, 8), ff), Z), 1);
 }
 
 ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
@@ -132,15 +157,13 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
     const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     int8_t cf[CHUNK][4][3][16];
-    uint8_t hq[CHUNK][4][8];
-    const uint8_t *pg = p + 512;
-    int32_t X[CHUNK * 8], Y[CHUNK * 8], Z[CHUNK * 8];
     size_t i = 0;
     while (i + 8 <= n) {
         size_t ng = (n - i) / 8;
         ng = ng < CHUNK ? ng : CHUNK;
         unsigned okm = 0;
-        /* the passes are separate so that no load waits on a recent store */
+        /* stage one: cells, hashes and coefficients of every group; stage two
+         * (below) the arithmetic, which then never waits on these stores */
         for (size_t g = 0; g < ng; g++) {
             size_t j = i + 8 * g;
             v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
@@ -152,29 +175,12 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
 #undef IN
             if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                index4(floor4(xa), X + 8 * g), index4(floor4(xb), X + 8 * g + 4);
-                index4(floor4(ya), Y + 8 * g), index4(floor4(yb), Y + 8 * g + 4);
-                index4(floor4(za), Z + 8 * g), index4(floor4(zb), Z + 8 * g + 4);
+                __m256i hq[4];
+                hash8_avx2(p, cell8_avx2(xa, xb), cell8_avx2(ya, yb), cell8_avx2(za, zb), hq);
+                coef8_avx2(hq, cf[g]);
                 okm |= 1u << g;
             }
         }
-        for (size_t g = 0; g < ng; g++) {
-            if (!(okm >> g & 1))
-                continue;
-            for (int l = 0; l < 8; l++) {
-                size_t j = 8 * g + (size_t)l;
-                unsigned hx = perm_pair(p, (unsigned)X[j]);
-                unsigned hA = perm_pair(p, (hx & 255u) + (unsigned)Y[j]);
-                unsigned hB = perm_pair(p, (hx >> 8) + (unsigned)Y[j]);
-                hq[g][0][l] = pg[(hA & 255u) + (unsigned)Z[j]];
-                hq[g][1][l] = pg[(hB & 255u) + (unsigned)Z[j]];
-                hq[g][2][l] = pg[(hA >> 8) + (unsigned)Z[j]];
-                hq[g][3][l] = pg[(hB >> 8) + (unsigned)Z[j]];
-            }
-        }
-        for (size_t g = 0; g < ng; g++)
-            if (okm >> g & 1)
-                coef8_avx2(hq[g], cf[g]);
         for (size_t g = 0; g < ng; g++, i += 8) {
             v4d xa = ld4(xs + i), xb = ld4(xs + i + 4), ya = ld4(ys + i), yb = ld4(ys + i + 4);
             v4d za = ld4(zs + i), zb = ld4(zs + i + 4), ra, rb;
