@@ -126,30 +126,46 @@ ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b)
     return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
 }
 
-/* perlin()'s hash chain for eight points in 32-bit lanes, each level one
- * gather per corner pair (4-byte loads; only the low bytes count): [P[X],
- * P[X+1]], then [P[A], P[A+1]] and [P[B], P[B+1]], then the four pair
- * bytes p[512 + AA] ... in byte 3 (the load starts 3 bytes early so that it
- * never reads past p[1023]; every index is <= 510). */
-ALWAYS_INLINE void hash8_avx2(const uint8_t *p, __m256i X, __m256i Y, __m256i Z, __m256i hq[4])
+/* Chunks of up to CHUNK groups of eight points: stage one finds the cells,
+ * hashes and coefficients of every group, stage two does the arithmetic, so
+ * the second never waits on the first's stores. */
+enum { CHUNK = 8 };
+
+/* perlin()'s hash chain for the groups of eight points whose bit is set in
+ * okm, in 32-bit lanes, each level one gather per corner pair (4-byte
+ * loads; only the low bytes count): [P[X], P[X+1]], then [P[A], P[A+1]] and
+ * [P[B], P[B+1]], then the four pair bytes p[512 + AA] ... in byte 3 (that
+ * load starts 3 bytes early, so it never reads past p[1023]; every index
+ * is <= 510). Level by level over all groups: a gather's latency is long,
+ * and the groups' chains are independent. */
+ALWAYS_INLINE void hash_avx2(const uint8_t *p, size_t ng, unsigned okm, const __m256i *X,
+                             const __m256i *Y, const __m256i *Z, __m256i (*hq)[4])
 {
     const __m256i ff = _mm256_set1_epi32(255);
     const int *pp = (const int *)(const void *)p, *pg = (const int *)(const void *)(p + 512 - 3);
-    __m256i hx = _mm256_i32gather_epi32(pp, X, 1);
-    __m256i hA = _mm256_i32gather_epi32(pp, _mm256_add_epi32(_mm256_and_si256(hx, ff), Y), 1);
-    __m256i hB = _mm256_i32gather_epi32(pp, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y), 1);
-    hq[0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA, ff), Z), 1);
-    hq[1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB, ff), Z), 1);
-    hq[2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA, 8), ff), Z), 1);
-    hq[3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB, 8), ff), Z), 1);
+    __m256i hA[CHUNK], hB[CHUNK];
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            __m256i hx = _mm256_i32gather_epi32(pp, X[g], 1);
+            hA[g] = _mm256_add_epi32(_mm256_and_si256(hx, ff), Y[g]);
+            hB[g] = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y[g]);
+        }
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            hA[g] = _mm256_i32gather_epi32(pp, hA[g], 1);
+            hB[g] = _mm256_i32gather_epi32(pp, hB[g], 1);
+        }
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            hq[g][0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA[g], ff), Z[g]), 1);
+            hq[g][1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB[g], ff), Z[g]), 1);
+            hq[g][2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA[g], 8), ff), Z[g]), 1);
+            hq[g][3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB[g], 8), ff), Z[g]), 1);
+        }
 }
 
 ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
 ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
-
-/* Chunks of up to CHUNK groups of eight: stage one hashes every group, stage
- * two does the arithmetic, so the second never waits on the first's stores. */
-enum { CHUNK = 8 };
 
 ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                                 const double *zs, double s, double a, int mode, double *out)
@@ -157,13 +173,12 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
     const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     int8_t cf[CHUNK][4][3][16];
+    __m256i X[CHUNK], Y[CHUNK], Z[CHUNK], hq[CHUNK][4];
     size_t i = 0;
     while (i + 8 <= n) {
         size_t ng = (n - i) / 8;
         ng = ng < CHUNK ? ng : CHUNK;
         unsigned okm = 0;
-        /* stage one: cells, hashes and coefficients of every group; stage two
-         * (below) the arithmetic, which then never waits on these stores */
         for (size_t g = 0; g < ng; g++) {
             size_t j = i + 8 * g;
             v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
@@ -175,12 +190,14 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
 #undef IN
             if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                __m256i hq[4];
-                hash8_avx2(p, cell8_avx2(xa, xb), cell8_avx2(ya, yb), cell8_avx2(za, zb), hq);
-                coef8_avx2(hq, cf[g]);
+                X[g] = cell8_avx2(xa, xb), Y[g] = cell8_avx2(ya, yb), Z[g] = cell8_avx2(za, zb);
                 okm |= 1u << g;
             }
         }
+        hash_avx2(p, ng, okm, X, Y, Z, hq);
+        for (size_t g = 0; g < ng; g++)
+            if (okm >> g & 1)
+                coef8_avx2(hq[g], cf[g]);
         for (size_t g = 0; g < ng; g++, i += 8) {
             v4d xa = ld4(xs + i), xb = ld4(xs + i + 4), ya = ld4(ys + i), yb = ld4(ys + i + 4);
             v4d za = ld4(zs + i), zb = ld4(zs + i + 4), ra, rb;
