@@ -119,10 +119,13 @@ ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
     }
 }
 
-/* (int)floor & 255 of eight lanes given as two 4-double halves */
-ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b)
+/* (int)floor & 255 of eight lanes given as two 4-double halves, and in
+ * fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
+ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
 {
-    __m128i lo = _mm256_cvttpd_epi32((__m256d)floor4(a)), hi = _mm256_cvttpd_epi32((__m256d)floor4(b));
+    v4d fa = floor4(a), fb = floor4(b);
+    fr[0] = a - fa, fr[1] = b - fb;
+    __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
     return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
 }
 
@@ -174,6 +177,7 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
     const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     int8_t cf[CHUNK][4][3][16];
     __m256i X[CHUNK], Y[CHUNK], Z[CHUNK], hq[CHUNK][4];
+    v4d fr[CHUNK][3][2]; /* the fractions of x, y, z, points 0..3 and 4..7 */
     size_t i = 0;
     while (i + 8 <= n) {
         size_t ng = (n - i) / 8;
@@ -190,7 +194,8 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
 #undef IN
             if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                X[g] = cell8_avx2(xa, xb), Y[g] = cell8_avx2(ya, yb), Z[g] = cell8_avx2(za, zb);
+                X[g] = cell8_avx2(xa, xb, fr[g][0]), Y[g] = cell8_avx2(ya, yb, fr[g][1]);
+                Z[g] = cell8_avx2(za, zb, fr[g][2]);
                 okm |= 1u << g;
             }
         }
@@ -199,18 +204,19 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             if (okm >> g & 1)
                 coef8_avx2(hq[g], cf[g]);
         for (size_t g = 0; g < ng; g++, i += 8) {
-            v4d xa = ld4(xs + i), xb = ld4(xs + i + 4), ya = ld4(ys + i), yb = ld4(ys + i + 4);
-            v4d za = ld4(zs + i), zb = ld4(zs + i + 4), ra, rb;
-            if (mode != NOISE_SET) {
-                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
-            }
+            v4d ra, rb;
             if (okm >> g & 1) {
-                ra = half4(cf[g], 0, xa - floor4(xa), ya - floor4(ya), za - floor4(za));
-                rb = half4(cf[g], 1, xb - floor4(xb), yb - floor4(yb), zb - floor4(zb));
+                ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
+                rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
             } else {
-                for (int l = 0; l < 4; l++) {
-                    ra[l] = perlin(p, xa[l], ya[l], za[l]);
-                    rb[l] = perlin(p, xb[l], yb[l], zb[l]);
+                for (int l = 0; l < 8; l++) {
+                    double x = xs[i + l], y = ys[i + l], z = zs[i + l];
+                    if (mode != NOISE_SET)
+                        x *= s, y *= s, z *= s;
+                    if (l < 4)
+                        ra[l] = perlin(p, x, y, z);
+                    else
+                        rb[l - 4] = perlin(p, x, y, z);
                 }
             }
             if (mode == NOISE_SET) {
