@@ -95,6 +95,9 @@ void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const 
 
 enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2, NOISE_LEVEL_AVX512 };
 int noise_simd_best(void);
+/* The level the *_block functions use: noise_simd_best(), except SSE2,
+ * where they run the per-point loop (NOISE_LEVEL_SCALAR). */
+int noise_block_level(void);
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
                             const double *y, const double *z, double *out);
 void noise_fbm3_block_at(int level, const noise_perm *np, int octaves, double lacunarity,

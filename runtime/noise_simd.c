@@ -38,6 +38,21 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 
 #define ALWAYS_INLINE static inline __attribute__((always_inline))
 
+/* The per-point loop: the scalar level, and every kernel's groups with a
+ * point the vector path cannot take and its last few points. */
+static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
+                          const double *zs, double s, double a, int mode, double *out)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (mode == NOISE_SET)
+            out[i] = perlin(p, xs[i], ys[i], zs[i]);
+        else if (mode == NOISE_ADD)
+            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
+        else
+            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
+    }
+}
+
 #define K(name) name##_sse2
 #include "noise_kernel.inc"
 #undef K
@@ -204,21 +219,12 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             if (okm >> g & 1)
                 coef8_avx2(hq[g], cf[g]);
         for (size_t g = 0; g < ng; g++, i += 8) {
-            v4d ra, rb;
-            if (okm >> g & 1) {
-                ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
-                rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
-            } else {
-                for (int l = 0; l < 8; l++) {
-                    double x = xs[i + l], y = ys[i + l], z = zs[i + l];
-                    if (mode != NOISE_SET)
-                        x *= s, y *= s, z *= s;
-                    if (l < 4)
-                        ra[l] = perlin(p, x, y, z);
-                    else
-                        rb[l - 4] = perlin(p, x, y, z);
-                }
+            if (!(okm >> g & 1)) {
+                kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
+                continue;
             }
+            v4d ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
+            v4d rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
             if (mode == NOISE_SET) {
                 st4(out + i, ra), st4(out + i + 4, rb);
                 continue;
@@ -230,14 +236,7 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             st4(out + i + 4, ld4(out + i + 4) + a * rb);
         }
     }
-    for (; i < n; i++) { /* the last 0..7 points */
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
+    kernel_scalar(p, n - i, xs + i, ys + i, zs + i, s, a, mode, out + i); /* the last 0..7 points */
 }
 
 #if defined(__clang__)
@@ -246,19 +245,6 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
 #pragma GCC pop_options
 #endif
 #endif
-
-static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
-                          const double *zs, double s, double a, int mode, double *out)
-{
-    for (size_t i = 0; i < n; i++) {
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
-}
 
 static void kernel_sse2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                         const double *zs, double s, double a, int mode, double *out)
@@ -376,18 +362,17 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
         v8d x = (v8d)_mm512_loadu_pd(xs + i), y = (v8d)_mm512_loadu_pd(ys + i);
-        v8d z = (v8d)_mm512_loadu_pd(zs + i), r;
+        v8d z = (v8d)_mm512_loadu_pd(zs + i);
         if (mode != NOISE_SET)
             x *= s, y *= s, z *= s;
         __mmask8 ok = _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)x), (__m512d)big, _CMP_LT_OQ) &
                       _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)y), (__m512d)big, _CMP_LT_OQ) &
                       _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)z), (__m512d)big, _CMP_LT_OQ);
-        if (ok == 0xff) {
-            r = perlin8_avx512(&t, x, y, z);
-        } else {
-            for (int l = 0; l < 8; l++)
-                r[l] = perlin(p, x[l], y[l], z[l]);
+        if (ok != 0xff) {
+            kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
+            continue;
         }
+        v8d r = perlin8_avx512(&t, x, y, z);
         if (mode == NOISE_SET) {
             _mm512_storeu_pd(out + i, (__m512d)r);
             continue;
@@ -396,14 +381,7 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
             r = (v8d)_mm512_abs_pd((__m512d)r);
         _mm512_storeu_pd(out + i, (__m512d)((v8d)_mm512_loadu_pd(out + i) + a * r));
     }
-    for (; i < n; i++) { /* the last 0..7 points */
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
+    kernel_scalar(p, n - i, xs + i, ys + i, zs + i, s, a, mode, out + i); /* the last 0..7 points */
 }
 #if defined(__clang__)
 #pragma clang attribute pop
