@@ -3,8 +3,8 @@
  *   SSE2    four points (GCC/Clang vector extensions, each 4-double vector
  *           split into two 128-bit halves; noise_kernel.inc), hash lane by
  *           lane; the x86-64 baseline;
- *   AVX2    eight points, the hash chains in the integer registers, the
- *           arithmetic on 4-double vectors (target("avx2"));
+ *   AVX2    eight points, the hash chains as 32-bit gathers (vpgatherdd),
+ *           the arithmetic on 4-double vectors (target("avx2"));
  *   AVX-512 eight points in 8-double vectors, the hash chains as byte-lane
  *           table lookups (vpermi2b; F, BW, VL, DQ, VBMI).
  * Every lane performs exactly the scalar perlin()'s operations in the same
