@@ -430,10 +430,11 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     uint64_t inside = 0;
     size_t ring[RING];
     uint32_t *ringp[RING];       /* colour: the cells, */
-    const uint32_t *ringe[RING]; /* and their hits' palette entries */
+    uint32_t ringe[RING];        /* and their hits' palette indices */
     for (int q = 0; q < RING; q++)
-        ring[q] = nbins, ringp[q] = out, ringe[q] = pal[0];
+        ring[q] = nbins, ringp[q] = out, ringe[q] = 0;
     uint64_t out0 = colour != CHAOS_COLOUR_NONE ? out_hits(w, out, nbins) : 0;
+#pragma GCC unroll 2
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
         step_map2(M + 6 * (size_t)k, &x, &y);
@@ -473,13 +474,13 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
             cell = cnt + 4 * (cell_of(fy) * hw + cell_of(fx));
         PREFETCHW(cell);
         size_t slot = (size_t)(i % RING);
-        add_cell(w, cnt, ringp[slot], ringe[slot], nbins);
+        add_cell(w, cnt, ringp[slot], pal[ringe[slot]], nbins);
         ringp[slot] = cell;
-        ringe[slot] = pal[pc];
+        ringe[slot] = pc;
     }
     for (int q = 0; q < RING; q++) {
         if (colour != CHAOS_COLOUR_NONE)
-            add_cell(w, cnt, ringp[q], ringe[q], nbins);
+            add_cell(w, cnt, ringp[q], pal[ringe[q]], nbins);
         else if (ring[q] != j->nbins && wide)
             cnt64[ring[q]]++;
         else if (ring[q] != j->nbins)
