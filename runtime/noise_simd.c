@@ -38,8 +38,8 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 
 #define ALWAYS_INLINE static inline __attribute__((always_inline))
 
-/* The per-point loop: the scalar level, and every kernel's groups with a
- * point the vector path cannot take and its last few points. */
+/* The per-point loop: the scalar level, the groups with a point a vector
+ * kernel cannot take, and the last few points (noise_kernel). */
 static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
                           const double *zs, double s, double a, int mode, double *out)
 {
@@ -58,6 +58,14 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
 #undef K
 
 #ifdef NOISE_X86
+/* the end of a target region (clang spells GCC's pop_options as an
+ * attribute pop) */
+#if defined(__clang__)
+#define NOISE_TARGET_POP _Pragma("clang attribute pop")
+#else
+#define NOISE_TARGET_POP _Pragma("GCC pop_options")
+#endif
+
 /* every function from here to the pop is compiled for AVX2 (clang spells
  * GCC's push_options/target pragma as an attribute pragma) */
 #if defined(__clang__)
@@ -236,14 +244,9 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             st4(out + i + 4, ld4(out + i + 4) + a * rb);
         }
     }
-    kernel_scalar(p, n - i, xs + i, ys + i, zs + i, s, a, mode, out + i); /* the last 0..7 points */
 }
 
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+NOISE_TARGET_POP
 #endif
 
 static void kernel_sse2(const uint8_t *p, size_t n, const double *xs, const double *ys,
@@ -381,13 +384,8 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
             r = (v8d)_mm512_abs_pd((__m512d)r);
         _mm512_storeu_pd(out + i, (__m512d)((v8d)_mm512_loadu_pd(out + i) + a * r));
     }
-    kernel_scalar(p, n - i, xs + i, ys + i, zs + i, s, a, mode, out + i); /* the last 0..7 points */
 }
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+NOISE_TARGET_POP
 #endif
 
 int noise_simd_best(void)
@@ -403,17 +401,19 @@ int noise_simd_best(void)
     return NOISE_LEVEL_SSE2;
 }
 
+/* The vector kernels take whole groups (of 8, or 4 for SSE2); the last
+ * points go through the per-point loop. */
 void noise_kernel(int level, const uint8_t *p, size_t n, const double *x, const double *y,
                   const double *z, double s, double a, int mode, double *out)
 {
-    if (level == NOISE_LEVEL_SCALAR)
-        kernel_scalar(p, n, x, y, z, s, a, mode, out);
+    size_t done = 0;
+    if (level == NOISE_LEVEL_SSE2)
+        kernel_sse2(p, done = n & ~(size_t)3, x, y, z, s, a, mode, out);
 #ifdef NOISE_X86
-    else if (level == NOISE_LEVEL_AVX512)
-        kernel_avx512(p, n, x, y, z, s, a, mode, out);
     else if (level == NOISE_LEVEL_AVX2)
-        kernel_avx2(p, n, x, y, z, s, a, mode, out);
+        kernel_avx2(p, done = n & ~(size_t)7, x, y, z, s, a, mode, out);
+    else if (level == NOISE_LEVEL_AVX512)
+        kernel_avx512(p, done = n & ~(size_t)7, x, y, z, s, a, mode, out);
 #endif
-    else
-        kernel_sse2(p, n, x, y, z, s, a, mode, out);
+    kernel_scalar(p, n - done, x + done, y + done, z + done, s, a, mode, out + done);
 }
