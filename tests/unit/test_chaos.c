@@ -878,6 +878,52 @@ static void test_colour_hits(void)
     ifs_free(&f2);
 }
 
+/* The 2-D colour loop counts outside points in its outside cell (flushed
+ * like every cell after 65536 hits) and derives inside from it. Right-angled
+ * Sierpinski, window y in [0, 0.5]: a point is inside when its last map is 0
+ * or 1 (map 2 adds 0.5 to y; y = 0.5 itself is never reached), 2/3 of the
+ * points, and ~100,000 of 300,007 outside, so each worker's outside cell
+ * flushes; ±1 % is ~12 binomial standard deviations. The counts-only loop on
+ * the same orbit must see the same inside, and the counts sum to it. */
+static void test_colour_inside(void)
+{
+    rt_error e;
+    ifs f;
+    affine m[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                   affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5)};
+    CHECK(ifs_build(&f, m, 3, NULL, 0, &e) == RT_OK, "build");
+    chaos_sys s = {&f, NULL};
+    double lo[2] = {0, 0}, hi[2] = {1, 0.5};
+    for (int t = 1; t <= 2; t++)
+        for (int ch = 0; ch < 2; ch++) {
+            uint64_t inside[2];
+            for (int col = 0; col < 2; col++) {
+                hist2 hs;
+                CHECK(hist2_init(&hs, 64, 32, lo, hi, col, &e) == RT_OK, "hist");
+                chaos_opts o = {0};
+                o.points = 300007;
+                o.seed = 3;
+                o.chunk = ch ? 7 : 0; /* 7 < the ring of 32 */
+                o.colour = col ? CHAOS_COLOUR_BLEND : CHAOS_COLOUR_NONE;
+                rt_run run = {t, NULL, 0};
+                chaos_stats st;
+                CHECK(chaos_hist2(&s, &o, &hs, &st, &run, &e) == RT_OK, "chaos: %s", e.msg);
+                uint64_t sum = 0;
+                for (size_t b = 0; b < 64 * 32; b++)
+                    sum += hs.count[b];
+                CHECK(sum == st.inside, "%d thread(s), chunk %u, colour %d: counts sum to %llu, inside %llu", t,
+                      o.chunk, col, (unsigned long long)sum, (unsigned long long)st.inside);
+                CHECK(st.inside > 198000 && st.inside < 202000, "inside %llu of 300007 (2/3: 200005)",
+                      (unsigned long long)st.inside);
+                inside[col] = st.inside;
+                hist2_free(&hs);
+            }
+            CHECK(inside[0] == inside[1], "colour and counts-only loops: inside %llu and %llu",
+                  (unsigned long long)inside[1], (unsigned long long)inside[0]);
+        }
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -892,5 +938,6 @@ int main(void)
     test_fit_quantiles();
     test_no_copies();
     test_volume_inside();
+    test_colour_inside();
     return check_done("test_chaos");
 }

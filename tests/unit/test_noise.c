@@ -235,6 +235,9 @@ static void test_simd_levels(void)
     noise_perm_init(&np, 12345);
     int best = noise_simd_best();
     CHECK(best >= NOISE_LEVEL_SSE2, "an x86-64 machine has at least SSE2 (level %d)", best);
+    int bl = noise_block_level();
+    CHECK(bl == (best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR),
+          "the blocks use the best level but SSE2 (per-point loop instead): %d of best %d", bl, best);
     for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
         size_t lens[5] = {N, N - 1, N - 2, N - 5, 5};
         for (int li = 0; li < 5; li++) {
