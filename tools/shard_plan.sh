@@ -3,7 +3,7 @@
 # splits, and which it computes fully, for the table "Per example" of
 # docs/scale.md. Runs each example at its default params as shard 0 of 7
 # (`frac run --shard 0/7`, two threads), reads its part with an independent
-# reader (python3; the format of docs/scale.md) and prints one line an
+# reader (python3: tests/shard/part.py) and prints one line an
 # example:
 #   | `NAME` | CALLS | KIND (K chunks), … | `BUILTIN` (line L): WHY; … | `BUILTIN`, … |
 # the engine calls the evaluation made; the split ones from the part's
@@ -15,6 +15,7 @@
 # script's text; docs/scale.md, "What is split", says why).
 set -u
 frac=${1:-build/frac}
+here=$(cd "$(dirname "$0")/../tests/shard" && pwd)
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-plan-XXXXXX") || exit 1
 trap 'rm -rf "$tmp"' EXIT
 for s in examples/*.frac; do
@@ -24,35 +25,17 @@ for s in examples/*.frac; do
         echo "$name | FAILED: $(head -n 1 "$tmp/err")"
         continue
     fi
-    python3 - "$name" "$tmp/p/$name.shard-0-of-7.part" "$tmp/err" <<'END'
-import re, struct, sys
-name, part, err = sys.argv[1:4]
-b = open(part, 'rb').read()
-pos = 0
-def take(n):
-    global pos
-    v = b[pos:pos + n]
-    pos += n
-    return v
-def u32(): return struct.unpack('<I', take(4))[0]
-def u64(): return struct.unpack('<Q', take(8))[0]
-def sstr(): return take(u32())
-assert take(8) == b'FRACPART' and u32() == 2
-sstr(); sstr(); take(32); u64(); u32(); take(32); sstr(); u32(); u32(); u32()
+    python3 - "$name" "$tmp/p/$name.shard-0-of-7.part" "$tmp/err" "$here" <<'END'
+import re, sys
+name, path, err, here = sys.argv[1:5]
+sys.dont_write_bytecode = True  # no __pycache__ in the tree
+sys.path.insert(0, here)
+import part
+p = part.read(path)
+calls = p['calls']
 split = {}
-while True:
-    mark = take(4)
-    if mark == b'END ':
-        u32()
-        calls = u32()
-        break
-    assert mark == b'REC '
-    call, sec, op = u32(), u32(), u32()
-    kind = take(16).rstrip(b'\0').decode()
-    chunks = u64()
-    u64(); u64(); u64(); u64()
-    take(u64() + 4)
-    split.setdefault(call, (kind, chunks))
+for r in p['records']:
+    split.setdefault(r['call'], (r['kind'], r['chunks']))
 # the full calls: grouped by where they were made and why
 full = {}
 for line in open(err):

@@ -4,38 +4,31 @@
 # tests/shard/fake_sbatch.sh stands in for it on PATH (sbatch queues the
 # jobs; then the emulated cluster runs a job array's script once a task with
 # the variables Slurm sets, and a job with --dependency=afterok only once
-# the array has ended well, the last submitted first; see its header). What is tested is the recipe and `--shard auto` under
-# Slurm's variables, not Slurm. The recipe's job script (render.sbatch) and
-# its two submission lines render tests/shard/small.frac (copied as
-# scene.frac) as the array's shards and merge them in the dependent job;
-# every file of out/ must equal the single run's, byte for byte, parts/ must
-# hold one part a task, and every job must have ended with exit code 0
-# (tests/cli/shard_slurm.cli). Prints "slurm (emulated sbatch): ok N=…";
-# exits non-zero on a failure.
+# the array has ended well, the last submitted first; see its header).
+# What is tested is the recipe and `--shard auto` under Slurm's variables,
+# not Slurm. The recipe's job script (render.sbatch) and its two submission
+# lines render tests/shard/small.frac (copied as scene.frac) as the array's
+# shards and merge them in the dependent job; every file of out/ must equal
+# the single run's, byte for byte, parts/ must hold one part a task, and
+# every job must have ended with exit code 0 (tests/cli/shard_slurm.cli).
+# Prints "slurm (emulated sbatch): ok N=…"; exits non-zero on a failure.
 set -u
 frac=${FRAC:-frac}
 here=$(cd "$(dirname "$0")" && pwd)
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-slurm-XXXXXX") || exit 1
-trap 'rm -rf "$tmp"' EXIT
+. "$here/recipe.sh"
 fail() { echo "slurm (emulated sbatch): FAIL ($*)"; exit 1; }
-# the recipe calls `frac` and `sbatch`: the frac under test and the emulation
-bin=$(mktemp -d "$tmp/bin-XXXXXX") || exit 1
-ln -s "$(command -v "$frac")" "$bin/frac" && ln -s "$here/fake_sbatch.sh" "$bin/sbatch" || exit 1
-PATH=$bin:$PATH
+recipe_setup slurm
+# the recipe calls `sbatch`: the emulation, next to the frac under test
+ln -s "$here/fake_sbatch.sh" "$bin/sbatch" || exit 1
 FAKE_SLURM_STATE=$tmp/slurm
-export PATH FAKE_SLURM_STATE
+export FAKE_SLURM_STATE
 # a task sees Slurm's variables only, as in a job (none of another launcher's)
 unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
 unset SLURM_CPUS_PER_TASK OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
-cp "$here/small.frac" "$tmp/scene.frac" && cd "$tmp" || exit 1
+cp "$here/small.frac" scene.frac || exit 1
 frac -q -o single scene.frac || exit 1
-# the sh block after the line naming this file and WORDS in docs/scale.md
-block() {
-    awk -v m="$1" 'index($0, m) { on = 1; next } on && /^```sh/ { inb = 1; next }
-         inb && /^```/ { exit } inb { print }' "$here/../../docs/scale.md"
-}
-block "tests/shard/slurm.sh runs this block as render.sbatch" >render.sbatch
-block "tests/shard/slurm.sh runs these two lines" >submit.sh
+recipe_block "tests/shard/slurm.sh runs this block as render.sbatch" >render.sbatch
+recipe_block "tests/shard/slurm.sh runs these two lines" >submit.sh
 grep -q '^#SBATCH --array=' render.sbatch || fail "no job array script in docs/scale.md"
 grep -q '^sbatch ' submit.sh || fail "no sbatch lines in docs/scale.md"
 # the array's size from its --array=A-B line: the recipe's N
@@ -53,14 +46,6 @@ for j in slurm/*.job; do
 done
 [ "$(ls slurm/*.job | wc -l)" -eq 2 ] || fail "$(ls slurm/*.job | wc -l) jobs submitted, not 2"
 [ "$(ls slurm-*_*.out | wc -l)" -eq "$n" ] || fail "$(ls slurm-*_*.out | wc -l) array tasks ran, not $n"
-i=0
-while [ "$i" -lt "$n" ]; do
-    [ -f "parts/scene.shard-$i-of-$n.part" ] || fail "no part of shard $i of $n"
-    i=$((i + 1))
-done
-[ "$(ls parts | wc -l)" -eq "$n" ] || fail "parts/ holds $(ls parts | tr '\n' ' ')"
-[ "$(ls single)" = "$(ls out)" ] || fail "out/ holds $(ls out | tr '\n' ' '), the single run $(ls single | tr '\n' ' ')"
-for f in $(ls single); do
-    cmp -s "single/$f" "out/$f" || fail "$f differs"
-done
+why=$(recipe_parts "$n") || fail "$why"
+why=$(recipe_same single out) || fail "$why"
 echo "slurm (emulated sbatch): ok N=$n, the recipe of docs/scale.md, $(ls out | wc -l) files as the single run"
