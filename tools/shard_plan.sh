@@ -1,10 +1,11 @@
 #!/bin/sh
-# shard_plan.sh [FRAC] — which engine calls of every examples/*.frac a shard
-# splits, and which it computes fully, for the table "Per example" of
-# docs/scale.md. Runs each example at its default params as shard 0 of 7
-# (`frac run --shard 0/7`, two threads), reads its part with an independent
-# reader (python3: tests/shard/part.py) and prints one line an
-# example:
+# shard_plan.sh [FRAC [EXAMPLE.frac…]] — which engine calls of every
+# examples/*.frac (or of the EXAMPLEs given) a shard splits, and which it
+# computes fully: the rows of the table "Per example" of docs/scale.md
+# (tests/shard/plan_doc.sh checks them). Runs each example at its default
+# params as shard 0 of 7 (`frac run --shard 0/7`, two threads), reads its
+# part with an independent reader (python3: tests/shard/part.py) and prints
+# one row an example:
 #   | `NAME` | CALLS | KIND (K chunks), … | `BUILTIN` (line L): WHY; … | `BUILTIN`, … |
 # the engine calls the evaluation made; the split ones from the part's
 # records, by kind with their chunk counts (at most that many shards share
@@ -15,19 +16,21 @@
 # script's text; docs/scale.md, "What is split", says why).
 set -u
 frac=${1:-build/frac}
+[ $# -gt 0 ] && shift
+[ $# -gt 0 ] || set -- examples/*.frac
 here=$(cd "$(dirname "$0")/../tests/shard" && pwd)
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-plan-XXXXXX") || exit 1
 trap 'rm -rf "$tmp"' EXIT
-for s in examples/*.frac; do
+for s in "$@"; do
     name=$(basename "$s" .frac)
     rm -rf "$tmp/p"
     if ! "$frac" run --threads 2 --shard 0/7 -o "$tmp/p" "$s" >/dev/null 2>"$tmp/err"; then
         echo "$name | FAILED: $(head -n 1 "$tmp/err")"
         continue
     fi
-    python3 - "$name" "$tmp/p/$name.shard-0-of-7.part" "$tmp/err" "$here" <<'END'
+    python3 - "$name" "$tmp/p/$name.shard-0-of-7.part" "$tmp/err" "$here" "$s" <<'END'
 import re, sys
-name, path, err, here = sys.argv[1:5]
+name, path, err, here, script = sys.argv[1:6]
 sys.dont_write_bytecode = True  # no __pycache__ in the tree
 sys.path.insert(0, here)
 import part
@@ -56,7 +59,7 @@ fulls = ['`%s` (line %d%s): %s' % (callee, l, ', %d calls' % len(v) if len(v) > 
 # the engines that make no engine call: never split (docs/scale.md, "What is split")
 never = ['superifs', 'superifs_image', 'iterate', 'draw', 'ist', 'ist_lists', 'ist_inv', 'wrinkly_draw',
          'wrinkly_points', 'fractal', 'fit', 'tiling', 'tile']
-code = '\n'.join(l.split('#')[0] for l in open('examples/%s.frac' % name))
+code = '\n'.join(l.split('#')[0] for l in open(script))
 used = [n for n in never if re.search(r'\b%s\(' % n, code)]
 kinds = {}
 for call, (kind, chunks) in sorted(split.items()):
