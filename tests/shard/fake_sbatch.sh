@@ -44,7 +44,6 @@ state=${FAKE_SLURM_STATE:?fake sbatch: FAKE_SLURM_STATE (its state folder) is no
 me="sbatch (emulated)"
 die() { echo "$me: error: $*" >&2; exit 1; }
 
-
 # ---- the queue (fake_sbatch.sh --run-queue): the stand-in for the cluster
 end() { echo "$2" >"$state/$1.end.tmp" && mv "$state/$1.end.tmp" "$state/$1.end"; }
 task() { # TASK_JOB_ID OUTPUT [ARRAY_TASK_ID], then the script's arguments
