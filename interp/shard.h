@@ -42,7 +42,8 @@
 #include "par.h"
 #include "state.h"
 
-#define SHARD_FORMAT 2
+#define SHARD_FORMAT 3
+#define SHARD_OP_WINDOW 4 /* a record's op: the window fitted for its call (after the par_part_op ones) */
 #define SHARD_MAX_FULL 4096
 #define SHARD_MAX_PARTS 65536
 
@@ -74,6 +75,10 @@ typedef struct shard {
     uint32_t sub;         /* its next section */
     size_t cur_nchunks;
     char cur_kind[16];
+    long win_seq;         /* shard: the call the window below was fitted for; -1 none */
+    int win_dim;          /* its dimension; 0 after a second fit for the same call (none recorded) */
+    double win[6];        /* lo[dim], hi[dim] */
+    long win_taken;       /* merge: the call whose window was taken from the parts; -1 none */
     bytebuf part;         /* shard: the part file being built */
     uint32_t nrec;
     FILE *devnull;        /* shard: print() goes nowhere (merge prints) */
@@ -117,6 +122,14 @@ int shard_after_builtin(interp *I, int rc, value *out);
  * replaced by a partial value, so a binding may skip finishing it (tone
  * mapping a histogram nobody will see). */
 int shard_pending(const interp *I);
+/* Windows fitted for the next engine call (the pre-pass finding an
+ * attractor's bounds, lang_chaos_fit_call). In a shard, put notes lo and hi
+ * (dim values each); if that call is split, its part gets a window record
+ * after the call's sections (two fits before one call: none). In merge,
+ * take returns 1 with the shards' window in lo, hi when the parts hold one
+ * for the next call (the binding then skips its pre-pass), else 0. */
+void shard_window_put(interp *I, int dim, const double *lo, const double *hi);
+int shard_window_take(interp *I, int dim, double *lo, double *hi);
 /* save(v, …) in a shard: writes nothing (1: handled), 0 otherwise. */
 int shard_skip_save(interp *I);
 

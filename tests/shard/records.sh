@@ -28,7 +28,7 @@ def take(n):
 def u32(): return struct.unpack('<I', take(4))[0]
 def u64(): return struct.unpack('<Q', take(8))[0]
 def sstr(): return take(u32())
-assert take(8) == b'FRACPART' and u32() == 2
+assert take(8) == b'FRACPART' and u32() == 3
 sstr(); sstr(); take(32); u64(); u32(); take(32); sstr(); u32(); u32(); u32()
 while True:
     mark = take(4)
