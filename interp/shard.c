@@ -1350,6 +1350,23 @@ int shard_pending(const interp *I)
     return I->shard && !I->shard->merging && I->shard->pending >= 0;
 }
 
+long shard_pending_call(const interp *I, const node **at)
+{
+    if (!shard_pending(I))
+        return -1;
+    *at = I->shard->pending_at;
+    return I->shard->pending;
+}
+
+void shard_pend_again(interp *I, long seq, const node *at)
+{
+    shard *s = I->shard;
+    if (!s || s->merging || s->pending >= 0)
+        return;
+    s->pending = seq;
+    s->pending_at = at;
+}
+
 int shard_skip_save(interp *I)
 {
     return I->shard && !I->shard->merging;

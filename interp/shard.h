@@ -122,6 +122,15 @@ int shard_after_builtin(interp *I, int rc, value *out);
  * replaced by a partial value, so a binding may skip finishing it (tone
  * mapping a histogram nobody will see). */
 int shard_pending(const interp *I);
+/* In a shard, the split engine call whose partial result the current
+ * builtin will return (-1: none) and in *at where it was made — for a value
+ * computed lazily and kept (superifs_image keeps the super IFS's points). */
+long shard_pending_call(const interp *I, const node **at);
+/* The current builtin's result is drawn from split call seq's partial
+ * result (made at `at`), kept from an earlier builtin: it becomes a partial
+ * value of that call too (used elsewhere, the call is made full and the
+ * script re-run). */
+void shard_pend_again(interp *I, long seq, const node *at);
 /* Windows fitted for the next engine call (the pre-pass finding an
  * attractor's bounds, lang_chaos_fit_call). In a shard, put notes lo and hi
  * (dim values each); if that call is split, its part gets a window record
