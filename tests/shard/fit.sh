@@ -6,12 +6,16 @@
 # chaos_fit in tests/shard/small.frac (chaos) and fset_chaos_fit in
 # tests/shard/fit_fset.frac (chaos_fset) (tests/cli/shard_fit.cli). Prints
 # "fit: ok …" per script and exits 0, or says what is wrong and exits 1;
-# "fit: skipped (…)" without valgrind.
+# "fit: skipped (…)" without valgrind or for an ASan build.
 set -u
 frac=${FRAC:-frac}
 here=$(dirname "$0")
 if ! command -v valgrind >/dev/null 2>&1; then
     echo "fit: skipped (valgrind is not installed to count the pre-pass's instructions)"
+    exit 0
+fi
+if nm "$(command -v "$frac")" 2>/dev/null | grep -q __asan_init; then
+    echo "fit: skipped (an AddressSanitizer build, which valgrind cannot run)"
     exit 0
 fi
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-fit-XXXXXX") || exit 1
