@@ -25,7 +25,10 @@
  * nothing, when one is wrong. Then it evaluates the script: call k with a
  * record takes its accumulator from the parts — sums added, rows placed,
  * streamed part by part, never N copies — and finishes as in a single run;
- * call k without a record (a full call) is computed. The format is in
+ * call k without a record (a full call) is computed. A split call whose
+ * builtin fitted a window first (the pre-pass of chaos, measure, …) has one
+ * more record after its sections, the window as doubles: the merge takes it
+ * instead of fitting (shard_window_put/take). The format is in
  * docs/scale.md.
  *
  * The struct lives on main's stack across the attempts (no heap of its own
