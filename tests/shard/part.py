@@ -32,8 +32,8 @@ def read(path):
     def sstr():
         return take(u32())
 
-    if take(8) != b'FRACPART' or u32() != 2:
-        raise ValueError('%s: not a part file of format 2' % path)
+    if take(8) != b'FRACPART' or u32() != 3:
+        raise ValueError('%s: not a part file of format 3' % path)
     p = {'version': sstr().decode(), 'hash_name': sstr().decode(), 'hash': take(32), 'seed': u64()}
     p['frames'] = u32()
     p['frame'], p['first'], p['last'], p['step'] = struct.unpack('<4q', take(32))
