@@ -12,7 +12,7 @@
 # a call); the ones computed fully in every shard from frac's notes (each
 # names the call, where it was made and why its result must be whole); and
 # the builtins of the script that make no engine call at all, so are never
-# split (super IFS, iterate/draw, the IST, … : a fixed list, found in the
+# split (iterate/draw, the IST, … : a fixed list, found in the
 # script's text; docs/scale.md, "What is split", says why).
 set -u
 frac=${1:-build/frac}
@@ -57,7 +57,7 @@ for line in open(err):
 fulls = ['`%s` (line %d%s): %s' % (callee, l, ', %d calls' % len(v) if len(v) > 1 else '', why)
          for (l, callee, why), v in sorted(full.items())]
 # the engines that make no engine call: never split (docs/scale.md, "What is split")
-never = ['superifs', 'superifs_image', 'iterate', 'draw', 'ist', 'ist_lists', 'ist_inv', 'wrinkly_draw',
+never = ['iterate', 'draw', 'ist', 'ist_lists', 'ist_inv', 'wrinkly_draw',
          'wrinkly_points', 'fractal', 'fit', 'tiling', 'tile']
 code = '\n'.join(l.split('#')[0] for l in open(script))
 used = [n for n in never if re.search(r'\b%s\(' % n, code)]
@@ -70,6 +70,6 @@ def chunks(v):
     return '/'.join(str(c) for c in v) + ' chunks'
 sp = ', '.join('%s%s (%s)' % (k, ' ×%d' % len(v) if len(v) > 1 else '', chunks(v)) for k, v in kinds.items())
 print('| `%s` | %d | %s | %s | %s |' % (name, calls, sp or '—', '; '.join(fulls) or '—',
-      ', '.join('`%s`%s' % (n, ' (full today)' if n.startswith('superifs') else '') for n in used) or '—'))
+      ', '.join('`%s`' % n for n in used) or '—'))
 END
 done
