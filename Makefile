@@ -62,6 +62,11 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libfracrt.a tests/unit/check.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
 
+# test_fileio_fsync sees (and fails) every fsync of the runtime through --wrap.
+$(BUILD)/tests/test_fileio_fsync: tests/unit/test_fileio_fsync.c $(BUILD)/libfracrt.a tests/unit/check.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -Wl,--wrap=fsync -o $@
+
 # test_lexer compiles interp/lexer.c into itself (the scanner needs only rt_alloc)
 $(BUILD)/tests/test_lexer: interp/lexer.c interp/lexer.h
 
