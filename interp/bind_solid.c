@@ -657,7 +657,8 @@ static const builtin solid_builtins[] = {
             "The 3-D random fractal D(P) of seed 000 (midpoint displacement to level R, L(n) = exp(-(n-1) beta)) "
             "as a field over the box lo..hi, trilinear between lattice nodes. strategy: \"auto\", 1 (Type I: whole "
             "array), 2 (Type II: memoised parents), 3 (Type III: octree descent), 4 (Type IV: array to level R2, "
-            "descent below); all give identical values. corners: 8 numbers (index x + 2y + 4z) or one."),
+            "descent below); all give identical values. Arrays count against --max-memory and --max-voxels (a lattice "
+            "node is a voxel); \"auto\" picks within both. corners: 8 numbers (index x + 2y + 4z) or one."),
     BUILTIN("fractal_memory", b_fractal_memory, p_fmem,
             "Bytes each strategy needs at level R: {type1, type3, type4, R2, nodes} (Type IV with array level R2; "
             "default: the automatic choice)."),
