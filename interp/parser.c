@@ -26,6 +26,8 @@ typedef struct parser {
     int failed;
     int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
     const struct oprow *row[2][T_COUNT]; /* ops[] indexed by fix and token (op_index) */
+    struct pending *items; /* the open lists' items (nodevec), reused for every list */
+    size_t nitems, cap_items;
 } parser;
 
 /* ---- token access ---------------------------------------------------------- */
@@ -286,42 +288,77 @@ static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
     return n;
 }
 
+/* The items of a list being parsed (arguments, parameters, fields, rows,
+ * entries, statements) wait on one stack in the parser, and only the finished
+ * list is copied into the arena at its exact size (nv_close), so no array is
+ * left in the syntax tree half empty or outgrown. Lists nest last in, first
+ * out: an inner list is closed before its outer list takes its next item. */
+typedef struct pending {
+    node *n;
+    const char *name;
+} pending;
+
 typedef struct nodevec {
-    node **v;
-    const char **names;
-    int n, cap;
+    size_t base; /* its first item in p->items */
+    int n;
 } nodevec;
 
-static int nv_grow(parser *p, nodevec *nv);
+static inline nodevec nv_open(const parser *p) { return (nodevec){p->nitems, 0}; }
+
+static int nv_grow(parser *p);
 
 static inline int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
-    if (nv->n == nv->cap && nv_grow(p, nv))
+    if (p->nitems == p->cap_items && nv_grow(p))
         return -1;
-    nv->v[nv->n] = n;
-    nv->names[nv->n] = name;
+    p->items[p->nitems++] = (pending){n, name};
     nv->n++;
     return 0;
 }
 
-/* Double a nodevec's room (the old arrays stay in the arena). */
-static int nv_grow(parser *p, nodevec *nv)
+static inline const pending *nv_item(const parser *p, const nodevec *nv, int i) { return &p->items[nv->base + (size_t)i]; }
+
+/* Double the stack (through the allocation hook; freed by parse_source). */
+static int nv_grow(parser *p)
 {
-    int nc = nv->cap ? nv->cap * 2 : 8;
-    /* the nodes, then the names, in one piece; items past n are never read */
-    node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
+    size_t nc = p->cap_items ? p->cap_items * 2 : 256;
+    pending *a = mem_realloc(p->I, p->items, nc * sizeof *a);
     if (!a) {
         p->failed = 1;
         return -1;
     }
-    const char **b = (const char **)(a + nc);
-    if (nv->n) {
-        memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
-        memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
+    p->items = a;
+    p->cap_items = nc;
+    return 0;
+}
+
+/* Move a list's items into the arena after `lead` leading slots (a call's
+ * callee), as kids and, when names is not NULL, their names in the same
+ * piece; pops them. An empty list with no lead has NULL arrays. */
+static int nv_close(parser *p, nodevec *nv, int lead, node ***kids, const char ***names)
+{
+    size_t k = (size_t)lead + (size_t)nv->n;
+    *kids = NULL;
+    if (names)
+        *names = NULL;
+    if (k) {
+        node **a = mem_arena_raw(p->I, k * (names ? sizeof(node *) + sizeof(char *) : sizeof(node *)));
+        if (!a) {
+            p->failed = 1;
+            return -1;
+        }
+        const pending *it = &p->items[nv->base];
+        for (int i = 0; i < nv->n; i++)
+            a[lead + i] = it[i].n;
+        if (names) {
+            const char **b = (const char **)(a + k);
+            for (int i = 0; i < nv->n; i++)
+                b[lead + i] = it[i].name;
+            *names = b;
+        }
+        *kids = a;
     }
-    nv->v = a;
-    nv->names = b;
-    nv->cap = nc;
+    p->nitems = nv->base;
     return 0;
 }
 
@@ -566,16 +603,10 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * (sizeof(node *) + sizeof(char *)));
-    if (!c->kids)
+    if (nv_close(p, args, 1, &c->kids, &c->names))
         return NULL;
-    c->names = (const char **)(c->kids + c->nkids);
     c->kids[0] = callee;
     c->names[0] = NULL;
-    for (int i = 0; i < args->n; i++) {
-        c->kids[i + 1] = args->v[i];
-        c->names[i + 1] = args->names[i];
-    }
     return c;
 }
 
@@ -591,7 +622,7 @@ static node *parse_postfix(parser *p, node *e)
         if (p->table_mode && t->space_before)
             return e;
         if (t->type == T_LPAREN) {
-            nodevec args = {0};
+            nodevec args = nv_open(p);
             if (parse_args(p, &args))
                 return NULL;
             e = make_call(p, e, &args, t);
@@ -621,7 +652,7 @@ static node *parse_postfix(parser *p, node *e)
             node *arg = parse_brace(p);
             if (!arg)
                 return NULL;
-            nodevec args = {0};
+            nodevec args = nv_open(p);
             if (nv_push(p, &args, arg, NULL))
                 return NULL;
             e = make_call(p, e, &args, t);
@@ -647,7 +678,7 @@ static int parse_param(parser *p, void *ctx)
     next(p);
     const char *name = tok_name(p, t);
     for (int i = 0; i < params->n; i++)
-        if (params->names[i] == name) {
+        if (nv_item(p, params, i)->name == name) {
             syntax_error(p, t, "duplicate parameter '%s'", name);
             return -1;
         }
@@ -655,7 +686,7 @@ static int parse_param(parser *p, void *ctx)
     if (match(p, T_ASSIGN)) {
         if (!(def = parse_expr(p)))
             return -1;
-    } else if (params->n && params->v[params->n - 1]) {
+    } else if (params->n && nv_item(p, params, params->n - 1)->n) {
         syntax_error(p, t, "parameter '%s' without a default follows one with a default", name);
         return -1;
     }
@@ -678,8 +709,8 @@ static node *make_lambda(parser *p, const token *at, nodevec *params, node *body
         return NULL;
     l->nparams = params->n;
     l->nkids = params->n;
-    l->kids = params->v;
-    l->names = params->names;
+    if (nv_close(p, params, 0, &l->kids, &l->names))
+        return NULL;
     l->body = body;
     l->str = name;
     return l;
@@ -691,7 +722,7 @@ static node *parse_lambda_rest(parser *p, const token *at, const char *name)
     const token *save_c = p->construct;
     if (at->type == T_FN)
         p->construct = at;
-    nodevec params = {0};
+    nodevec params = nv_open(p);
     if (parse_params(p, &params))
         return NULL;
     node *body;
@@ -761,7 +792,7 @@ static int parse_field(parser *p, void *ctx)
     if (!v)
         return -1;
     for (int j = 0; j < fields->n; j++)
-        if (fields->names[j] == key) {
+        if (nv_item(p, fields, j)->name == key) {
             syntax_error(p, k, "duplicate field '%s' in record", key);
             return -1;
         }
@@ -783,22 +814,21 @@ static node *parse_brace(parser *p)
     node *n;
     if (is_record) {
         n = mk(p, N_RECORD, open);
-        nodevec fields = {0};
+        nodevec fields = nv_open(p);
         if (n && !parse_comma_list(p, open, T_RBRACE, parse_field, &fields)) {
-            n->kids = fields.v;
-            n->names = fields.names;
             n->nkids = fields.n;
+            nv_close(p, &fields, 0, &n->kids, &n->names);
         }
     } else {
         /* table: rows separated by newlines or ';', entries by white space or ',' */
         p->skip_nl = 0;
         n = mk(p, N_TABLE, open);
-        nodevec rows = {0};
+        nodevec rows = nv_open(p);
         skip_newlines(p);
         while (n && !p->failed && !check(p, T_RBRACE) && !check(p, T_EOF)) {
             token *rt = peek(p);
             node *row = mk(p, N_ROW, rt);
-            nodevec entries = {0};
+            nodevec entries = nv_open(p);
             while (row && !p->failed) {
                 tok_type t = peek_raw(p)->type;
                 if (t == T_NEWLINE || t == T_SEMI || t == T_RBRACE || t == T_EOF)
@@ -812,16 +842,15 @@ static node *parse_brace(parser *p)
             }
             if (p->failed || !row)
                 break;
-            row->kids = entries.v;
             row->nkids = entries.n;
-            if (nv_push(p, &rows, row, NULL))
+            if (nv_close(p, &entries, 0, &row->kids, NULL) || nv_push(p, &rows, row, NULL))
                 break;
             skip_newlines(p);
         }
         if (n && !p->failed) {
             expect_close(p, T_RBRACE, open);
-            n->kids = rows.v;
             n->nkids = rows.n;
+            nv_close(p, &rows, 0, &n->kids, NULL);
         }
     }
     restore_mode(p, m);
@@ -873,12 +902,13 @@ static int parse_list_item(parser *p, void *ctx)
 static node *parse_list(parser *p)
 {
     token *open = next(p);
-    list_ctx c = {mk(p, N_LIST, open), {0}};
+    list_ctx c = {mk(p, N_LIST, open), nv_open(p)};
     if (!c.n || parse_comma_list(p, open, T_RBRACKET, parse_list_item, &c))
         return NULL;
     if (c.n->kind == N_LIST) {
-        c.n->kids = c.items.v;
         c.n->nkids = c.items.n;
+        if (nv_close(p, &c.items, 0, &c.n->kids, NULL))
+            return NULL;
     }
     return c.n;
 }
@@ -963,7 +993,7 @@ static node *parse_name(parser *p)
     if (peek2(p)->type == T_ARROW && !p->table_mode) {
         next(p);
         next(p);
-        nodevec params = {0};
+        nodevec params = nv_open(p);
         if (nv_push(p, &params, NULL, tok_name(p, t)))
             return NULL;
         node *body = parse_expr(p);
@@ -981,7 +1011,7 @@ static node *parse_paren(parser *p)
 {
     token *t = peek(p);
     if (is_paren_lambda(p)) {
-        nodevec params = {0};
+        nodevec params = nv_open(p);
         if (parse_params(p, &params) || expect(p, T_ARROW, "after the parameter list"))
             return NULL;
         node *body = parse_expr(p);
@@ -1051,7 +1081,7 @@ static node *parse_subexpr(parser *p, int level);
  * argument, `x |> f(a)` is `f(x, a)` and `x |> f` is `f(x)` */
 static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 {
-    nodevec args = {0};
+    nodevec args = nv_open(p);
     if (nv_push(p, &args, left, NULL))
         return NULL;
     if (rhs->kind != N_CALL)
@@ -1308,7 +1338,7 @@ static node *parse_block_until(parser *p, const token *open)
 {
     parse_mode m = enter_mode(p, 0);
     node *b = mk(p, N_BLOCK, open ? open : &p->tl.toks[0]);
-    nodevec stmts = {0};
+    nodevec stmts = nv_open(p);
     for (;;) {
         skip_newlines(p);
         tok_type t = peek_raw(p)->type;
@@ -1333,9 +1363,8 @@ static node *parse_block_until(parser *p, const token *open)
     restore_mode(p, m);
     if (p->failed || !b)
         return NULL;
-    b->kids = stmts.v;
     b->nkids = stmts.n;
-    return b;
+    return nv_close(p, &stmts, 0, &b->kids, NULL) ? NULL : b;
 }
 
 int parse_source(interp *I, int src, node **out)
@@ -1356,6 +1385,7 @@ int parse_source(interp *I, int src, node **out)
     p.cur = p.tl.toks;
     node *b = parse_block_until(&p, NULL);
     lex_free(&p.tl);
+    mem_free(I, p.items);
     if (!b || p.failed) {
         if (!I->err.active)
             err_pos(I, src, 1, 1, ERR_MEMORY, "out of memory while parsing");
