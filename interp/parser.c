@@ -16,8 +16,8 @@
 #include "lexer.h"
 
 /* A token kept by value, with its number in the script (tokens are numbered
- * from 0), for what must outlive the window: the constructs and brackets an
- * error at the end of the input names. */
+ * from 0), for what must outlive the window: the construct an error at the
+ * end of the input names. */
 typedef struct tokmark {
     token t;
     size_t at;
@@ -47,11 +47,6 @@ typedef struct parser {
     size_t base;
     token first;    /* the script's first token (the top block's position) */
     token eof;      /* the rest of the input when the window could not move */
-    /* the brackets and 'do's still open after the tokens lexed so far, for
-     * an error at the end of the input (innermost MAX_OPEN of them) */
-    tokmark open[MAX_OPEN];
-    int nopen;
-    size_t deeper;
     int skip_nl;    /* newlines are insignificant here */
     int table_mode; /* parsing an entry of a table row */
     int closing;    /* the error being reported is a missing closer */
@@ -83,33 +78,17 @@ static inline void advance(parser *p)
         fill(p, 0);
 }
 
+/* +1 for the tokens that open a bracket or block, -1 for those that close one */
+static const signed char nesting[T_COUNT] = {
+    [T_LPAREN] = 1, [T_LBRACKET] = 1, [T_LBRACE] = 1, [T_DO] = 1,
+    [T_RPAREN] = -1, [T_RBRACKET] = -1, [T_RBRACE] = -1, [T_END] = -1,
+};
+
+static int is_opener(tok_type k) { return nesting[k] > 0; }
+
 static inline size_t tok_number(const parser *p, const token *t) { return p->base + (size_t)(t - p->buf); }
 
 static tokmark mark(const parser *p, const token *t) { return (tokmark){*t, tok_number(p, t)}; }
-
-static int is_opener(tok_type k) { return k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO; }
-
-static int is_closer(tok_type k) { return k == T_RPAREN || k == T_RBRACKET || k == T_RBRACE || k == T_END; }
-
-/* The innermost bracket or 'do' still open after the new tokens from..end
- * (closers pop whatever is open, so a mismatch is reported elsewhere). */
-static void track_open(parser *p, const token *from)
-{
-    for (const token *t = from; t < p->end; t++) {
-        tok_type k = t->type;
-        if (is_opener(k)) {
-            if (p->nopen < MAX_OPEN)
-                p->open[p->nopen++] = mark(p, t);
-            else
-                p->deeper++;
-        } else if (is_closer(k)) {
-            if (p->deeper)
-                p->deeper--;
-            else if (p->nopen)
-                p->nopen--;
-        }
-    }
-}
 
 /* The window could not grow, or the lexer ran out of memory: the parser
  * sees the end of the input and reports nothing more (failed); parse_source
@@ -159,7 +138,6 @@ static token *fill(parser *p, size_t k)
         if (got < 0)
             return window_failed(p);
         p->end += got;
-        track_open(p, from);
     }
     return p->cur + k;
 }
@@ -174,7 +152,17 @@ static inline token *peek(parser *p)
     return p->cur;
 }
 
-static token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
+static token *peek2_slow(parser *p);
+
+static inline token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
+{
+    token *t = p->cur;
+    if (t + 1 < p->end && t->type != T_NEWLINE && t->type != T_EOF && t[1].type != T_NEWLINE)
+        return t + 1;
+    return peek2_slow(p);
+}
+
+static token *peek2_slow(parser *p)
 {
     size_t k = 0;
     if (p->skip_nl)
@@ -223,6 +211,40 @@ static void skip_newlines(parser *p)
         advance(p);
 }
 
+/* The innermost bracket or 'do' still open at the end of the input (closers
+ * pop whatever is open, so a mismatch is reported elsewhere): 1 and *out, or
+ * 0 if none. Only an error at the end of the input asks, so the text is lexed
+ * again from its start rather than the parser tracking every token. */
+static int innermost_open(const parser *p, tokmark *out)
+{
+    lexer L;
+    lex_init(&L, p->lx.text, p->lx.src, p->lx.first_line);
+    tokmark stack[MAX_OPEN];
+    size_t n = 0, deeper = 0, num = 0;
+    token batch[256];
+    int got;
+    while ((got = lex_next(&L, batch, (int)(sizeof batch / sizeof batch[0]))) > 0) {
+        for (int i = 0; i < got; i++, num++) {
+            int d = nesting[batch[i].type];
+            if (d > 0) {
+                if (n < MAX_OPEN)
+                    stack[n++] = (tokmark){batch[i], num};
+                else
+                    deeper++;
+            } else if (d < 0) {
+                if (deeper)
+                    deeper--;
+                else if (n)
+                    n--;
+            }
+        }
+    }
+    if (got < 0 || !n) /* out of memory (a long number literal): no note */
+        return 0;
+    *out = stack[n - 1];
+    return 1;
+}
+
 static void note_opened_here(parser *p, const token *open)
 {
     err_state *e = &p->I->err;
@@ -251,7 +273,8 @@ static int syntax_error(parser *p, const token *t, const char *fmt, const char *
         p->I->err.incomplete = 1;
         /* input that ends inside a construct names where it opened (an
          * expected closer says so itself, see expect_close) */
-        const tokmark *open = p->closing || !p->nopen ? NULL : &p->open[p->nopen - 1];
+        tokmark opened;
+        const tokmark *open = !p->closing && innermost_open(p, &opened) ? &opened : NULL;
         const tokmark *c = p->closing || p->construct.at == NO_TOKEN ? NULL : &p->construct;
         if (c && (!open || c->at > open->at)) {
             err_state *e = &p->I->err;
@@ -594,15 +617,18 @@ static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : 
 
 /* The infix operator at the next token, or NULL. In a table row a '+' or '-' with space
  * before it and none after starts a new entry instead (`1 -2`). */
-static const oprow *infix_at(parser *p)
+static const oprow *infix_in_row(parser *p, const oprow *r)
+{
+    const token *after = ahead(p, 1);
+    return !after->space_before && after->type != T_NEWLINE ? NULL : r;
+}
+
+static inline const oprow *infix_at(parser *p)
 {
     const token *t = peek(p);
     const oprow *r = op_row(p, t->type, INFIX);
-    if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
-        const token *after = ahead(p, 1);
-        if (!after->space_before && after->type != T_NEWLINE)
-            return NULL;
-    }
+    if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before)
+        return infix_in_row(p, r);
     return r;
 }
 
