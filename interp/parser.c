@@ -489,13 +489,16 @@ static int nv_close(parser *p, nodevec *nv, int lead, node ***kids, const char *
             return -1;
         }
         const pending *it = &p->items[nv->base];
-        for (int i = 0; i < nv->n; i++)
-            a[lead + i] = it[i].n;
         if (names) {
             const char **b = (const char **)(a + k);
-            for (int i = 0; i < nv->n; i++)
+            for (int i = 0; i < nv->n; i++) {
+                a[lead + i] = it[i].n;
                 b[lead + i] = it[i].name;
+            }
             *names = b;
+        } else {
+            for (int i = 0; i < nv->n; i++)
+                a[lead + i] = it[i].n;
         }
         *kids = a;
     }
@@ -763,11 +766,16 @@ static node *parse_brace(parser *p);
 static node *parse_postfix(parser *p, node *e)
 {
     for (;;) {
-        token t = *peek_raw(p);
-        if (p->skip_nl && t.type == T_NEWLINE)
-            t = *peek(p);
-        if (p->table_mode && t.space_before)
+        const token *at = peek_raw(p);
+        if (p->skip_nl && at->type == T_NEWLINE)
+            at = peek(p);
+        if (p->table_mode && at->space_before)
             return e;
+        tok_type k = at->type;
+        if (k != T_LPAREN && k != T_LBRACKET && k != T_DOT &&
+            !(k == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)))
+            return e;
+        token t = *at; /* kept: the window may move on while the suffix is parsed */
         if (t.type == T_LPAREN) {
             nodevec args = nv_open(p);
             if (parse_args(p, &args))
@@ -803,8 +811,6 @@ static node *parse_postfix(parser *p, node *e)
             if (nv_push(p, &args, arg, NULL))
                 return NULL;
             e = make_call(p, e, &args, &t);
-        } else {
-            return e;
         }
         if (!e)
             return NULL;
