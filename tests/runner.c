@@ -949,39 +949,59 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
 }
 
 /* ---- allocation failure ----------------------------------------------------------
- * Run a script failing the N-th allocation, for every N until the script no
- * longer runs out: each run must end with exit 70 and an "out of memory"
+ * Run a script failing the N-th allocation, for N = 1, 2, … until the script
+ * no longer runs out: each run must end with exit 70 and an "out of memory"
  * message (or succeed once N is past the last allocation) — never a crash, a
  * sanitizer report (leaks included, under ASan) or another exit code. Every
  * allocation counts: the interpreter's, and the engines' and codecs' through
  * the runtime's allocation hook (runtime/rt_alloc.h);
  * tests/failalloc/engines_io.frac renders, saves and loads an image, a
- * volume and a mesh to reach them. */
-static void run_fail_alloc(const char *frac, const char *script)
+ * volume and a mesh to reach them.
+ *
+ * A big script is affordable with a stride k: the loop tries every N up to
+ * FA_HEAD (start-up: the stdlib, the parser), then every k-th, plus the
+ * allocations in `extra` (where a bug once was). FA_STRIDE=K in the
+ * environment overrides every loop's stride (FA_STRIDE=1: the whole loop);
+ * `runner --frac F --fail-alloc SCRIPT…` runs only these loops, over any
+ * scripts (tests/README.md, "Allocation failure"). */
+enum { FA_HEAD = 64 };
+
+static void run_fail_alloc(const char *frac, const char *script, int stride, const int *extra)
 {
     char label[4200];
     snprintf(label, sizeof label, "fail-alloc/%s", script);
     if (!matches_filter(label))
         return;
+    const char *env = getenv("FA_STRIDE");
+    if (env && atoi(env) > 0)
+        stride = atoi(env);
+    if (stride < 1)
+        stride = 1;
     char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
     char *dir = mkdtemp(tmpl);
     buf why = {0}, ref = {0}, referr = {0};
-    int ok = 1, n;
+    int ok = 1, n, runs = 0;
+    long made = -1;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     /* the output of a run that fails nothing: the run that ends the loop must
      * print the same, or an allocation failure was swallowed silently */
     char *refargv[] = {(char *)frac, "--quiet", "-o", dir, (char *)script, NULL};
-    run(refargv, NULL, &ref, &referr, 60);
-    for (n = 1; n < 20000; n++) {
+    run(refargv, NULL, &ref, &referr, 600);
+    for (n = 1; n < 100000000;) {
         char num[32];
         snprintf(num, sizeof num, "%d", n);
         char *argv[] = {(char *)frac, "--quiet", "--fail-alloc", num, "-o", dir, (char *)script, NULL};
         buf out = {0}, err = {0};
-        int rc = run(argv, NULL, &out, &err, 60);
+        int rc = run(argv, NULL, &out, &err, 600);
         int oom = strstr(err.d, "out of memory") != NULL;
+        runs++;
         if (rc == 0 && !oom) {
             /* a failure frac may tolerate (a cache, a check-time evaluation
              * it can skip) — but then it must print what a normal run does */
-            int past = strstr(err.d, "was not reached") != NULL;
+            const char *past = strstr(err.d, "was not reached");
+            if (past)
+                sscanf(past, "was not reached: the run made %ld", &made);
             if (strcmp(out.d ? out.d : "", ref.d ? ref.d : "") != 0) {
                 ok = 0;
                 buf_fmt(&why, "  --fail-alloc %d: exit 0 but stdout differs from a normal run (a failure "
@@ -990,18 +1010,25 @@ static void run_fail_alloc(const char *frac, const char *script)
             free(out.d); free(err.d);
             if (past || !ok)
                 break; /* past the last allocation (frac says so), or a failure found */
-            continue;
-        }
-        if (rc != 70 || !oom) {
+        } else if (rc != 70 || !oom) {
             ok = 0;
             buf_fmt(&why, "  --fail-alloc %d: exit %d\n  stderr: %.2000s\n", n, rc, err.d);
             free(out.d); free(err.d);
             break;
+        } else {
+            free(out.d); free(err.d);
         }
-        free(out.d); free(err.d);
+        /* the next N: n + 1 in the head, else n + stride or an extra one before it */
+        int next = n < FA_HEAD ? n + 1 : n + stride;
+        for (const int *x = extra; x && *x; x++)
+            if (*x > n && *x < next)
+                next = *x;
+        n = next;
     }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
     if (getenv("FA_DEBUG"))
-        fprintf(stderr, "%s: stopped at %d\n", label, n);
+        fprintf(stderr, "%s: stopped at %d (%ld allocations, stride %d, %d runs, %.1f s)\n", label, n, made,
+                stride, runs, (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9);
     if (dir)
         rm_tree(dir);
     result(label, ok, &why);
@@ -1337,7 +1364,8 @@ static void run_docs(const char *frac)
 int main(int argc, char **argv)
 {
     const char *frac = NULL, *unit = NULL, *ptyrun = NULL;
-    int update = 0;
+    int update = 0, nscan = 0;
+    const char **scan = calloc((size_t)argc, sizeof *scan);
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--frac") == 0 && i + 1 < argc)
             frac = argv[++i];
@@ -1345,6 +1373,8 @@ int main(int argc, char **argv)
             unit = argv[++i];
         else if (strcmp(argv[i], "--ptyrun") == 0 && i + 1 < argc)
             ptyrun = argv[++i];
+        else if (strcmp(argv[i], "--fail-alloc") == 0 && i + 1 < argc)
+            scan[nscan++] = argv[++i];
         else if (strcmp(argv[i], "--update-golden") == 0)
             update = 1;
         else if (strcmp(argv[i], "--timeout") == 0 && i + 1 < argc)
@@ -1353,7 +1383,7 @@ int main(int argc, char **argv)
             filter = argv[i];
     }
     if (!frac) {
-        fprintf(stderr, "usage: runner --frac FRAC [--unit DIR] [--update-golden] [FILTER]\n");
+        fprintf(stderr, "usage: runner --frac FRAC [--unit DIR] [--update-golden] [--fail-alloc SCRIPT]... [FILTER]\n");
         return 64;
     }
     static char fracabs[4096];
@@ -1365,6 +1395,14 @@ int main(int argc, char **argv)
         run_golden(fracabs, 1);
         return 0;
     }
+    if (nscan) { /* only the allocation-failure loop, over the scripts given */
+        for (int i = 0; i < nscan; i++)
+            run_fail_alloc(fracabs, scan[i], 1, NULL);
+        printf("%d passed, %d failed\n", passed, failed);
+        free(scan);
+        return failed ? 1 : 0;
+    }
+    free(scan);
     if (unit)
         run_unit(unit);
     run_lang_dir(fracabs, "tests/lang");
@@ -1386,16 +1424,20 @@ int main(int argc, char **argv)
     run_py_check(fracabs, "apng_check.py");   /* APNG: own decoder, pngcheck, PIL, apngdis */
     run_py_check(fracabs, "watch_check.py");  /* frac watch in the background: edits, cancel, Ctrl-C */
     run_golden(fracabs, 0);
-    run_fail_alloc(fracabs, "examples/tour.frac");
-    run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
-    run_fail_alloc(fracabs, "tests/failalloc/engines_io.frac");
+    run_fail_alloc(fracabs, "examples/tour.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/core/functions.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/failalloc/engines_io.frac", 1, NULL);
     /* each of these crashed or printed a wrong value at some allocation before
      * the loop went on past tolerated failures (session 5): superifs sets,
      * the wood and marble warps, field compilation under the solid renderer */
-    run_fail_alloc(fracabs, "tests/lang/fset/image_facts.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/wood.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/marble.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/render.frac");
+    run_fail_alloc(fracabs, "tests/lang/fset/image_facts.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/wood.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/marble.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/render.frac", 1, NULL);
+    /* session 7: a failed level-of-detail bound became "the finest level", a
+     * 28908 MiB mesh and exit 65 (allocations 475, 557, 772, 821 of 1,663) */
+    static const int wrinkly_lod[] = {475, 476, 477, 557, 558, 559, 772, 773, 774, 821, 822, 823, 0};
+    run_fail_alloc(fracabs, "tests/lang/wrinkly/surface_facts.frac", 5, wrinkly_lod);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
