@@ -966,6 +966,29 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
  * scripts (tests/README.md, "Allocation failure"). */
 enum { FA_HEAD = 64 };
 
+/* A script's "# args: A B" and "# stdin: TEXT" lines, as run_lang_file reads them. */
+static int script_setup(const char *path, char **args, int max, buf *in)
+{
+    char *text = read_file(path, NULL);
+    int n = 0;
+    for (char *p = text; p && *p;) {
+        char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        char ln[4096], *c;
+        snprintf(ln, sizeof ln, "%.*s", (int)(l < sizeof ln - 1 ? l : sizeof ln - 1), p);
+        if ((c = strstr(ln, "# stdin: "))) {
+            buf_add(in, c + 9, strlen(c + 9));
+            buf_add(in, "\n", 1);
+        } else if ((c = strstr(ln, "# args: "))) {
+            for (char *tok = strtok(c + 8, " "); tok && n < max; tok = strtok(NULL, " "))
+                args[n++] = strdup(tok);
+        }
+        p = e ? e + 1 : p + l;
+    }
+    free(text);
+    return n;
+}
+
 static void run_fail_alloc(const char *frac, const char *script, int stride, const int *extra)
 {
     char label[4200];
@@ -979,42 +1002,62 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
         stride = 1;
     char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
     char *dir = mkdtemp(tmpl);
-    buf why = {0}, ref = {0}, referr = {0};
+    buf why = {0}, ref = {0}, referr = {0}, in = {0};
+    char *sargs[32], num[32];
+    int nargs = script_setup(script, sargs, 32, &in);
+    /* frac --quiet [--fail-alloc N] -o DIR ARGS… SCRIPT */
+    char *argv[48];
+    int k = 0;
+    argv[k++] = (char *)frac;
+    argv[k++] = "--quiet";
+    int at_n = k;
+    argv[k++] = "--fail-alloc";
+    argv[k++] = num;
+    argv[k++] = "-o";
+    argv[k++] = dir;
+    for (int i = 0; i < nargs; i++)
+        argv[k++] = sargs[i];
+    argv[k++] = (char *)script;
+    argv[k] = NULL;
     int ok = 1, n, runs = 0;
     long made = -1;
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    /* the output of a run that fails nothing: the run that ends the loop must
-     * print the same, or an allocation failure was swallowed silently */
-    char *refargv[] = {(char *)frac, "--quiet", "-o", dir, (char *)script, NULL};
-    run(refargv, NULL, &ref, &referr, 600);
+    /* the output of a run that fails nothing: a run that ends without running
+     * out of memory must print the same and exit the same (0, or the script's
+     * own error), or an allocation failure was swallowed or turned into
+     * another error */
+    char *refargv[48];
+    int rk = 0;
+    for (int i = 0; i < k; i++)
+        if (i != at_n && i != at_n + 1) /* without --fail-alloc N */
+            refargv[rk++] = argv[i];
+    refargv[rk] = NULL;
+    int refrc = run(refargv, in.d, &ref, &referr, timeout_s);
     for (n = 1; n < 100000000;) {
-        char num[32];
         snprintf(num, sizeof num, "%d", n);
-        char *argv[] = {(char *)frac, "--quiet", "--fail-alloc", num, "-o", dir, (char *)script, NULL};
         buf out = {0}, err = {0};
-        int rc = run(argv, NULL, &out, &err, 600);
+        int rc = run(argv, in.d, &out, &err, timeout_s);
         int oom = strstr(err.d, "out of memory") != NULL;
         runs++;
-        if (rc == 0 && !oom) {
+        if (!(rc == 70 && oom)) {
             /* a failure frac may tolerate (a cache, a check-time evaluation
-             * it can skip) — but then it must print what a normal run does */
+             * it can skip), or the run is past the last allocation — either
+             * way it must do what a normal run does */
             const char *past = strstr(err.d, "was not reached");
             if (past)
                 sscanf(past, "was not reached: the run made %ld", &made);
-            if (strcmp(out.d ? out.d : "", ref.d ? ref.d : "") != 0) {
+            if (rc != refrc) {
                 ok = 0;
-                buf_fmt(&why, "  --fail-alloc %d: exit 0 but stdout differs from a normal run (a failure "
-                              "swallowed?)\n  stdout: %.500s\n", n, out.d ? out.d : "");
+                buf_fmt(&why, "  --fail-alloc %d: exit %d (a normal run: %d)\n  stderr: %.2000s\n", n, rc, refrc, err.d);
+            } else if (strcmp(out.d ? out.d : "", ref.d ? ref.d : "") != 0) {
+                ok = 0;
+                buf_fmt(&why, "  --fail-alloc %d: exit %d but stdout differs from a normal run (a failure "
+                              "swallowed?)\n  stdout: %.500s\n", n, rc, out.d ? out.d : "");
             }
             free(out.d); free(err.d);
             if (past || !ok)
                 break; /* past the last allocation (frac says so), or a failure found */
-        } else if (rc != 70 || !oom) {
-            ok = 0;
-            buf_fmt(&why, "  --fail-alloc %d: exit %d\n  stderr: %.2000s\n", n, rc, err.d);
-            free(out.d); free(err.d);
-            break;
         } else {
             free(out.d); free(err.d);
         }
@@ -1032,9 +1075,12 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
     if (dir)
         rm_tree(dir);
     result(label, ok, &why);
+    for (int i = 0; i < nargs; i++)
+        free(sargs[i]);
     free(why.d);
     free(ref.d);
     free(referr.d);
+    free(in.d);
 }
 
 /* ---- checks with outside tools --------------------------------------------------------
