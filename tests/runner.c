@@ -1484,6 +1484,11 @@ int main(int argc, char **argv)
      * 28908 MiB mesh and exit 65 (allocations 475, 557, 772, 821 of 1,663) */
     static const int wrinkly_lod[] = {475, 476, 477, 557, 558, 559, 772, 773, 774, 821, 822, 823, 0};
     run_fail_alloc(fracabs, "tests/lang/wrinkly/surface_facts.frac", 5, wrinkly_lod);
+    /* session 7: out of memory while the check evaluated a constant argument
+     * skipped the check (the script ran, printed, then failed at the call);
+     * slice reported its image's out of memory as a bad value (exit 65) */
+    run_fail_alloc(fracabs, "tests/lang/contract/camera_required.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/contract/volume_choices_runtime.frac", 1, NULL);
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
