@@ -961,7 +961,9 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
  * A big script is affordable with a stride k: the loop tries every N up to
  * FA_HEAD (start-up: the stdlib, the parser), then every k-th, plus the
  * allocations in `extra` (where a bug once was). FA_STRIDE=K in the
- * environment overrides every loop's stride (FA_STRIDE=1: the whole loop);
+ * environment overrides every loop's stride (FA_STRIDE=1: the whole loop),
+ * FA_HEAD=H the head (a scan of many small scripts under ASan need not
+ * repeat the start-up allocations they share in every one);
  * `runner --frac F --fail-alloc SCRIPT…` runs only these loops, over any
  * scripts (tests/README.md, "Allocation failure"). */
 enum { FA_HEAD = 64 };
@@ -1000,6 +1002,9 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
         stride = atoi(env);
     if (stride < 1)
         stride = 1;
+    int head = FA_HEAD;
+    if ((env = getenv("FA_HEAD")) && atoi(env) >= 0)
+        head = atoi(env);
     char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
     char *dir = mkdtemp(tmpl);
     buf why = {0}, ref = {0}, referr = {0}, in = {0};
@@ -1062,7 +1067,7 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
             free(out.d); free(err.d);
         }
         /* the next N: n + 1 in the head, else n + stride or an extra one before it */
-        int next = n < FA_HEAD ? n + 1 : n + stride;
+        int next = n < head ? n + 1 : n + stride;
         for (const int *x = extra; x && *x; x++)
             if (*x > n && *x < next)
                 next = *x;
@@ -1070,8 +1075,8 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);
     if (getenv("FA_DEBUG"))
-        fprintf(stderr, "%s: stopped at %d (%ld allocations, stride %d, %d runs, %.1f s)\n", label, n, made,
-                stride, runs, (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9);
+        fprintf(stderr, "%s: stopped at %d (%ld allocations, head %d, stride %d, %d runs, %.1f s)\n", label, n,
+                made, head, stride, runs, (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9);
     if (dir)
         rm_tree(dir);
     result(label, ok, &why);

@@ -4,7 +4,9 @@
 # run counts its allocations (`--fail-alloc` past the end says how many),
 # then the runner's loop (`runner --fail-alloc SCRIPT`) fails allocation
 # 1, 2, … with a stride that keeps it to about MAXRUNS runs (every N up to
-# 64 always). One line per script: count, stride, and ok or FAIL.
+# 64 always; FA_HEAD=H in the environment changes that, e.g. FA_HEAD=0 for
+# an ASan scan of small scripts, whose first allocations are the start-up
+# every script shares). One line per script: count, stride, ok or FAIL.
 #
 #   tools/failalloc_scan.sh [FRAC [RUNNER [MAXRUNS [SCRIPT…]]]]
 #
@@ -34,7 +36,7 @@ for f in "${scripts[@]}"; do
     count=$("$frac" --quiet --fail-alloc 2000000000 -o "$tmp" $args "$f" < "$tmp/stdin" 2>&1 >/dev/null |
         sed -n 's/.*the run made \([0-9]*\) allocations.*/\1/p')
     count=${count:-0}
-    stride=$(((count - 64) / maxruns + 1))
+    stride=$(((count - ${FA_HEAD:-64}) / maxruns + 1))
     [ "$stride" -lt 1 ] && stride=1
     if FA_STRIDE=$stride "$runner" --frac "$frac" --fail-alloc "$f" > "$tmp/out" 2>&1; then
         echo "$f $count $stride ok"
