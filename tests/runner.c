@@ -1494,6 +1494,17 @@ int main(int argc, char **argv)
      * slice reported its image's out of memory as a bad value (exit 65) */
     run_fail_alloc(fracabs, "tests/lang/contract/camera_required.frac", 1, NULL);
     run_fail_alloc(fracabs, "tests/lang/contract/volume_choices_runtime.frac", 1, NULL);
+    /* one script per engine family the loops above do not reach, with a
+     * stride (session 7: each scanned whole, or with a stride under 25,
+     * outside make test; tests/README.md "Allocation failure") */
+    run_fail_alloc(fracabs, "tests/lang/ifs/contraction.frac", 10, NULL);      /* IFS, RIFS, chaos game */
+    run_fail_alloc(fracabs, "tests/lang/fset/order_facts.frac", 50, NULL);     /* function sets by order */
+    run_fail_alloc(fracabs, "tests/lang/fset/chaos_3d_facts.frac", 100, NULL); /* 3-D chaos, views */
+    run_fail_alloc(fracabs, "tests/lang/fset/polyhedron_facts.frac", 20, NULL); /* fset meshes */
+    run_fail_alloc(fracabs, "tests/lang/solid/levels.frac", 25, NULL);         /* isosurface levels */
+    run_fail_alloc(fracabs, "examples/asai_fig1.frac", 10, NULL);              /* tiles, strokes, PNG */
+    run_fail_alloc(fracabs, "tests/lang/fit/budget.frac", 8, NULL);            /* fit */
+    run_fail_alloc(fracabs, "tests/lang/fields/sdf.frac", 12, NULL);           /* fields, raymarch */
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
