@@ -1005,8 +1005,22 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
     int head = FA_HEAD;
     if ((env = getenv("FA_HEAD")) && atoi(env) >= 0)
         head = atoi(env);
+    if (access(script, R_OK) != 0) { /* or every run fails alike and the loop passes */
+        buf why = {0};
+        buf_fmt(&why, "  cannot read %s: %s\n", script, strerror(errno));
+        result(label, 0, &why);
+        free(why.d);
+        return;
+    }
     char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
     char *dir = mkdtemp(tmpl);
+    if (!dir) {
+        buf why = {0};
+        buf_fmt(&why, "  mkdtemp: %s\n", strerror(errno));
+        result(label, 0, &why);
+        free(why.d);
+        return;
+    }
     buf why = {0}, ref = {0}, referr = {0}, in = {0};
     char *sargs[32], num[32];
     int nargs = script_setup(script, sargs, 32, &in);
@@ -1077,8 +1091,7 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
     if (getenv("FA_DEBUG"))
         fprintf(stderr, "%s: stopped at %d (%ld allocations, head %d, stride %d, %d runs, %.1f s)\n", label, n,
                 made, head, stride, runs, (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9);
-    if (dir)
-        rm_tree(dir);
+    rm_tree(dir);
     result(label, ok, &why);
     for (int i = 0; i < nargs; i++)
         free(sargs[i]);
