@@ -98,7 +98,7 @@ const char *lex_name(tok_type t)
 /* The lexer has no interpreter state: it allocates with rt_realloc, which
  * goes through the same allocation hook as mem_alloc (counted, and failed by
  * --fail-alloc); lex_all's caller reports the failure. Doubles the array;
- * -1 if refused (the tokens so far stay in tl, for lex_free). */
+ * -1 if refused (the tokens so far stay in tl: lex_all frees them). */
 static int grow(token_list *tl)
 {
     size_t nc = tl->cap ? tl->cap * 2 : 1024;
@@ -234,8 +234,10 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
          * alias it for the compiler (-fno-strict-aliasing) */
         if (n == cap) {
             out->n = n;
-            if (grow(out))
+            if (grow(out)) {
+                lex_free(out);
                 return -1;
+            }
             toks = out->toks;
             cap = out->cap;
         }
@@ -258,7 +260,7 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             t->type = T_NUMBER;
             t->len = scan_number(p, &t->num);
             if (t->len < 0) {
-                out->n = n - 1;
+                lex_free(out);
                 return -1;
             }
             p += t->len;

@@ -43,8 +43,9 @@ typedef struct token_list {
     size_t n, cap;
 } token_list;
 
-/* Tokenise text (NUL-terminated). Returns 0, or -1 if out of memory. The
- * list always ends with T_EOF; lexical errors are T_ERROR tokens. */
+/* Tokenise text (NUL-terminated). Returns 0, or -1 if out of memory (out is
+ * then empty: nothing to free). The list always ends with T_EOF; lexical
+ * errors are T_ERROR tokens. */
 int lex_all(const char *text, int src, int first_line, token_list *out);
 void lex_free(token_list *tl);
 const char *lex_name(tok_type t); /* human name for messages: "')'", "number" */

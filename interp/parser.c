@@ -1348,7 +1348,6 @@ int parse_source(interp *I, int src, node **out)
     if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl)) {
         /* the token array goes through the hook: say why it was refused (the
          * memory limit, --fail-alloc or the system), at the script's start */
-        lex_free(&p.tl); /* the tokens made before the refusal */
         mem_engine_error(I, "reading the script", "out of memory");
         I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
         return -1;
