@@ -32,7 +32,7 @@ for path in sys.argv[2:]:
     def u64(): return struct.unpack('<Q', take(8))[0]
     def sstr(): return take(u32())
     assert take(8) == b'FRACPART'
-    assert u32() == 2, 'format'
+    assert u32() == 3, 'format'
     sstr()  # frac version
     assert sstr() == b'sha256'
     assert take(32) == hashlib.sha256(script).digest(), 'script hash'

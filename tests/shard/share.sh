@@ -39,7 +39,7 @@ def records(path):
     def u64(): return struct.unpack('<Q', take(8))[0]
     def sstr(): return take(u32())
     assert take(8) == b'FRACPART'
-    assert u32() == 2, 'format'
+    assert u32() == 3, 'format'
     sstr(); sstr(); take(32); u64(); u32(); take(32); sstr()
     index, count = u32(), u32()
     assert u32() == zlib.crc32(b[:pos - 4]), 'header CRC'
