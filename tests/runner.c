@@ -1522,6 +1522,15 @@ int main(int argc, char **argv)
     run_fail_alloc(fracabs, "examples/asai_fig1.frac", 10, NULL);              /* tiles, strokes, PNG */
     run_fail_alloc(fracabs, "tests/lang/fit/budget.frac", 8, NULL);            /* fit */
     run_fail_alloc(fracabs, "tests/lang/fields/sdf.frac", 12, NULL);           /* fields, raymarch */
+    run_fail_alloc(fracabs, "examples/super_steal.frac", 4, NULL);             /* steal */
+    run_fail_alloc(fracabs, "examples/super_top.frac", 2, NULL);               /* fractal tops */
+    run_fail_alloc(fracabs, "examples/ifs_flam3.frac", 10, NULL);              /* flam3 writer */
+    run_fail_alloc(fracabs, "examples/ifs_fractint.frac", 4, NULL);            /* .ifs reader */
+    run_fail_alloc(fracabs, "examples/rifs_forbidden.frac", 8, NULL);          /* forbidden-word RIFS */
+    run_fail_alloc(fracabs, "examples/anim_morph.frac", 2, NULL);              /* APNG writer */
+    run_fail_alloc(fracabs, "examples/wrinkly_fig2.frac", 2, NULL);            /* wrinkly curves */
+    run_fail_alloc(fracabs, "examples/hypertexture_vdb.frac", 2, NULL);        /* hypertexture, VDB writer */
+    run_fail_alloc(fracabs, "examples/patterns.frac", 2, NULL);                /* PNG 8/16-bit, PPM, PGM, PFM writers */
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
