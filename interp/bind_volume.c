@@ -483,9 +483,10 @@ static int b_slice(interp *I, value *a, int n, value *out)
     if (!im)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     rt_error e;
-    if (volume_slice_axis(v, axis, (int)index, &r, lo, hi, im, &e)) {
+    rt_code c = volume_slice_axis(v, axis, (int)index, &r, lo, hi, im, &e);
+    if (c) {
         mem_free(I, im);
-        return err_at(I, NULL, ERR_VALUE, "slice: %s", e.msg);
+        return lang_rt_error(I, c, &e, "slice"); /* out of memory is 70, not a bad value */
     }
     return lang_image_value(I, im, out);
 }

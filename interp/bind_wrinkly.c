@@ -304,7 +304,12 @@ static int curve_sample(interp *I, const curve_obj *c, const lod *l, wrinkly_pol
     int *ki = mem_alloc(I, sizeof(int) * (size_t)c->n);
     if (!ki)
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
-    wrinkly_curve_levels(&wc, &o, ki);
+    rt_error e;
+    rt_code rc = wrinkly_curve_levels(&wc, &o, ki, &e);
+    if (rc) {
+        mem_free(I, ki);
+        return lang_rt_error(I, rc, &e, what);
+    }
     double count = c->ax.cyclic ? 0 : 2;
     for (int i = 0; i < c->n; i++)
         count += pow(2.0 * c->ax.m + 1, ki[i]);
@@ -315,9 +320,8 @@ static int curve_sample(interp *I, const curve_obj *c, const lod *l, wrinkly_pol
                       what, count, I->lim.max_points);
     if (mem_precheck(I, count * 40, "the curve samples"))
         return -1;
-    rt_error e;
     double t0 = report_clock();
-    rt_code rc = wrinkly_curve_sample(&wc, &o, pl, &e);
+    rc = wrinkly_curve_sample(&wc, &o, pl, &e);
     if (rc)
         return lang_rt_error(I, rc, &e, what);
     report_work(I, "wrinkly curve", "points", (double)pl->n, t0);
@@ -681,7 +685,13 @@ static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, in
         mem_free(I, kv);
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
-    wrinkly_surface_levels(&ws, &o, ku, kv);
+    rt_error e;
+    rt_code rc = wrinkly_surface_levels(&ws, &o, ku, kv, &e);
+    if (rc) {
+        mem_free(I, ku);
+        mem_free(I, kv);
+        return lang_rt_error(I, rc, &e, what);
+    }
     double cu = so->au.cyclic ? 0 : 2, cv = so->av.cyclic ? 0 : 2;
     for (int i = 0; i < so->nu; i++)
         cu += pow(2.0 * so->au.m + 1, ku[i]);
@@ -704,9 +714,8 @@ static int surf_mesh(interp *I, const surf_obj *so, const camera *cam, int w, in
         return err_at(I, NULL, ERR_MEMORY, "out of memory");
     }
     rt_run run = lang_run(I);
-    rt_error e;
     double t0 = report_clock();
-    rt_code rc = wrinkly_surface_mesh(&ws, &o, &run, m, NULL, &e);
+    rc = wrinkly_surface_mesh(&ws, &o, &run, m, NULL, &e);
     if (rc) {
         mesh_free(m);
         mem_free(I, m);

@@ -165,6 +165,10 @@ static int check_builtin(interp *I, const builtin *b, const node *call)
             continue;
         value v;
         if (eval_expr(I, I->globals, anodes[i], &v)) {
+            /* out of memory is not the argument's error: skipping the check
+             * would run a script this check refuses (its prints first) */
+            if (I->err.kind == ERR_MEMORY)
+                return -1;
             err_clear(I); /* the run reports it where it happens */
             continue;
         }

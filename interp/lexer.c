@@ -395,11 +395,11 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
     out->toks = NULL;
     out->n = out->cap = 0;
     for (;;) {
-        if (out->n == out->cap && grow(out))
+        int k = out->n == out->cap && grow(out) ? -1 : lex_next(&L, out->toks + out->n, (int)(out->cap - out->n));
+        if (k < 0) { /* out of memory: the caller has nothing to free */
+            lex_free(out);
             return -1;
-        int k = lex_next(&L, out->toks + out->n, (int)(out->cap - out->n));
-        if (k < 0)
-            return -1;
+        }
         out->n += (size_t)k;
         if (L.done)
             return 0;

@@ -58,8 +58,8 @@ void lex_init(lexer *L, const char *text, int src, int first_line);
  * -1 if out of memory (a number literal of 128 characters or more needs a
  * buffer). Lexical errors are T_ERROR tokens. */
 int lex_next(lexer *L, token *toks, int max);
-/* Tokenise the whole text. Returns 0, or -1 if out of memory. The list
- * always ends with T_EOF. */
+/* Tokenise the whole text. Returns 0, or -1 if out of memory (out is then
+ * empty: nothing to free). The list always ends with T_EOF. */
 int lex_all(const char *text, int src, int first_line, token_list *out);
 void lex_free(token_list *tl);
 const char *lex_name(tok_type t); /* human name for messages: "')'", "number" */

@@ -216,16 +216,18 @@ static int push_candidate(interp *I, const char ***c, size_t *n, size_t *cap, co
 }
 
 /* The standard module whose top level defines `name` (a `let`, `fn` or
- * `param` at the start of a statement outside any bracket or block), or
- * NULL. Only scanned when a name is unknown, so the modules are lexed then,
- * not at every start. */
-static const char *stdlib_defining(const char *name)
+ * `param` at the start of a statement outside any bracket or block) in
+ * *mod, or NULL. Only scanned when a name is unknown, so the modules are
+ * lexed then, not at every start. -1 when out of memory (not "no module":
+ * the message would lose its hint). */
+static int stdlib_defining(interp *I, const char *name, const char **mod)
 {
     size_t nl = strlen(name);
+    *mod = NULL;
     for (const stdlib_module *m = stdlib_modules; m->name; m++) {
         token_list tl;
         if (lex_all(m->source, 0, 1, &tl))
-            continue;
+            return mem_engine_error(I, NULL, "out of memory");
         int depth = 0, at_start = 1, found = 0;
         for (size_t i = 0; i + 1 < tl.n && !found; i++) {
             const token *t = &tl.toks[i];
@@ -241,10 +243,12 @@ static const char *stdlib_defining(const char *name)
             at_start = k == T_NEWLINE || k == T_SEMI;
         }
         lex_free(&tl);
-        if (found)
-            return m->name;
+        if (found) {
+            *mod = m->name;
+            return 0;
+        }
     }
-    return NULL;
+    return 0;
 }
 
 static int unknown(resolver *r, scope *s, const node *at, const char *name)
@@ -260,7 +264,11 @@ static int unknown(resolver *r, scope *s, const node *at, const char *name)
         for (size_t i = 0; i < e->n; i++)
             if (push_candidate(r->I, &c, &n, &cap, e->names[i]))
                 return -1;
-    const char *mod = stdlib_defining(name);
+    const char *mod;
+    if (stdlib_defining(r->I, name, &mod)) {
+        mem_free(r->I, c);
+        return -1;
+    }
     const char *sug = mod ? NULL : interp_suggest_name(name, c, n);
     if (mod)
         err_at(r->I, at, ERR_NAME, "unknown name '%s' (import \"%s\" defines it)", name, mod);

@@ -978,14 +978,17 @@ static int merge_open(shard *s)
     }
     int rc = 0;
     for (int p = 0; p < n && !rc; p++) {
-        int c;
-        /* the first part read stores the records; the others must match */
+        /* the first part read stores the records; the others must match.
+         * c (the shard count a part declares) is known only once its header
+         * has been read: a part that fails its check leaves count alone */
+        int c = -1;
         if (check_part(s, s->parts[p], p == 0, &idx[p], &c, &first[p]))
             rc = -1;
         else if (p > 0 && c != count)
             rc = err_pos(I, -1, 0, 0, ERR_VALUE, "merge: '%s' is shard %d of %d, but '%s' is of %d", s->parts[p], idx[p], c,
                          s->parts[0], count);
-        count = c;
+        else
+            count = c;
     }
     if (!rc) {
         s->count = count;

@@ -652,6 +652,7 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
                          long *gens_done, int *timed_out)
 {
     const fit_opts *o = F->o;
+    *loss = HUGE_VAL; /* no fit yet: what an error return leaves */
     double x2[XLEN]; /* the second collage variant (starts 1 and 3) */
     size_t cells0 = (size_t)F->lv[0].gw * F->lv[0].gh;
     if (o->start) {
@@ -718,7 +719,7 @@ static rt_code fit_count(fitter *F, int n, const rt_run *run, progress *pg, doub
         if (c)
             return c;
         double l = eval_loss(F, xs, n, &F->lv[hi - 1], &F->sc[0]);
-        if (l < best) {
+        if (st == 0 || l < best) { /* the first start always counts: a NaN loss leaves bestx set */
             best = l;
             bsigma = F->sigma;
             memcpy(bestx, xs, sizeof(double) * (size_t)np);

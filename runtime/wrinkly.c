@@ -228,7 +228,11 @@ rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrin
     int *ki = rt_malloc(sizeof(int) * (size_t)n);
     if (!ki)
         return rt_fail(e, RT_ENOMEM, "out of memory for a wrinkly curve");
-    wrinkly_curve_levels(c, o, ki);
+    rc = wrinkly_curve_levels(c, o, ki, e);
+    if (rc) {
+        rt_free(ki);
+        return rc;
+    }
     ist map;
     double *pos;
     size_t np;
@@ -589,7 +593,7 @@ static void curve_frame(const wrinkly_curve *c, double lam, double u, double p[3
     n[0] = l > 0 ? -d[1] / l : 0, n[1] = l > 0 ? d[0] / l : 0, n[2] = 0;
 }
 
-void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki)
+rt_code wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki, rt_error *e)
 {
     double lam = lam_of(o->tension);
     int n = c->n, b = 2 * c->ax.m + 1;
@@ -599,18 +603,17 @@ void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki
     for (int i = 0; i < n; i++)
         ki[i] = o->cam || o->tol > 0 ? 0 : kf;
     if (!adaptive)
-        return;
+        return RT_OK;
     double E[4][3], hg = 0;
     bez_rows(lam, E);
     for (int i = 0; i < n; i++)
         hg = fabs(c->pts[i].h) > hg ? fabs(c->pts[i].h) : hg;
     /* per interval: the height's Bézier bounds */
+    /* no memory for the bound is out of memory, not "the finest level":
+     * (2M+1)^kmax samples per interval would turn it into a bogus size */
     hbound *hb = rt_malloc(sizeof *hb * (size_t)n);
-    if (!hb) { /* no memory for the bound: the finest level is always safe */
-        for (int i = 0; i < n; i++)
-            ki[i] = kmax;
-        return;
-    }
+    if (!hb)
+        return rt_fail(e, RT_ENOMEM, "out of memory for the level-of-detail bounds of a wrinkly curve");
     for (int i = 0; i < n; i++) {
         axw a;
         axis_weights(n, c->ax.cyclic, lam, 0, i + 0.5, &a);
@@ -656,6 +659,7 @@ void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki
         ki[i] = k;
     }
     rt_free(hb);
+    return RT_OK;
 }
 
 double wrinkly_surface_attr(const wrinkly_surface *s, double tension, int which, double u, double v)
@@ -725,7 +729,7 @@ static void patch_samples(const wrinkly_surface *s, const wrinkly_opts *o, doubl
 }
 
 /* K_i per base interval of both axes (§5.2, wrinkly.h). */
-void wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int *ku, int *kv)
+rt_code wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int *ku, int *kv, rt_error *e)
 {
     double lam = lam_of(o->tension);
     int kmax = o->kmax > 0 ? o->kmax : 8;
@@ -737,16 +741,16 @@ void wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int
     for (int j = 0; j < nv; j++)
         kv[j] = adaptive ? 0 : kf;
     if (!adaptive)
-        return;
+        return RT_OK;
     size_t np = (size_t)nu * (size_t)nv, nmax = (size_t)(nu > nv ? nu : nv);
     patchb *pb = rt_malloc(sizeof *pb * np);
     patchb *win = rt_malloc(sizeof *win * np);
     lodpt *q = rt_malloc(sizeof *q * nmax * LOD_GS * LOD_GS);
-    if (!pb || !win || !q) { /* no memory for the bound: the finest level is always safe */
-        for (int i = 0; i < nu; i++)
-            ku[i] = 2 * s->au.m + 1 > 1 ? kmax : 0;
-        for (int j = 0; j < nv; j++)
-            kv[j] = 2 * s->av.m + 1 > 1 ? kmax : 0;
+    rt_code rc = RT_OK;
+    /* no memory for the bound is out of memory, not "the finest level":
+     * (2M+1)^kmax vertices per interval would turn it into a bogus size */
+    if (!pb || !win || !q) {
+        rc = rt_fail(e, RT_ENOMEM, "out of memory for the level-of-detail bounds of a wrinkly surface");
         goto done;
     }
     double hg = 0;
@@ -804,6 +808,7 @@ done:
     rt_free(pb);
     rt_free(win);
     rt_free(q);
+    return rc;
 }
 
 static rt_code make_axis(int n, const wrinkly_axis *ax, const int *ki, const wrinkly_opts *o,
@@ -861,8 +866,9 @@ rt_code wrinkly_surface_mesh(const wrinkly_surface *s, const wrinkly_opts *o, co
         rc = RT_EINVAL;
         goto done;
     }
-    wrinkly_surface_levels(s, o, ku, kv);
-    rc = make_axis(s->nu, &s->au, ku, o, lam, 1, &su, &nu, &k[0], e);
+    rc = wrinkly_surface_levels(s, o, ku, kv, e);
+    if (!rc)
+        rc = make_axis(s->nu, &s->au, ku, o, lam, 1, &su, &nu, &k[0], e);
     if (!rc)
         rc = make_axis(s->nv, &s->av, kv, o, lam, 2, &sv, &nv, &k[1], e);
     if (rc)

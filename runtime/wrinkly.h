@@ -161,8 +161,9 @@ rt_code wrinkly_curve_sample(const wrinkly_curve *c, const wrinkly_opts *o, wrin
 void wrinkly_polyline_free(wrinkly_polyline *p);
 /* The level K_i of each of the c->n base intervals that wrinkly_curve_sample
  * uses (so a caller can size the output first: Σ (2M+1)^{K_i}, plus the two
- * ends of an open curve). */
-void wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki);
+ * ends of an open curve). RT_ENOMEM when the level-of-detail bounds find no
+ * memory (ki is then not set). */
+rt_code wrinkly_curve_levels(const wrinkly_curve *c, const wrinkly_opts *o, int *ki, rt_error *e);
 
 /* ---- surfaces ---- */
 typedef struct wrinkly_surface {
@@ -195,8 +196,9 @@ typedef struct wrinkly_info {
 
 /* The levels K_i of the nu base intervals along u and the nv along v that
  * wrinkly_surface_mesh uses (vertices along u: Σ (2M_u+1)^{ku[i]}, plus 2
- * on an open axis; likewise v). */
-void wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int *ku, int *kv);
+ * on an open axis; likewise v). RT_ENOMEM when the level-of-detail bounds
+ * find no memory (ku, kv are then not all set). */
+rt_code wrinkly_surface_levels(const wrinkly_surface *s, const wrinkly_opts *o, int *ku, int *kv, rt_error *e);
 
 /* Tessellate eq. (11) into out (initialised here; free with mesh_free).
  * Parallel over rows of vertices; byte-identical for any thread count. */

@@ -953,65 +953,156 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
 }
 
 /* ---- allocation failure ----------------------------------------------------------
- * Run a script failing the N-th allocation, for every N until the script no
- * longer runs out: each run must end with exit 70 and an "out of memory"
+ * Run a script failing the N-th allocation, for N = 1, 2, … until the script
+ * no longer runs out: each run must end with exit 70 and an "out of memory"
  * message (or succeed once N is past the last allocation) — never a crash, a
  * sanitizer report (leaks included, under ASan) or another exit code. Every
  * allocation counts: the interpreter's, and the engines' and codecs' through
  * the runtime's allocation hook (runtime/rt_alloc.h);
  * tests/failalloc/engines_io.frac renders, saves and loads an image, a
- * volume and a mesh to reach them. */
-static void run_fail_alloc(const char *frac, const char *script)
+ * volume and a mesh to reach them.
+ *
+ * A big script is affordable with a stride k: the loop tries every N up to
+ * FA_HEAD (start-up: the stdlib, the parser), then every k-th, plus the
+ * allocations in `extra` (where a bug once was). FA_STRIDE=K in the
+ * environment overrides every loop's stride (FA_STRIDE=1: the whole loop),
+ * FA_HEAD=H the head (a scan of many small scripts under ASan need not
+ * repeat the start-up allocations they share in every one);
+ * `runner --frac F --fail-alloc SCRIPT…` runs only these loops, over any
+ * scripts (tests/README.md, "Allocation failure"). */
+enum { FA_HEAD = 64 };
+
+/* A script's "# args: A B" and "# stdin: TEXT" lines, as run_lang_file reads them. */
+static int script_setup(const char *path, char **args, int max, buf *in)
+{
+    char *text = read_file(path, NULL);
+    int n = 0;
+    for (char *p = text; p && *p;) {
+        char *e = strchr(p, '\n');
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        char ln[4096], *c;
+        snprintf(ln, sizeof ln, "%.*s", (int)(l < sizeof ln - 1 ? l : sizeof ln - 1), p);
+        if ((c = strstr(ln, "# stdin: "))) {
+            buf_add(in, c + 9, strlen(c + 9));
+            buf_add(in, "\n", 1);
+        } else if ((c = strstr(ln, "# args: "))) {
+            for (char *tok = strtok(c + 8, " "); tok && n < max; tok = strtok(NULL, " "))
+                args[n++] = strdup(tok);
+        }
+        p = e ? e + 1 : p + l;
+    }
+    free(text);
+    return n;
+}
+
+static void run_fail_alloc(const char *frac, const char *script, int stride, const int *extra)
 {
     char label[4200];
     snprintf(label, sizeof label, "fail-alloc/%s", script);
     if (!matches_filter(label))
         return;
+    const char *env = getenv("FA_STRIDE");
+    if (env && atoi(env) > 0)
+        stride = atoi(env);
+    if (stride < 1)
+        stride = 1;
+    int head = FA_HEAD;
+    if ((env = getenv("FA_HEAD")) && atoi(env) >= 0)
+        head = atoi(env);
+    if (access(script, R_OK) != 0) { /* or every run fails alike and the loop passes */
+        buf why = {0};
+        buf_fmt(&why, "  cannot read %s: %s\n", script, strerror(errno));
+        result(label, 0, &why);
+        free(why.d);
+        return;
+    }
     char tmpl[] = "/tmp/frac-failalloc-XXXXXX";
     char *dir = mkdtemp(tmpl);
-    buf why = {0}, ref = {0}, referr = {0};
-    int ok = 1, n;
-    /* the output of a run that fails nothing: the run that ends the loop must
-     * print the same, or an allocation failure was swallowed silently */
-    char *refargv[] = {(char *)frac, "--quiet", "-o", dir, (char *)script, NULL};
-    run(refargv, NULL, &ref, &referr, 60);
-    for (n = 1; n < 20000; n++) {
-        char num[32];
+    if (!dir) {
+        buf why = {0};
+        buf_fmt(&why, "  mkdtemp: %s\n", strerror(errno));
+        result(label, 0, &why);
+        free(why.d);
+        return;
+    }
+    buf why = {0}, ref = {0}, referr = {0}, in = {0};
+    char *sargs[32], num[32];
+    int nargs = script_setup(script, sargs, 32, &in);
+    /* frac --quiet [--fail-alloc N] -o DIR ARGS… SCRIPT */
+    char *argv[48];
+    int k = 0;
+    argv[k++] = (char *)frac;
+    argv[k++] = "--quiet";
+    int at_n = k;
+    argv[k++] = "--fail-alloc";
+    argv[k++] = num;
+    argv[k++] = "-o";
+    argv[k++] = dir;
+    for (int i = 0; i < nargs; i++)
+        argv[k++] = sargs[i];
+    argv[k++] = (char *)script;
+    argv[k] = NULL;
+    int ok = 1, n, runs = 0;
+    long made = -1;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    /* the output of a run that fails nothing: a run that ends without running
+     * out of memory must print the same and exit the same (0, or the script's
+     * own error), or an allocation failure was swallowed or turned into
+     * another error */
+    char *refargv[48];
+    int rk = 0;
+    for (int i = 0; i < k; i++)
+        if (i != at_n && i != at_n + 1) /* without --fail-alloc N */
+            refargv[rk++] = argv[i];
+    refargv[rk] = NULL;
+    int refrc = run(refargv, in.d, &ref, &referr, timeout_s);
+    for (n = 1; n < 100000000;) {
         snprintf(num, sizeof num, "%d", n);
-        char *argv[] = {(char *)frac, "--quiet", "--fail-alloc", num, "-o", dir, (char *)script, NULL};
         buf out = {0}, err = {0};
-        int rc = run(argv, NULL, &out, &err, 60);
+        int rc = run(argv, in.d, &out, &err, timeout_s);
         int oom = strstr(err.d, "out of memory") != NULL;
-        if (rc == 0 && !oom) {
+        runs++;
+        if (!(rc == 70 && oom)) {
             /* a failure frac may tolerate (a cache, a check-time evaluation
-             * it can skip) — but then it must print what a normal run does */
-            int past = strstr(err.d, "was not reached") != NULL;
-            if (strcmp(out.d ? out.d : "", ref.d ? ref.d : "") != 0) {
+             * it can skip), or the run is past the last allocation — either
+             * way it must do what a normal run does */
+            const char *past = strstr(err.d, "was not reached");
+            if (past)
+                sscanf(past, "was not reached: the run made %ld", &made);
+            if (rc != refrc) {
                 ok = 0;
-                buf_fmt(&why, "  --fail-alloc %d: exit 0 but stdout differs from a normal run (a failure "
-                              "swallowed?)\n  stdout: %.500s\n", n, out.d ? out.d : "");
+                buf_fmt(&why, "  --fail-alloc %d: exit %d (a normal run: %d)\n  stderr: %.2000s\n", n, rc, refrc, err.d);
+            } else if (strcmp(out.d ? out.d : "", ref.d ? ref.d : "") != 0) {
+                ok = 0;
+                buf_fmt(&why, "  --fail-alloc %d: exit %d but stdout differs from a normal run (a failure "
+                              "swallowed?)\n  stdout: %.500s\n", n, rc, out.d ? out.d : "");
             }
             free(out.d); free(err.d);
             if (past || !ok)
                 break; /* past the last allocation (frac says so), or a failure found */
-            continue;
-        }
-        if (rc != 70 || !oom) {
-            ok = 0;
-            buf_fmt(&why, "  --fail-alloc %d: exit %d\n  stderr: %.2000s\n", n, rc, err.d);
+        } else {
             free(out.d); free(err.d);
-            break;
         }
-        free(out.d); free(err.d);
+        /* the next N: n + 1 in the head, else n + stride or an extra one before it */
+        int next = n < head ? n + 1 : n + stride;
+        for (const int *x = extra; x && *x; x++)
+            if (*x > n && *x < next)
+                next = *x;
+        n = next;
     }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
     if (getenv("FA_DEBUG"))
-        fprintf(stderr, "%s: stopped at %d\n", label, n);
-    if (dir)
-        rm_tree(dir);
+        fprintf(stderr, "%s: stopped at %d (%ld allocations, head %d, stride %d, %d runs, %.1f s)\n", label, n,
+                made, head, stride, runs, (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9);
+    rm_tree(dir);
     result(label, ok, &why);
+    for (int i = 0; i < nargs; i++)
+        free(sargs[i]);
     free(why.d);
     free(ref.d);
     free(referr.d);
+    free(in.d);
 }
 
 /* ---- checks with outside tools --------------------------------------------------------
@@ -1341,7 +1432,8 @@ static void run_docs(const char *frac)
 int main(int argc, char **argv)
 {
     const char *frac = NULL, *unit = NULL, *ptyrun = NULL;
-    int update = 0;
+    int update = 0, nscan = 0;
+    const char **scan = calloc((size_t)argc, sizeof *scan);
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--frac") == 0 && i + 1 < argc)
             frac = argv[++i];
@@ -1349,6 +1441,8 @@ int main(int argc, char **argv)
             unit = argv[++i];
         else if (strcmp(argv[i], "--ptyrun") == 0 && i + 1 < argc)
             ptyrun = argv[++i];
+        else if (strcmp(argv[i], "--fail-alloc") == 0 && i + 1 < argc)
+            scan[nscan++] = argv[++i];
         else if (strcmp(argv[i], "--update-golden") == 0)
             update = 1;
         else if (strcmp(argv[i], "--timeout") == 0 && i + 1 < argc)
@@ -1357,7 +1451,7 @@ int main(int argc, char **argv)
             filter = argv[i];
     }
     if (!frac) {
-        fprintf(stderr, "usage: runner --frac FRAC [--unit DIR] [--update-golden] [FILTER]\n");
+        fprintf(stderr, "usage: runner --frac FRAC [--unit DIR] [--update-golden] [--fail-alloc SCRIPT]... [FILTER]\n");
         return 64;
     }
     static char fracabs[4096];
@@ -1369,6 +1463,14 @@ int main(int argc, char **argv)
         run_golden(fracabs, 1);
         return 0;
     }
+    if (nscan) { /* only the allocation-failure loop, over the scripts given */
+        for (int i = 0; i < nscan; i++)
+            run_fail_alloc(fracabs, scan[i], 1, NULL);
+        printf("%d passed, %d failed\n", passed, failed);
+        free(scan);
+        return failed ? 1 : 0;
+    }
+    free(scan);
     if (unit)
         run_unit(unit);
     run_lang_dir(fracabs, "tests/lang");
@@ -1390,16 +1492,49 @@ int main(int argc, char **argv)
     run_py_check(fracabs, "apng_check.py");   /* APNG: own decoder, pngcheck, PIL, apngdis */
     run_py_check(fracabs, "watch_check.py");  /* frac watch in the background: edits, cancel, Ctrl-C */
     run_golden(fracabs, 0);
-    run_fail_alloc(fracabs, "examples/tour.frac");
-    run_fail_alloc(fracabs, "tests/lang/core/functions.frac");
-    run_fail_alloc(fracabs, "tests/failalloc/engines_io.frac");
+    run_fail_alloc(fracabs, "examples/tour.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/core/functions.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/failalloc/engines_io.frac", 1, NULL);
     /* each of these crashed or printed a wrong value at some allocation before
      * the loop went on past tolerated failures (session 5): superifs sets,
      * the wood and marble warps, field compilation under the solid renderer */
-    run_fail_alloc(fracabs, "tests/lang/fset/image_facts.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/wood.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/marble.frac");
-    run_fail_alloc(fracabs, "tests/lang/solid/render.frac");
+    run_fail_alloc(fracabs, "tests/lang/fset/image_facts.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/wood.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/marble.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/solid/render.frac", 1, NULL);
+    /* session 7: a failed level-of-detail bound became "the finest level", a
+     * 28908 MiB mesh and exit 65 (allocations 475, 557, 772, 821 of 1,663) */
+    static const int wrinkly_lod[] = {475, 476, 477, 557, 558, 559, 772, 773, 774, 821, 822, 823, 0};
+    run_fail_alloc(fracabs, "tests/lang/wrinkly/surface_facts.frac", 5, wrinkly_lod);
+    /* session 7: out of memory while the check evaluated a constant argument
+     * skipped the check (the script ran, printed, then failed at the call);
+     * slice reported its image's out of memory as a bad value (exit 65) */
+    run_fail_alloc(fracabs, "tests/lang/contract/camera_required.frac", 1, NULL);
+    run_fail_alloc(fracabs, "tests/lang/contract/volume_choices_runtime.frac", 1, NULL);
+    /* session 7, under ASan: a failed lex of a stdlib module (looking up
+     * which module defines an unknown name) leaked its tokens and lost the
+     * out-of-memory */
+    run_fail_alloc(fracabs, "tests/lang/names/scope.frac", 1, NULL);
+    /* one script per engine family the loops above do not reach, with a
+     * stride (session 7: each scanned whole, or with a stride under 25,
+     * outside make test; tests/README.md "Allocation failure") */
+    run_fail_alloc(fracabs, "tests/lang/ifs/contraction.frac", 10, NULL);      /* IFS, RIFS, chaos game */
+    run_fail_alloc(fracabs, "tests/lang/fset/order_facts.frac", 50, NULL);     /* function sets by order */
+    run_fail_alloc(fracabs, "tests/lang/fset/chaos_3d_facts.frac", 100, NULL); /* 3-D chaos, views */
+    run_fail_alloc(fracabs, "tests/lang/fset/polyhedron_facts.frac", 20, NULL); /* fset meshes */
+    run_fail_alloc(fracabs, "tests/lang/solid/levels.frac", 25, NULL);         /* isosurface levels */
+    run_fail_alloc(fracabs, "examples/asai_fig1.frac", 10, NULL);              /* tiles, strokes, PNG */
+    run_fail_alloc(fracabs, "tests/lang/fit/budget.frac", 8, NULL);            /* fit */
+    run_fail_alloc(fracabs, "tests/lang/fields/sdf.frac", 12, NULL);           /* fields, raymarch */
+    run_fail_alloc(fracabs, "examples/super_steal.frac", 4, NULL);             /* steal */
+    run_fail_alloc(fracabs, "examples/super_top.frac", 2, NULL);               /* fractal tops */
+    run_fail_alloc(fracabs, "examples/ifs_flam3.frac", 10, NULL);              /* flam3 writer */
+    run_fail_alloc(fracabs, "examples/ifs_fractint.frac", 4, NULL);            /* .ifs reader */
+    run_fail_alloc(fracabs, "examples/rifs_forbidden.frac", 8, NULL);          /* forbidden-word RIFS */
+    run_fail_alloc(fracabs, "examples/anim_morph.frac", 2, NULL);              /* APNG writer */
+    run_fail_alloc(fracabs, "examples/wrinkly_fig2.frac", 2, NULL);            /* wrinkly curves */
+    run_fail_alloc(fracabs, "examples/hypertexture_vdb.frac", 2, NULL);        /* hypertexture, VDB writer */
+    run_fail_alloc(fracabs, "examples/patterns.frac", 2, NULL);                /* PNG 8/16-bit, PPM, PGM, PFM writers */
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }

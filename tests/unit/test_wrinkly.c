@@ -444,7 +444,8 @@ static void test_lod(void)
                 o.cam = &cc, o.width = o.height = 300, o.pixel = 1;
             double target = mode == 0 ? o.tol : o.pixel;
             int ki[N], wasteful = 0, kmaxed = 0;
-            wrinkly_curve_levels(&c, &o, ki);
+            rt_error le;
+            CHECK(wrinkly_curve_levels(&c, &o, ki, &le) == RT_OK, "curve levels: %s", le.msg);
             for (int i = 0; i < N; i++) {
                 double l = curve_longest(&c, o.cam, o.width, o.height, i, ki[i]);
                 CHECK(l <= target, "curve cyc %d mode %d interval %d: K_i %d, longest %g > %g", cyc, mode, i, ki[i], l, target);
@@ -474,7 +475,8 @@ static void test_lod(void)
             o.cam = &cam, o.width = o.height = 200;
         double target = mode == 0 ? o.tol : o.pixel;
         int ku[8], kv[6], kx[2] = {0, 0};
-        wrinkly_surface_levels(&s, &o, ku, kv);
+        rt_error le;
+        CHECK(wrinkly_surface_levels(&s, &o, ku, kv, &le) == RT_OK, "surface levels: %s", le.msg);
         for (int i = 0; i < nu; i++)
             kx[0] = ku[i] > kx[0] ? ku[i] : kx[0];
         for (int j = 0; j < nv; j++)
