@@ -492,6 +492,38 @@ static void write_normal(iso_job *j, uint32_t id, double nv[3], const int p[3], 
         N[a] = (float)(nv[a] / l);
 }
 
+/* Where the level crosses an edge whose ends hold fp and fq, as a fraction
+ * of the edge from the fp end, kept S_EPS off both ends (0.5 when the ends
+ * are equal or not finite). */
+static inline double edge_fraction(double level, double fp, double fq)
+{
+    double s = 0.5;
+    if (isfinite(fp) && isfinite(fq) && fq != fp) {
+        s = (level - fp) / (fq - fp);
+        if (!(s >= S_EPS))
+            s = S_EPS;
+        if (s > 1 - S_EPS)
+            s = 1 - S_EPS;
+    }
+    return s;
+}
+
+/* Vertex id: its cap flag, its edge (p, axis d) when edges are kept, and
+ * its position the fraction s of the way from node p to node q. */
+static inline void put_vertex(iso_job *j, uint32_t id, int d, const int p[3], const int q[3], double s, int cap)
+{
+    j->cap[id] = (unsigned char)cap;
+    if (j->edges) {
+        int32_t *E = j->edges + 4 * (size_t)id;
+        E[0] = p[0], E[1] = p[1], E[2] = p[2], E[3] = d;
+    }
+    float *O = j->pos + 3 * (size_t)id;
+    for (int a = 0; a < 3; a++) {
+        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
+        O[a] = (float)(cp + s * (cq - cp));
+    }
+}
+
 /* make_vertex for an edge whose two ends are at least one node from the
  * grid's border on every axis (most edges): the same arithmetic without
  * the border cases, so the compiler can overlap the divisions. */
@@ -499,25 +531,9 @@ static void make_vertex_inner(iso_job *j, int x, int y, int z, int d, uint32_t i
 {
     int p[3] = {x, y, z}, q[3] = {x + (d & 1), y + (d >> 1 & 1), z + (d >> 2 & 1)};
     const float *P = volume_at(j->vol, x, y, z), *Q = P + j->stride[d >> 1];
-    double fp = *P, fq = *Q, s = 0.5;
+    double fp = *P, fq = *Q, s = edge_fraction(j->level, fp, fq);
     int pin = fp >= j->level;
-    if (isfinite(fp) && isfinite(fq) && fq != fp) {
-        s = (j->level - fp) / (fq - fp);
-        if (!(s >= S_EPS))
-            s = S_EPS;
-        if (s > 1 - S_EPS)
-            s = 1 - S_EPS;
-    }
-    j->cap[id] = 0;
-    if (j->edges) {
-        int32_t *E = j->edges + 4 * (size_t)id;
-        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
-    }
-    float *O = j->pos + 3 * (size_t)id;
-    for (int a = 0; a < 3; a++) {
-        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
-        O[a] = (float)(cp + s * (cq - cp));
-    }
+    put_vertex(j, id, d, p, q, s, 0);
     if (j->want_normals) {
         double g0[3], g1[3], nv[3];
         for (int a = 0; a < 3; a++) {
@@ -546,37 +562,21 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         const float *fpp = volume_at(j->vol, p[0], p[1], p[2]), *fqp = volume_at(j->vol, q[0], q[1], q[2]);
         double fp = *fpp, fq = *fqp;
         pin = fp >= j->level;
-        if (isfinite(fp) && isfinite(fq) && fq != fp) {
-            s = (j->level - fp) / (fq - fp);
-            if (!(s >= S_EPS))
-                s = S_EPS;
-            if (s > 1 - S_EPS)
-                s = 1 - S_EPS;
-        }
+        s = edge_fraction(j->level, fp, fq);
         if (j->want_normals) {
             for (int a = 0; a < 3; a++) {
                 double g0 = grid_grad(j, fpp, p[a], a), g1 = grid_grad(j, fqp, q[a], a);
                 nv[a] = -((1 - s) * g0 + s * g1);
             }
         }
-        j->cap[id] = 0;
     } else {
         /* One end is padding: the vertex is on the box face; normal = the
          * outward normal of the face(s) the padding node lies beyond. */
         int *pad = pr ? q : p;
         for (int a = 0; a < 3; a++)
             nv[a] = pad[a] < 0 ? -1.0 : pad[a] >= j->n[a] ? 1.0 : 0.0;
-        j->cap[id] = 1;
     }
-    if (j->edges) {
-        int32_t *E = j->edges + 4 * (size_t)id;
-        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
-    }
-    float *P = j->pos + 3 * (size_t)id;
-    for (int a = 0; a < 3; a++) {
-        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
-        P[a] = (float)(cp + s * (cq - cp));
-    }
+    put_vertex(j, id, d, p, q, s, !(pr && qr));
     if (j->want_normals)
         write_normal(j, id, nv, p, q, pin);
 }
