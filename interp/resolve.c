@@ -329,6 +329,27 @@ static int is_literal(const node *n)
 
 static int resolve_kid(resolver *r, scope *s, const node *k);
 
+/* The loop of a for or a comprehension: `iter` resolves in s, then the loop
+ * variable `name` is declared in a scope of its own inside s, where `first`
+ * and then `second` (either may be NULL) resolve. */
+static int resolve_loop(resolver *r, scope *s, const char *name, const node *iter, const node *first,
+                        const node *second)
+{
+    if (resolve_node(r, s, iter))
+        return -1;
+    scope inner = {0};
+    inner.parent = s;
+    int rc = declare(r, &inner, name);
+    if (rc == 0)
+        rc = bind(r, name, NULL);
+    if (rc == 0)
+        rc = resolve_node(r, &inner, first);
+    if (rc == 0)
+        rc = resolve_node(r, &inner, second);
+    scope_free(r->I, &inner);
+    return rc;
+}
+
 static int resolve_node(resolver *r, scope *s, const node *n)
 {
     if (!n)
@@ -348,21 +369,8 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         scope_free(r->I, &inner);
         return rc;
     }
-    case N_COMP: {
-        if (resolve_node(r, s, n->kids[1]))
-            return -1;
-        scope inner = {0};
-        inner.parent = s;
-        int rc = declare(r, &inner, n->str);
-        if (rc == 0)
-            rc = bind(r, n->str, NULL);
-        if (rc == 0)
-            rc = resolve_node(r, &inner, n->kids[2]);
-        if (rc == 0)
-            rc = resolve_node(r, &inner, n->kids[0]);
-        scope_free(r->I, &inner);
-        return rc;
-    }
+    case N_COMP: /* [kids[0] for str in kids[1] if kids[2]] */
+        return resolve_loop(r, s, n->str, n->kids[1], n->kids[2], n->kids[0]);
     case N_FIELD:
         return resolve_node(r, s, n->kids[0]);
     case N_CALL:
@@ -432,21 +440,10 @@ static int resolve_block(resolver *r, scope *s, const node *b)
             if (module_names(r, s, st))
                 return -1;
             break;
-        case N_FOR: {
-            if (resolve_node(r, s, st->kids[0]))
-                return -1;
-            scope inner = {0};
-            inner.parent = s;
-            int rc = declare(r, &inner, st->str);
-            if (rc == 0)
-                rc = bind(r, st->str, NULL);
-            if (rc == 0)
-                rc = resolve_node(r, &inner, st->kids[1]);
-            scope_free(r->I, &inner);
-            if (rc)
+        case N_FOR:
+            if (resolve_loop(r, s, st->str, st->kids[0], st->kids[1], NULL))
                 return -1;
             break;
-        }
         case N_EXPR:
             if (resolve_node(r, s, st->kids[0]))
                 return -1;
