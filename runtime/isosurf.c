@@ -508,11 +508,10 @@ static inline double edge_fraction(double level, double fp, double fq)
     return s;
 }
 
-/* Vertex id: its cap flag, its edge (p, axis d) when edges are kept, and
- * its position the fraction s of the way from node p to node q. */
-static inline void put_vertex(iso_job *j, uint32_t id, int d, const int p[3], const int q[3], double s, int cap)
+/* Vertex id: its edge (p, axis d) when edges are kept, and its position
+ * the fraction s of the way from node p to node q. */
+static inline void put_vertex(iso_job *j, uint32_t id, int d, const int p[3], const int q[3], double s)
 {
-    j->cap[id] = (unsigned char)cap;
     if (j->edges) {
         int32_t *E = j->edges + 4 * (size_t)id;
         E[0] = p[0], E[1] = p[1], E[2] = p[2], E[3] = d;
@@ -533,7 +532,8 @@ static void make_vertex_inner(iso_job *j, int x, int y, int z, int d, uint32_t i
     const float *P = volume_at(j->vol, x, y, z), *Q = P + j->stride[d >> 1];
     double fp = *P, fq = *Q, s = edge_fraction(j->level, fp, fq);
     int pin = fp >= j->level;
-    put_vertex(j, id, d, p, q, s, 0);
+    j->cap[id] = 0;
+    put_vertex(j, id, d, p, q, s);
     if (j->want_normals) {
         double g0[3], g1[3], nv[3];
         for (int a = 0; a < 3; a++) {
@@ -563,6 +563,7 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         double fp = *fpp, fq = *fqp;
         pin = fp >= j->level;
         s = edge_fraction(j->level, fp, fq);
+        j->cap[id] = 0;
         if (j->want_normals) {
             for (int a = 0; a < 3; a++) {
                 double g0 = grid_grad(j, fpp, p[a], a), g1 = grid_grad(j, fqp, q[a], a);
@@ -575,8 +576,9 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         int *pad = pr ? q : p;
         for (int a = 0; a < 3; a++)
             nv[a] = pad[a] < 0 ? -1.0 : pad[a] >= j->n[a] ? 1.0 : 0.0;
+        j->cap[id] = 1;
     }
-    put_vertex(j, id, d, p, q, s, !(pr && qr));
+    put_vertex(j, id, d, p, q, s);
     if (j->want_normals)
         write_normal(j, id, nv, p, q, pin);
 }
