@@ -40,6 +40,11 @@
 #include "par.h"
 
 #define SLAB 4
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#else
+#define INLINE static inline
+#endif
 #define S_EPS 1e-3
 
 /* The case table, generated here from the cube's topology (no table is
@@ -626,6 +631,78 @@ static const mc_case *cell_case(const iso_job *j, int x, int y, int z, int mask)
     return &j->tb.cases[ci];
 }
 
+/* What the two passes carry while they walk the cells: pass 1 counts the
+ * triangles and centre vertices; pass 2 writes them, the next triangle at
+ * T and the next centre record at CR, centre ids from cen0 on, edge ids
+ * from ids[0] (cell layer z's bottom node layer) and ids[1] (its top). */
+typedef struct cell_acc {
+    size_t ntri, ncen;
+    uint32_t *T, *CR, **ids;
+    size_t cen0;
+} cell_acc;
+
+INLINE void count_cell(cell_acc *a, const mc_case *K)
+{
+    a->ntri += K->nt;
+    for (int k = 0; k < K->nc; k++)
+        a->ntri += K->ck[k];
+    a->ncen += K->nc;
+}
+
+/* the triangles of the cell at layer index idx, and its centre vertices
+ * (each with a fan of triangles around it) */
+INLINE void build_cell(iso_job *j, cell_acc *a, size_t idx, const mc_case *K)
+{
+    uint32_t *T = a->T, *const *ids = a->ids;
+    for (int ti = 0; ti < K->nt; ti++, T += 3)
+        for (int r = 0; r < 3; r++) {
+            int e = K->e[ti][r];
+            T[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+        }
+    for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
+        uint32_t *rec = a->CR;
+        int n = K->ck[k];
+        a->CR += CEN_REC;
+        rec[0] = (uint32_t)(a->cen0 + a->ncen++);
+        rec[1] = (uint32_t)n;
+        for (int r = 0; r < n; r++) {
+            int e = K->ce[at + r];
+            rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+        }
+        for (int r = 0; r < n; r++, T += 3) {
+            T[0] = rec[2 + r];
+            T[1] = rec[2 + (r + 1) % n];
+            T[2] = rec[0];
+        }
+        j->cap[rec[0]] = 2;
+    }
+    a->T = T;
+}
+
+/* The cells of cell layer z that the surface crosses (corners not all
+ * alike), in (y, x) order: counted (build 0, pass 1) or written (1). */
+INLINE void walk_cells(iso_job *j, int z, cell_acc *a, const int build)
+{
+    int W = j->W;
+    for (int y = -1; y < j->n[1]; y++) {
+        const uint64_t *R[4];
+        if (!cell_rows(j, y, z, R))
+            continue;
+        for (int w = 0; w < W; w++) {
+            uint64_t v[8], act = cell_words(R, w, W, v);
+            while (act) {
+                int b = __builtin_ctzll(act), x = 64 * w + b - 1;
+                act &= act - 1;
+                const mc_case *K = cell_case(j, x, y, z, cell_mask(v, b));
+                if (build)
+                    build_cell(j, a, lidx(j, x, y), K);
+                else
+                    count_cell(a, K);
+            }
+        }
+    }
+}
+
 /* Pass 1: the chunk's crossing edges (node layers z0 .. z1-1), and the
  * triangles and centre vertices of its cell layers. */
 static void pass_count(void *ctx, size_t c, int worker)
@@ -634,7 +711,8 @@ static void pass_count(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     int z0, z1, W = j->W;
     chunk_range(j, c, &z0, &z1);
-    size_t cnt = 0, ncen = 0, ntri = 0;
+    size_t cnt = 0;
+    cell_acc a = {0};
     for (int z = z0; z < z1; z++) {
         for (int y = -1; y <= j->n[1]; y++) {
             if (!row_has_crossings(j, y, z))
@@ -646,28 +724,12 @@ static void pass_count(void *ctx, size_t c, int worker)
                                 __builtin_popcountll(e[2]));
             }
         }
-        for (int y = -1; y < j->n[1]; y++) {
-            const uint64_t *R[4];
-            if (!cell_rows(j, y, z, R))
-                continue;
-            for (int w = 0; w < W; w++) {
-                uint64_t v[8], act = cell_words(R, w, W, v);
-                while (act) {
-                    int b = __builtin_ctzll(act);
-                    act &= act - 1;
-                    const mc_case *K = cell_case(j, 64 * w + b - 1, y, z, cell_mask(v, b));
-                    ntri += K->nt;
-                    for (int k = 0; k < K->nc; k++)
-                        ntri += K->ck[k];
-                    ncen += K->nc;
-                }
-            }
-        }
+        walk_cells(j, z, &a, 0);
     }
     j->nedge[c] = cnt;
-    j->ncen[c] = ncen;
-    j->ntri[c] = ntri;
-    j->counts[c] = cnt + ncen;
+    j->ncen[c] = a.ncen;
+    j->ntri[c] = a.ntri;
+    j->counts[c] = cnt + a.ncen;
 }
 
 /* The asymptotic decider on face f of the cell at (x, y, z): the bilinear
@@ -740,12 +802,15 @@ static void pass_centres(void *ctx, size_t c, int worker)
 static void pass_build(void *ctx, size_t c, int worker)
 {
     iso_job *j = ctx;
-    int z0, z1, W = j->W;
+    int z0, z1;
     chunk_range(j, c, &z0, &z1);
     uint32_t *ids[2] = {j->scratch[worker], j->scratch[worker] + j->lsz * 3};
-    size_t counter = 0, ncen = 0, base = j->counts[c];
-    uint32_t *T = j->tri + 3 * j->tri_at[c];
-    uint32_t *CR = j->cen + CEN_REC * j->cen_at[c];
+    size_t counter = 0, base = j->counts[c];
+    cell_acc a = {0};
+    a.T = j->tri + 3 * j->tri_at[c];
+    a.CR = j->cen + CEN_REC * j->cen_at[c];
+    a.ids = ids;
+    a.cen0 = base + j->nedge[c];
     number_layer(j, z0, ids[0], base, &counter, 1);
     for (int z = z0; z < z1; z++) {
         /* ids[0] = layer z; number layer z+1 (the next chunk's first layer
@@ -756,42 +821,7 @@ static void pass_build(void *ctx, size_t c, int worker)
             size_t c2 = 0, nb = c + 1 < j->nchunks ? j->counts[c + 1] : 0;
             number_layer(j, z + 1, ids[1], nb, &c2, 0);
         }
-        for (int y = -1; y < j->n[1]; y++) {
-            const uint64_t *R[4];
-            if (!cell_rows(j, y, z, R))
-                continue;
-            for (int w = 0; w < W; w++) {
-                uint64_t v[8], act = cell_words(R, w, W, v);
-                while (act) {
-                    int b = __builtin_ctzll(act), x = 64 * w + b - 1;
-                    act &= act - 1;
-                    size_t idx = lidx(j, x, y);
-                    const mc_case *K = cell_case(j, x, y, z, cell_mask(v, b));
-                    for (int ti = 0; ti < K->nt; ti++, T += 3)
-                        for (int r = 0; r < 3; r++) {
-                            int e = K->e[ti][r];
-                            T[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
-                        }
-                    for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
-                        uint32_t *rec = CR;
-                        int n = K->ck[k];
-                        CR += CEN_REC;
-                        rec[0] = (uint32_t)(base + j->nedge[c] + ncen++);
-                        rec[1] = (uint32_t)n;
-                        for (int r = 0; r < n; r++) {
-                            int e = K->ce[at + r];
-                            rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
-                        }
-                        for (int r = 0; r < n; r++, T += 3) {
-                            T[0] = rec[2 + r];
-                            T[1] = rec[2 + (r + 1) % n];
-                            T[2] = rec[0];
-                        }
-                        j->cap[rec[0]] = 2;
-                    }
-                }
-            }
-        }
+        walk_cells(j, z, &a, 1);
         uint32_t *t = ids[0];
         ids[0] = ids[1];
         ids[1] = t;
