@@ -639,6 +639,25 @@ static int slots_block(interp *I, rscope *s, const node *b)
     return slots_defs(I, s, b) || slots_stmts(I, s, b) ? -1 : 0;
 }
 
+/* The slots of a for (body; an N_BLOCK's statements share the loop
+ * variable's scope) or a comprehension (its condition cond, then its
+ * element elem): iter in s, then the loop variable in a scope of its own. */
+static int slots_loop(interp *I, rscope *s, const char *name, node *iter, node *body, node *cond, node *elem)
+{
+    if (slots_node(I, s, iter))
+        return -1;
+    rscope inner = {.parent = s};
+    int rc = rs_define(I, &inner, name);
+    if (rc == 0 && body)
+        rc = body->kind == N_BLOCK ? slots_block(I, &inner, body) : slots_node(I, &inner, body);
+    if (rc == 0)
+        rc = slots_node(I, &inner, cond);
+    if (rc == 0)
+        rc = slots_node(I, &inner, elem);
+    rs_free(I, &inner);
+    return rc;
+}
+
 static int slots_stmts(interp *I, rscope *s, const node *b)
 {
     if (cstack_exhausted())
@@ -660,19 +679,10 @@ static int slots_stmts(interp *I, rscope *s, const node *b)
             break;
         case N_IMPORT:
             break;
-        case N_FOR: {
-            if (slots_node(I, s, st->kids[0]))
-                return -1;
-            rscope inner = {.parent = s};
-            int rc = rs_define(I, &inner, st->str);
-            if (rc == 0)
-                rc = st->kids[1]->kind == N_BLOCK ? slots_block(I, &inner, st->kids[1])
-                                                  : slots_node(I, &inner, st->kids[1]);
-            rs_free(I, &inner);
-            if (rc)
+        case N_FOR:
+            if (slots_loop(I, s, st->str, st->kids[0], st->kids[1], NULL, NULL))
                 return -1;
             break;
-        }
         default:
             if (slots_node(I, s, st))
                 return -1;
@@ -711,18 +721,8 @@ static int slots_node(interp *I, rscope *s, node *n)
         rs_free(I, &inner);
         return rc;
     }
-    case N_COMP: {
-        if (slots_node(I, s, n->kids[1]))
-            return -1;
-        rscope inner = {.parent = s};
-        rc = rs_define(I, &inner, n->str);
-        if (rc == 0)
-            rc = slots_node(I, &inner, n->kids[2]);
-        if (rc == 0)
-            rc = slots_node(I, &inner, n->kids[0]);
-        rs_free(I, &inner);
-        return rc;
-    }
+    case N_COMP:
+        return slots_loop(I, s, n->str, n->kids[1], NULL, n->kids[2], n->kids[0]);
     default:
         for (int i = 0; i < n->nkids && rc == 0; i++)
             rc = slots_node(I, s, n->kids[i]);
