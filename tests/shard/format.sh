@@ -23,7 +23,7 @@ script = open(sys.argv[1], 'rb').read()
 sums = {}  # (call, section) -> summed values over the parts
 for path in sys.argv[2:]:
     p = part.read(path)  # checks the magic, markers, CRCs, record count, the end
-    assert p.format == 2, 'format'
+    assert p.format == part.FORMAT, 'format'
     assert p.hash_name == b'sha256'
     assert p.script_hash == hashlib.sha256(script).digest(), 'script hash'
     assert p.seed == 1, 'seed'

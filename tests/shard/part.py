@@ -15,6 +15,8 @@ import struct
 import zlib
 from types import SimpleNamespace
 
+FORMAT = 2  # the format number docs/scale.md gives; the scripts check parts carry it
+
 
 class Bytes:
     """A cursor over a file's bytes: take(n), u32(), u64(), i64(), sstr()."""

@@ -20,7 +20,7 @@ PYTHONPATH=$(dirname "$0") PYTHONDONTWRITEBYTECODE=1 python3 - "$tmp"/*.part <<'
 import sys
 import part
 p = part.read(sys.argv[1])
-assert p.format == 2
+assert p.format == part.FORMAT, 'format'
 for r in p.records:
     print('call %d.%d %s op %d chunks %d lo %d hi %d bytes %d' % (r.call, r.section, r.kind, r.op, r.chunks, r.lo, r.hi, r.total))
 print('calls', p.calls)

@@ -30,7 +30,7 @@ import part
 
 def records(path):
     p = part.read(path)  # checks the markers, every CRC and that none is truncated
-    assert p.format == 2, 'format'
+    assert p.format == part.FORMAT, 'format'
     out = []
     for r in p.records:
         assert (r.lo, r.hi) == (r.chunks * p.index // p.count, r.chunks * (p.index + 1) // p.count), 'chunk range'
