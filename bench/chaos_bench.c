@@ -234,9 +234,39 @@ static void job_measure3(void)
     volume_free(&vol);
 }
 
+/* A fresh job of ~10 ms swings several-fold on the shared machine (one
+ * sample of the plain loop took 2–13 ms in the same minute): each job runs
+ * FRESH_REPS times and reports its best and median CPU, the fewest faults
+ * and the smallest peak RSS; the ratio is best against best. */
+#define FRESH_REPS 5
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static fresh run_fresh_best(void (*job)(void), double *median)
+{
+    double t[FRESH_REPS];
+    fresh best = run_fresh(job);
+    t[0] = best.cpu;
+    for (int r = 1; r < FRESH_REPS; r++) {
+        fresh f = run_fresh(job);
+        t[r] = f.cpu;
+        best.cpu = f.cpu < best.cpu ? f.cpu : best.cpu;
+        best.rss_mb = f.rss_mb < best.rss_mb ? f.rss_mb : best.rss_mb;
+        best.faults = f.faults < best.faults ? f.faults : best.faults;
+    }
+    qsort(t, FRESH_REPS, sizeof t[0], cmp_double);
+    *median = t[FRESH_REPS / 2];
+    return best;
+}
+
 static void fresh_report(void)
 {
-    fresh base = run_fresh(job_empty);
+    double base_med;
+    fresh base = run_fresh_best(job_empty, &base_med);
     struct { const char *what; void (*job)(void); double data_mb; } jobs[] = {
         {"plain 2-D loop (1024^2 uint32 counts)", job_plain2, 4},
         {"chaos render 1024^2 (fit, counts, tone map)", job_render2, 24},
@@ -245,21 +275,23 @@ static void fresh_report(void)
         {"plain 3-D loop (256^3 uint32, prefetch ring)", job_plain3, 64},
         {"chaos measure 256^3 (counts, float volume)", job_measure3, 64},
     };
-    printf("fresh process, %d points, 1 thread (CPU s and peak RSS above an empty child: %.1f MB)\n",
-           FRESH_POINTS, base.rss_mb);
-    printf("  %-46s %8s %9s %9s %8s %7s\n", "job", "CPU s", "RSS MB", "data MB", "RSS/data", "faults");
+    printf("fresh process, %d points, 1 thread, best and median of %d (CPU s above an empty child's\n"
+           "  best %.4f s; peak RSS above its %.1f MB)\n", FRESH_POINTS, FRESH_REPS, base.cpu, base.rss_mb);
+    printf("  %-46s %8s %8s %8s %8s %8s %7s\n", "job", "CPU best", "median", "RSS MB", "data MB", "RSS/data",
+           "faults");
     double cpu[sizeof jobs / sizeof jobs[0]];
     for (size_t i = 0; i < sizeof jobs / sizeof jobs[0]; i++) {
-        fresh f = run_fresh(jobs[i].job);
+        double med;
+        fresh f = run_fresh_best(jobs[i].job, &med);
         double rss = f.rss_mb - base.rss_mb;
         cpu[i] = f.cpu - base.cpu;
-        printf("  %-46s %8.3f %9.1f %9.0f %7.2fx %7ld\n", jobs[i].what, cpu[i], rss, jobs[i].data_mb,
-               rss / jobs[i].data_mb, f.faults - base.faults);
+        printf("  %-46s %8.4f %8.4f %8.1f %8.0f %7.2fx %7ld\n", jobs[i].what, cpu[i], med - base_med, rss,
+               jobs[i].data_mb, rss / jobs[i].data_mb, f.faults - base.faults);
     }
     printf("  (data: what the job must hold at once; 2-D render: 8 B/px counts + 16 B/px float RGBA image,\n"
            "   with colour 20 B/px histogram; 3-D: the 4 B/voxel float volume)\n");
-    printf("  fixed cost of a 1024^2 chaos render (fit, counts, tone map) vs the plain loop: %.2fx CPU"
-           " (goal <= 2x)\n", cpu[1] / cpu[0]);
+    printf("  fixed cost of a 1024^2 chaos render (fit, counts, tone map) vs the plain loop: %.2fx CPU,"
+           " best of %d each (goal <= 2x)\n", cpu[1] / cpu[0], FRESH_REPS);
 }
 
 /* best-of-3 timer: thread CPU time for one thread, wall time otherwise */

@@ -24,6 +24,7 @@
 #include "lexer.h"
 #include "tonemap.h"
 #include "report.h"
+#include "shard.h"
 
 /* ---- function sets ---------------------------------------------------------------------- */
 
@@ -454,8 +455,11 @@ static int chaos_fset_view(interp *I, const lang_fset *f, const fset_order *o, c
             return -1;
     } else {
         double lo[3], hi[3];
-        if ((c = fset_chaos_box(&f->fs, o, co, lo, hi, &e)))
-            return lang_rt_error(I, c, &e, "chaos_fset");
+        if (!shard_window_take(I, 3, lo, hi)) { /* merge: the box the shards fitted */
+            if ((c = fset_chaos_box(&f->fs, o, co, lo, hi, &e)))
+                return lang_rt_error(I, c, &e, "chaos_fset");
+            shard_window_put(I, 3, lo, hi);
+        }
         if (lang_frame_default(I, lo, hi, w, h, &cam, "chaos_fset: cannot frame the set (its box is not finite)"))
             return -1;
     }
@@ -538,9 +542,12 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
     if (a[4].k != V_NIL) {
         if (lang_window_arg(I, a[4], lo, hi, "chaos_fset: window"))
             goto done;
-    } else if ((c = fset_order_validate(&o, f->n, &e)) || (c = fset_chaos_fit(&f->fs, &o, &co, w, h, lo, hi, &run, &e))) {
-        lang_rt_error(I, c, &e, "chaos_fset");
-        goto done;
+    } else if (!shard_window_take(I, 2, lo, hi)) { /* in a merge, the window the shards fitted */
+        if ((c = fset_order_validate(&o, f->n, &e)) || (c = fset_chaos_fit(&f->fs, &o, &co, w, h, lo, hi, &run, &e))) {
+            lang_rt_error(I, c, &e, "chaos_fset");
+            goto done;
+        }
+        shard_window_put(I, 2, lo, hi);
     }
     double bytes = (double)w * h * 8 * (I->threads + 1);
     if ((double)w * h > I->lim.max_pixels) {

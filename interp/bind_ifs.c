@@ -372,6 +372,18 @@ rt_code lang_chaos_fit(interp *I, const chaos_sys *s, const chaos_opts *o, int w
     return chaos_fit(s, &fo, w, h, lo, hi, e);
 }
 
+rt_code lang_chaos_fit_call(interp *I, const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
+                            rt_error *e)
+{
+    int dim = s->ifs ? s->ifs->dim : s->rifs->dim;
+    if (shard_window_take(I, dim, lo, hi)) /* merge: the window the shards fitted */
+        return RT_OK;
+    rt_code c = lang_chaos_fit(I, s, o, w, h, lo, hi, e);
+    if (!c)
+        shard_window_put(I, dim, lo, hi);
+    return c;
+}
+
 int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what)
 {
     const lang_ifs *li = lang_as_ifs(v);
@@ -633,7 +645,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
         hi[1] = win[3];
         if (!(hi[0] > lo[0]) || !(hi[1] > lo[1]))
             return err_at(I, NULL, ERR_VALUE, "chaos: window is [xmin, xmax, ymin, ymax] with min < max");
-    } else if ((c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e))) {
+    } else if ((c = lang_chaos_fit_call(I, &s, &o, w, h, lo, hi, &e))) {
         return lang_rt_error(I, c, &e, "chaos");
     }
     if ((double)w * h * ss * ss > I->lim.max_pixels)
@@ -709,7 +721,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
         for (int i = 0; i < dim; i++)
             if (!(hi[i] > lo[i]))
                 return err_at(I, NULL, ERR_VALUE, "measure: the box needs lo < hi on every axis");
-    } else if ((c = lang_chaos_fit(I, &s, &o, (int)g[0], (int)g[1], lo, hi, &e))) {
+    } else if ((c = lang_chaos_fit_call(I, &s, &o, (int)g[0], (int)g[1], lo, hi, &e))) {
         return lang_rt_error(I, c, &e, "measure");
     }
     rt_run run = lang_run(I);
@@ -804,7 +816,7 @@ static int b_view(interp *I, value *a, int n, value *out)
     rt_code c;
     if (a[1].k == V_NIL) { /* the default framing (camera.h) of the fitted box */
         double lo[3], hi[3];
-        if ((c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e)))
+        if ((c = lang_chaos_fit_call(I, &s, &o, w, h, lo, hi, &e)))
             return lang_rt_error(I, c, &e, "view");
         if (lang_frame_default(I, lo, hi, w, h, &cam, "view: cannot frame the attractor (its box is not finite)"))
             return -1;

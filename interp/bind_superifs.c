@@ -19,11 +19,23 @@
 #include "superifs.h"
 #include "tonemap.h"
 #include "report.h"
+#include "shard.h"
 
 /* ---- super IFS ------------------------------------------------------------------------- */
 
+/* The points are computed when superifs_image first needs them (the
+ * engine call, split across shards: superifs.h), so a script may print a
+ * super IFS, its V, points, steps and ifs (all from the draws) in a shard
+ * without making its points a result the shard must have whole. */
 typedef struct lang_superifs {
-    superifs_state st;
+    fset fs;           /* a copy of the sets (sets, maps, p in mem) */
+    double *P;         /* N, or NULL */
+    superifs_opts so;
+    void *mem;
+    int *ifs_of;       /* V: the IFS of each buffer at the last step */
+    superifs_state st; /* st.pts NULL until computed */
+    long part;         /* a shard: the split engine call whose share only st holds; -1 */
+    const node *part_at; /* where that call was made */
     int nifs;
     uint64_t steps;
 } lang_superifs;
@@ -32,21 +44,53 @@ static void superifs_destroy(void *pp)
 {
     lang_superifs *s = pp;
     superifs_free(&s->st);
+    rt_free(s->mem);
+    rt_free(s->P);
+    rt_free(s->ifs_of);
     rt_free(s);
+}
+
+/* Copy the sets into one block that s owns. */
+static int copy_sets(lang_superifs *s, const fset *fs)
+{
+    size_t bytes = (size_t)fs->n * sizeof(fset_ifs);
+    for (int k = 0; k < fs->n; k++)
+        bytes += (size_t)fs->sets[k].n * (sizeof(affine) + sizeof(double));
+    unsigned char *m = rt_malloc(bytes);
+    if (!m)
+        return -1;
+    fset_ifs *sets = (fset_ifs *)m;
+    unsigned char *p = m + (size_t)fs->n * sizeof(fset_ifs);
+    for (int k = 0; k < fs->n; k++) {
+        size_t n = (size_t)fs->sets[k].n;
+        affine *maps = (affine *)p;
+        memcpy(maps, fs->sets[k].maps, n * sizeof(affine));
+        p += n * sizeof(affine);
+        double *pr = NULL;
+        if (fs->sets[k].p) {
+            pr = (double *)p;
+            memcpy(pr, fs->sets[k].p, n * sizeof(double));
+        }
+        p += n * sizeof(double);
+        sets[k] = (fset_ifs){(int)n, maps, pr};
+    }
+    s->mem = m;
+    s->fs = (fset){fs->n, sets};
+    return 0;
 }
 
 static void superifs_summary(const void *pp, bytebuf *out)
 {
     const lang_superifs *s = pp;
-    bytebuf_printf(out, "superifs: V = %d buffers of %zu points, %d IFSs, %llu steps; last step used", s->st.V,
-                   s->st.points, s->nifs, (unsigned long long)s->steps);
-    for (int v = 0; v < s->st.V && v < 16; v++) {
-        if (s->st.ifs_of[v] < 0)
+    bytebuf_printf(out, "superifs: V = %d buffers of %zu points, %d IFSs, %llu steps; last step used", s->so.V,
+                   s->so.points, s->nifs, (unsigned long long)s->steps);
+    for (int v = 0; v < s->so.V && v < 16; v++) {
+        if (s->ifs_of[v] < 0)
             bytebuf_printf(out, " -");
         else
-            bytebuf_printf(out, " F%d", s->st.ifs_of[v] + 1);
+            bytebuf_printf(out, " F%d", s->ifs_of[v] + 1);
     }
-    if (s->st.V > 16)
+    if (s->so.V > 16)
         bytebuf_printf(out, " …");
 }
 
@@ -55,7 +99,7 @@ static int ifs_value(interp *I, const void *pp, size_t v, value *out)
 {
     (void)I;
     const lang_superifs *s = pp;
-    *out = s->st.ifs_of[v] < 0 ? val_nil() : val_num(s->st.ifs_of[v] + 1);
+    *out = s->ifs_of[v] < 0 ? val_nil() : val_num(s->ifs_of[v] + 1);
     return 0;
 }
 
@@ -63,13 +107,13 @@ static int superifs_get(interp *I, const void *pp, const char *name, value *out)
 {
     const lang_superifs *s = pp;
     if (strcmp(name, "V") == 0)
-        *out = val_num(s->st.V);
+        *out = val_num(s->so.V);
     else if (strcmp(name, "points") == 0)
-        *out = val_num((double)s->st.points);
+        *out = val_num((double)s->so.points);
     else if (strcmp(name, "steps") == 0)
         *out = val_num((double)s->steps);
     else if (strcmp(name, "ifs") == 0) {
-        return val_list_build(I, (size_t)s->st.V, ifs_value, s, out);
+        return val_list_build(I, (size_t)s->so.V, ifs_value, s, out);
     } else
         return 1;
     return 0;
@@ -135,22 +179,24 @@ static int b_superifs(interp *I, value *a, int n, value *out)
     double bytes = (double)V * (double)pts * 16 * 2;
     if (mem_precheck(I, bytes, "superifs: the buffers"))
         goto done;
-    lang_superifs *ls = mem_calloc(I, 1, sizeof *ls);
-    if (!ls) {
-        err_at(I, NULL, ERR_MEMORY, "out of memory");
-        goto done;
-    }
     rt_error e;
-    rt_run run = lang_run(I);
-    double t0 = report_clock();
-    rt_code c = superifs_run(&f->fs, P, &so, &ls->st, &run, &e);
-    if (!c)
-        report_work(I, "super IFS", "points", (double)so.points * (double)so.V, t0);
+    rt_code c = superifs_check(&f->fs, P, &so, &e); /* the errors of the run, here where they were made */
     if (c) {
-        mem_free(I, ls);
         lang_rt_error(I, c, &e, "superifs");
         goto done;
     }
+    lang_superifs *ls = mem_calloc(I, 1, sizeof *ls);
+    if (!ls || copy_sets(ls, &f->fs) || !(ls->ifs_of = rt_malloc((size_t)V * sizeof *ls->ifs_of))) {
+        if (ls)
+            superifs_destroy(ls);
+        err_at(I, NULL, ERR_MEMORY, "out of memory");
+        goto done;
+    }
+    ls->P = P; /* ls owns it */
+    P = NULL;
+    ls->so = so;
+    ls->part = -1;
+    superifs_last_ifs(&ls->fs, ls->P, &ls->so, ls->ifs_of);
     ls->nifs = f->n;
     ls->steps = so.steps;
     *out = val_obj(I, &superifs_class, ls);
@@ -165,31 +211,45 @@ done:
 static int b_superifs_image(interp *I, value *a, int n, value *out)
 {
     (void)n;
-    const lang_superifs *s = AS_OBJ(a[0])->payload;
+    lang_superifs *s = AS_OBJ(a[0])->payload;
     long buf = (long)a[1].u.n; /* declared int>=1 */
     int w, h;
     ramp r;
     tonemap_opts t;
-    if (buf > s->st.V)
-        return err_arg(I, 1, ERR_VALUE, "superifs_image: buffer must be between 1 and V = %d, got %ld", s->st.V, buf);
+    if (buf > s->so.V)
+        return err_arg(I, 1, ERR_VALUE, "superifs_image: buffer must be between 1 and V = %d, got %ld", s->so.V, buf);
     if (lang_arg_size2(I, a[2], &w, &h, "superifs_image: size") ||
         lang_tone_args(I, a[4], a[5], a[6], a[7], a[8], &t, &r, "superifs_image"))
         return -1;
     double lo[2], hi[2];
-    if (a[3].k != V_NIL) {
-        if (lang_window_arg(I, a[3], lo, hi, "superifs_image: window"))
-            return -1;
-    } else {
+    if (a[3].k != V_NIL && lang_window_arg(I, a[3], lo, hi, "superifs_image: window"))
+        return -1;
+    if ((double)w * h > I->lim.max_pixels)
+        return err_at(I, NULL, ERR_LIMIT, "superifs_image: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);
+    rt_error e;
+    rt_code c;
+    if (!s->st.pts) { /* the points: the engine call (split in a shard) */
+        rt_run run = lang_run(I);
+        double t0 = report_clock();
+        if ((c = superifs_run(&s->fs, s->P, &s->so, &s->st, &run, &e)))
+            return lang_rt_error(I, c, &e, "superifs_image");
+        report_work(I, "super IFS", "points", (double)s->so.points * (double)s->so.V, t0);
+        s->part = shard_pending_call(I, &s->part_at);
+    } else if (s->part >= 0) {
+        shard_pend_again(I, s->part, s->part_at); /* drawn from a shard's points: a partial result of that call */
+    }
+    if (s->part >= 0) { /* a shard: the result becomes a partial value (shard.h) */
+        *out = val_nil();
+        return 0;
+    }
+    if (a[3].k == V_NIL) {
         if (superifs_bounds(&s->st, lo, hi)) /* all buffers: every buffer is drawn at one scale */
             return err_at(I, NULL, ERR_VALUE, "superifs_image: the buffers hold no finite points; give window:");
         fset_fit_aspect(lo, hi, w, h, 0.03);
     }
-    if ((double)w * h > I->lim.max_pixels)
-        return err_at(I, NULL, ERR_LIMIT, "superifs_image: %d×%d pixels exceed the pixel limit (raise it with --max-pixels)", w, h);
     hist2 hs;
-    rt_error e;
     image *im = NULL;
-    rt_code c = hist2_init(&hs, w, h, lo, hi, 0, &e);
+    c = hist2_init(&hs, w, h, lo, hi, 0, &e);
     if (c)
         return lang_rt_error(I, c, &e, "superifs_image");
     c = superifs_render(&s->st, (int)buf - 1, &hs, &e);

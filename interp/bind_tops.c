@@ -37,7 +37,7 @@ static int ifs_window(interp *I, const lang_ifs *li, value window, int w, int h,
     o.seed = seed;
     o.points = 100000;
     rt_error e;
-    rt_code c = lang_chaos_fit(I, &s, &o, w, h, lo, hi, &e);
+    rt_code c = lang_chaos_fit_call(I, &s, &o, w, h, lo, hi, &e);
     return c ? lang_rt_error(I, c, &e, what) : 0;
 }
 

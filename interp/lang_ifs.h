@@ -25,6 +25,12 @@ int lang_get_sys(interp *I, value v, chaos_sys *s, const char *what);
  * fitting a window calls this, not chaos_fit). */
 rt_code lang_chaos_fit(interp *I, const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
                        rt_error *e);
+/* lang_chaos_fit for the window of the engine call the binding makes next
+ * (chaos, measure, view, top, steal…): a shard records the window in its
+ * part, and merge takes it from there instead of running the pre-pass
+ * (shard_window_put/take, shard.h). */
+rt_code lang_chaos_fit_call(interp *I, const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
+                            rt_error *e);
 /* Maps (and probabilities) from a table of rows, a list of maps or an ifs:
  * malloc'd arrays; returns 1 if probabilities were given, 0 if not, -1 on
  * error. */

@@ -2,6 +2,7 @@
 #include "shard.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -101,6 +102,8 @@ static void shard_zero(shard *s)
     memset(s, 0, sizeof *s);
     s->pending = -1;
     s->cur = -1;
+    s->win_seq = -1;
+    s->win_taken = -1;
 }
 
 int shard_init_run(shard *s, const char *spec)
@@ -257,6 +260,7 @@ struct shard_rec {
     uint32_t seq, sub, op;
     char kind[16];
     uint64_t nchunks, total, chunk_bytes;
+    double win[6]; /* SHARD_OP_WINDOW: its payload, lo[dim] then hi[dim]; zero otherwise */
 };
 
 static void rec_head(bytebuf *b, const shard_rec *r, uint64_t lo, uint64_t hi, uint64_t payload)
@@ -475,10 +479,25 @@ static int unused_record(shard *s)
                    s->next_rec, r->seq, r->kind);
 }
 
+/* merge: step over the window record of the call whose window was taken
+ * (it follows that call's sections); one not taken stays, to be reported
+ * as unused. */
+static void skip_window(shard *s)
+{
+    while (s->next_rec < s->nrecs && s->recs[s->next_rec].op == SHARD_OP_WINDOW &&
+           (long)s->recs[s->next_rec].seq == s->win_taken) {
+        for (int i = 0; i < s->count; i++) /* the same size in every part: head, doubles, CRC */
+            s->off[i] += REC_HEAD + (long)s->recs[s->next_rec].total + 4;
+        s->next_rec++;
+    }
+}
+
 static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo, size_t *hi)
 {
     shard *s = (shard *)rs;
     interp *I = s->I;
+    if (s->merging)
+        skip_window(s);
     if (s->pending >= 0) { /* a second call inside one builtin while the first one is partial */
         taint(s, (uint32_t)s->pending, s->pending_at, "feeds another engine call inside the same builtin");
         return -1;
@@ -564,6 +583,66 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     put_u32(&s->part, part_crc(0, s->part.data + start, s->part.len - start));
     s->nrec++;
     return s->part.failed ? rt_fail(e, RT_ENOMEM, "out of memory for the part file") : RT_OK;
+}
+
+/* shard: the window record of split call seq, after its sections (its
+ * chunk range like theirs, so every record of a part says whose it is). */
+static void put_window(shard *s, uint32_t seq)
+{
+    shard_rec r;
+    memset(&r, 0, sizeof r);
+    r.seq = seq;
+    r.sub = s->sub++;
+    r.op = SHARD_OP_WINDOW;
+    memcpy(r.kind, s->cur_kind, 16);
+    r.nchunks = s->cur_nchunks;
+    r.total = 16 * (uint64_t)s->win_dim;
+    r.chunk_bytes = 8;
+    size_t lo, hi;
+    chunk_range(r.nchunks, s->index, s->count, &lo, &hi);
+    size_t start = s->part.len;
+    rec_head(&s->part, &r, lo, hi, r.total);
+    for (int k = 0; k < 2 * s->win_dim; k++) { /* the doubles' IEEE 754 bits, little-endian */
+        uint64_t bits;
+        memcpy(&bits, &s->win[k], 8);
+        put_u64(&s->part, bits);
+    }
+    if (!s->part.failed)
+        put_u32(&s->part, part_crc(0, s->part.data + start, s->part.len - start));
+    s->nrec++;
+}
+
+void shard_window_put(interp *I, int dim, const double *lo, const double *hi)
+{
+    shard *s = I->shard;
+    if (!s || s->merging || dim < 1 || dim > 3)
+        return;
+    if (s->win_seq == (long)s->seq) { /* a second fit before one call: which one the call used is not known here */
+        s->win_dim = 0;
+        return;
+    }
+    s->win_seq = s->seq;
+    s->win_dim = dim;
+    memcpy(s->win, lo, (size_t)dim * sizeof *lo);
+    memcpy(s->win + dim, hi, (size_t)dim * sizeof *hi);
+}
+
+int shard_window_take(interp *I, int dim, double *lo, double *hi)
+{
+    shard *s = I->shard;
+    if (!s || !s->merging || s->win_taken == (long)s->seq)
+        return 0; /* the second fit before one call: the shards recorded none */
+    skip_window(s);
+    for (uint32_t k = s->next_rec; k < s->nrecs && s->recs[k].seq <= s->seq; k++) {
+        const shard_rec *r = &s->recs[k];
+        if (r->seq == s->seq && r->op == SHARD_OP_WINDOW && r->total == 16 * (uint64_t)dim) {
+            memcpy(lo, r->win, (size_t)dim * sizeof *lo);
+            memcpy(hi, r->win + dim, (size_t)dim * sizeof *hi);
+            s->win_taken = s->seq;
+            return 1;
+        }
+    }
+    return 0;
 }
 
 static int file_sha256(const char *path, unsigned char out[32], rt_error *e)
@@ -685,7 +764,8 @@ static int read_header(shard *s, reader *r, int *index, int *count, char *msg, s
     else if (rd(r, b, 4))
         snprintf(msg, ms, "is truncated (in its header)");
     else if (get_u32(b) != SHARD_FORMAT)
-        snprintf(msg, ms, "has part format %u; this frac reads format %d", get_u32(b), SHARD_FORMAT);
+        snprintf(msg, ms, "has part format %u, from a%s frac; this frac reads format %d only: make the parts again with it",
+                 get_u32(b), get_u32(b) < SHARD_FORMAT ? "n older" : "nother", SHARD_FORMAT);
     else if (rd_str(r, str, sizeof str))
         snprintf(msg, ms, "is truncated or corrupt (in its header)");
     else if (strcmp(str, FRAC_VERSION) != 0)
@@ -818,7 +898,8 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         payload_range(&h, elo, ehi, &efrom, &elen);
         int sums = h.op == PAR_OP_SUM; /* LEB128: one to ten bytes a value */
         if (lo != elo || hi != ehi || (sums ? len < h.total / 8 || len / 10 > h.total / 8 : len != elen) ||
-            h.op < PAR_OP_SUM || h.op > PAR_OP_COMBINE ||
+            h.op < PAR_OP_SUM || h.op > SHARD_OP_WINDOW ||
+            (h.op == SHARD_OP_WINDOW && (h.chunk_bytes != 8 || (h.total != 32 && h.total != 48))) ||
             (h.op == PAR_OP_SUM && h.total % 8) || (h.op == PAR_OP_COMBINE && (!h.chunk_bytes || h.total % h.chunk_bytes))) {
             snprintf(msg, sizeof msg, "it is corrupt (record at byte %ld)", at);
             break;
@@ -846,6 +927,19 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
         if (sums && !sum_done(&sd)) {
             snprintf(msg, sizeof msg, "it is corrupt (the sums of record %u, engine call %u)", k, h.seq);
             break;
+        }
+        if (h.op == SHARD_OP_WINDOW) { /* its doubles (one block: 48 bytes at most) */
+            int dim = (int)(h.total / 16), ok = 1;
+            for (int q = 0; q < 2 * dim; q++) {
+                uint64_t bits = get_u64(blk + 8 * q);
+                memcpy(&h.win[q], &bits, 8);
+            }
+            for (int q = 0; q < dim; q++)
+                ok = ok && isfinite(h.win[q]) && isfinite(h.win[dim + q]) && h.win[dim + q] > h.win[q];
+            if (!ok) {
+                snprintf(msg, sizeof msg, "it is corrupt (the window of record %u, engine call %u)", k, h.seq);
+                break;
+            }
         }
         if (first) {
             if (k % 64 == 0) {
@@ -1019,6 +1113,9 @@ int shard_attempt_begin(shard *s, interp *I, const char *script, const unsigned 
     s->live = 0;
     s->nrec = 0;
     s->next_rec = 0;
+    s->win_seq = -1;
+    s->win_dim = 0;
+    s->win_taken = -1;
     sha256_ctx h;
     sha256_init(&h);
     sha256_update(&h, text, len);
@@ -1044,6 +1141,8 @@ int shard_attempt_end(shard *s, int ok, const char *script)
 {
     interp *I = s->I;
     int rc = 0;
+    if (ok && s->merging)
+        skip_window(s);
     if (ok && s->merging && (s->next_rec < s->nrecs || s->seq != s->ncalls)) {
         if (s->next_rec < s->nrecs)
             unused_record(s);
@@ -1217,7 +1316,11 @@ int shard_scan_args(interp *I, const char *bname, const node *call, const value 
 int shard_after_builtin(interp *I, int rc, value *out)
 {
     shard *s = I->shard;
-    if (!s || s->pending < 0)
+    if (!s)
+        return rc;
+    long win = s->win_dim ? s->win_seq : -1; /* a window fitted for the call this builtin made */
+    s->win_seq = -1;
+    if (s->pending < 0)
         return rc;
     if (rc != 0) { /* the builtin used its partial result itself (a pre-pass, a check) */
         if (!s->again && !(I->err.active && I->err.kind == ERR_INTERRUPT)) {
@@ -1227,6 +1330,8 @@ int shard_after_builtin(interp *I, int rc, value *out)
         s->pending = -1;
         return -1;
     }
+    if (win == s->pending && s->cur == s->pending)
+        put_window(s, (uint32_t)s->pending);
     partial *p = mem_alloc(I, sizeof *p);
     if (!p)
         return -1;
@@ -1243,6 +1348,23 @@ int shard_after_builtin(interp *I, int rc, value *out)
 int shard_pending(const interp *I)
 {
     return I->shard && !I->shard->merging && I->shard->pending >= 0;
+}
+
+long shard_pending_call(const interp *I, const node **at)
+{
+    if (!shard_pending(I))
+        return -1;
+    *at = I->shard->pending_at;
+    return I->shard->pending;
+}
+
+void shard_pend_again(interp *I, long seq, const node *at)
+{
+    shard *s = I->shard;
+    if (!s || s->merging || s->pending >= 0)
+        return;
+    s->pending = seq;
+    s->pending_at = at;
 }
 
 int shard_skip_save(interp *I)

@@ -25,7 +25,10 @@
  * nothing, when one is wrong. Then it evaluates the script: call k with a
  * record takes its accumulator from the parts — sums added, rows placed,
  * streamed part by part, never N copies — and finishes as in a single run;
- * call k without a record (a full call) is computed. The format is in
+ * call k without a record (a full call) is computed. A split call whose
+ * builtin fitted a window first (the pre-pass of chaos, measure, …) has one
+ * more record after its sections, the window as doubles: the merge takes it
+ * instead of fitting (shard_window_put/take). The format is in
  * docs/scale.md.
  *
  * The struct lives on main's stack across the attempts (no heap of its own
@@ -42,7 +45,8 @@
 #include "par.h"
 #include "state.h"
 
-#define SHARD_FORMAT 2
+#define SHARD_FORMAT 3
+#define SHARD_OP_WINDOW 4 /* a record's op: the window fitted for its call (after the par_part_op ones) */
 #define SHARD_MAX_FULL 4096
 #define SHARD_MAX_PARTS 65536
 
@@ -74,6 +78,10 @@ typedef struct shard {
     uint32_t sub;         /* its next section */
     size_t cur_nchunks;
     char cur_kind[16];
+    long win_seq;         /* shard: the call the window below was fitted for; -1 none */
+    int win_dim;          /* its dimension; 0 after a second fit for the same call (none recorded) */
+    double win[6];        /* lo[dim], hi[dim] */
+    long win_taken;       /* merge: the call whose window was taken from the parts; -1 none */
     bytebuf part;         /* shard: the part file being built */
     uint32_t nrec;
     FILE *devnull;        /* shard: print() goes nowhere (merge prints) */
@@ -117,6 +125,23 @@ int shard_after_builtin(interp *I, int rc, value *out);
  * replaced by a partial value, so a binding may skip finishing it (tone
  * mapping a histogram nobody will see). */
 int shard_pending(const interp *I);
+/* In a shard, the split engine call whose partial result the current
+ * builtin will return (-1: none) and in *at where it was made — for a value
+ * computed lazily and kept (superifs_image keeps the super IFS's points). */
+long shard_pending_call(const interp *I, const node **at);
+/* The current builtin's result is drawn from split call seq's partial
+ * result (made at `at`), kept from an earlier builtin: it becomes a partial
+ * value of that call too (used elsewhere, the call is made full and the
+ * script re-run). */
+void shard_pend_again(interp *I, long seq, const node *at);
+/* Windows fitted for the next engine call (the pre-pass finding an
+ * attractor's bounds, lang_chaos_fit_call). In a shard, put notes lo and hi
+ * (dim values each); if that call is split, its part gets a window record
+ * after the call's sections (two fits before one call: none). In merge,
+ * take returns 1 with the shards' window in lo, hi when the parts hold one
+ * for the next call (the binding then skips its pre-pass), else 0. */
+void shard_window_put(interp *I, int dim, const double *lo, const double *hi);
+int shard_window_take(interp *I, int dim, double *lo, double *hi);
 /* save(v, …) in a shard: writes nothing (1: handled), 0 otherwise. */
 int shard_skip_save(interp *I);
 

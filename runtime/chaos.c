@@ -345,8 +345,8 @@ INLINE size_t cell_of(double f)
  * side sums and cleared. */
 COLD void flush_cell(worker *w, const uint32_t *cnt, uint32_t *cell, size_t nbins)
 {
-    if (!w->carry)
-        w->carry = rt_calloc(4 * nbins, sizeof *w->carry);
+    if (!w->carry) /* the bins' cells and the outside cell (flushed too, never read) */
+        w->carry = rt_calloc(4 * (nbins + 1), sizeof *w->carry);
     if (!w->carry) {
         w->oom = 1;
         return;
@@ -362,10 +362,10 @@ typedef uint32_t cell4 __attribute__((vector_size(16)));
 #endif
 
 /* One coloured hit: the palette entry (1, r, g, b) added to the cell
- * (count, r, g, b) in one 16-byte add; out is the outside cell (never
- * flushed, never read). */
-INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint32_t *pe,
-                     const uint32_t *out, size_t nbins)
+ * (count, r, g, b) in one 16-byte add. The outside cell is one more cell:
+ * it is flushed like the others (no test in the loop), its sums are never
+ * read, and its count between flushes gives the loop its outside hits. */
+INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint32_t *pe, size_t nbins)
 {
 #if defined(__GNUC__)
     cell4 a, h;
@@ -379,7 +379,7 @@ INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint3
         cell[q] += pe[q];
     uint32_t n = cell[0];
 #endif
-    if (!(n & 0xffffu) && cell != out)
+    if (!(n & 0xffffu))
         flush_cell(w, cnt, cell, nbins);
 }
 
@@ -400,6 +400,13 @@ INLINE void chunk_orbit(const job *j, size_t chunk, orbit *ob, uint64_t *count, 
         if (colour == CHAOS_COLOUR_BLEND)
             (void)orbit_colour(ob, d, colour);
     }
+}
+
+/* Hits of the outside colour cell so far: its count and what flushes moved
+ * into the side sums. */
+INLINE uint64_t out_hits(const worker *w, const uint32_t *out, size_t nbins)
+{
+    return out[0] + (w->carry ? w->carry[4 * nbins] : 0);
 }
 
 /* Both 2-D loops prefetch the hit's bin and add the hit RING points later
@@ -436,9 +443,11 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     uint64_t inside = 0;
     size_t ring[RING];
     uint32_t *ringp[RING];       /* colour: the cells, */
-    const uint32_t *ringe[RING]; /* and their hits' palette entries */
+    uint32_t ringe[RING];        /* and their hits' palette indices */
     for (int q = 0; q < RING; q++)
-        ring[q] = nbins, ringp[q] = out, ringe[q] = pal[0];
+        ring[q] = nbins, ringp[q] = out, ringe[q] = 0;
+    uint64_t out0 = colour != CHAOS_COLOUR_NONE ? out_hits(w, out, nbins) : 0;
+#pragma GCC unroll 2
     for (uint64_t i = 0; i < count; i++) {
         uint32_t k = step_choose(&r, n, thr, sel, &st, &cur, kind);
         step_map2(M + 6 * (size_t)k, &x, &y);
@@ -472,26 +481,26 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
             continue;
         }
         /* colour: prefetch this hit's cell, add the hit RING points back
-         * (outside points go to the extra cell nbins) */
+         * (outside points go to the extra cell nbins, which counts them) */
         uint32_t *cell = out;
-        if (fx >= 0 && fx < fw && fy >= 0 && fy < fh) {
+        if (fx >= 0 && fx < fw && fy >= 0 && fy < fh)
             cell = cnt + 4 * (cell_of(fy) * hw + cell_of(fx));
-            inside++;
-        }
         PREFETCHW(cell);
         size_t slot = (size_t)(i % RING);
-        add_cell(w, cnt, ringp[slot], ringe[slot], out, nbins);
+        add_cell(w, cnt, ringp[slot], pal[ringe[slot]], nbins);
         ringp[slot] = cell;
-        ringe[slot] = pal[pc];
+        ringe[slot] = pc;
     }
     for (int q = 0; q < RING; q++) {
         if (colour != CHAOS_COLOUR_NONE)
-            add_cell(w, cnt, ringp[q], ringe[q], out, nbins);
+            add_cell(w, cnt, ringp[q], pal[ringe[q]], nbins);
         else if (ring[q] != j->nbins && wide)
             cnt64[ring[q]]++;
         else if (ring[q] != j->nbins)
             bump(w, cnt, ring[q], j->nbins);
     }
+    if (colour != CHAOS_COLOUR_NONE) /* the outside cell got RING placeholders and the outside hits */
+        inside = count - (out_hits(w, out, nbins) - out0 - RING);
     w->inside += inside;
     w->plotted += count;
 }

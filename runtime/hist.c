@@ -5,27 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Big arrays start on a 2 MiB boundary inside a block 2 MiB larger: the
- * allocator asks for transparent huge pages on a block's 2 MiB-aligned
- * interior (rt_alloc.c), so the whole array is in huge pages and zeroing a
- * 1024² histogram costs 4 page faults instead of ~520 (the unaligned head
- * and tail in 4 KiB pages; a fault costs more than writing its page on
- * these machines). The slack is never touched (no RSS) but is counted by
- * the memory budget. */
-#define HUGE_ALIGN ((size_t)2 << 20)
-
+/* big arrays lie in huge pages: zeroing a 1024² histogram costs 4 page
+ * faults instead of ~520 (rt_calloc_huge) */
 void *hist_zeroed(size_t n, size_t size, void **mem)
 {
-    size_t bytes = rt_mul_size(n, size);
-    if (bytes < 2 * HUGE_ALIGN || bytes > SIZE_MAX - HUGE_ALIGN)
-        return *mem = rt_calloc(n, size);
-    /* rt_calloc, not malloc + memset: a fresh block of this size comes from
-     * the kernel already zero, and calloc then skips the clearing */
-    char *p = *mem = rt_calloc(bytes + HUGE_ALIGN, 1);
-    if (!p)
-        return NULL;
-    p += (HUGE_ALIGN - (uintptr_t)p % HUGE_ALIGN) % HUGE_ALIGN;
-    return p;
+    return rt_calloc_huge(n, size, mem);
 }
 
 rt_code hist2_init(hist2 *hs, int w, int h, const double lo[2], const double hi[2], int with_colour,

@@ -30,7 +30,7 @@ void hist2_free(hist2 *hs);
 
 /* n × size zero bytes for a big accumulator; arrays of 4 MiB and more start
  * on a 2 MiB boundary inside a larger block (all in huge pages, see
- * hist.c). *mem gets the block to rt_free; NULL when out of memory. */
+ * rt_calloc_huge). *mem gets the block to rt_free; NULL when out of memory. */
 void *hist_zeroed(size_t n, size_t size, void **mem);
 
 #endif

@@ -15,7 +15,9 @@
 
 typedef struct image {
     int w, h;
-    float *px; /* w * h * 4 floats */
+    float *px; /* w * h * 4 floats; NULL: no pixels (mem is then ignored) */
+    void *mem; /* the block px lies in: big images start on a 2 MiB boundary
+                * (rt_calloc_huge), so filling one faults in huge pages only */
 } image;
 
 /* Allocate a w×h image filled with transparent black. w, h >= 1. */

@@ -143,7 +143,7 @@ double noise_perlin3(const noise_perm *np, double x, double y, double z)
 /* The level the blocks use: the best the machine has, except SSE2, whose
  * four-lane kernel measured slower than the per-point loop's paired lanes
  * (bench/noise_bench.c). The choice never changes a value. */
-static int block_level(void)
+int noise_block_level(void)
 {
     int best = noise_simd_best();
     return best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR;
@@ -158,7 +158,7 @@ void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const dou
 void noise_perlin3_block(const noise_perm *np, size_t n, const double *x, const double *y,
                          const double *z, double *out)
 {
-    noise_perlin3_block_at(block_level(), np, n, x, y, z, out);
+    noise_perlin3_block_at(noise_block_level(), np, n, x, y, z, out);
 }
 
 double noise_fbm3(const noise_perm *np, int octaves, double lacunarity, double gain, double x,
@@ -190,7 +190,7 @@ void noise_fbm3_block_at(int level, const noise_perm *np, int octaves, double la
 void noise_fbm3_block(const noise_perm *np, int octaves, double lacunarity, double gain, size_t n,
                       const double *x, const double *y, const double *z, double *out)
 {
-    noise_fbm3_block_at(block_level(), np, octaves, lacunarity, gain, n, x, y, z, out);
+    noise_fbm3_block_at(noise_block_level(), np, octaves, lacunarity, gain, n, x, y, z, out);
 }
 
 double noise_turbulence3(const noise_perm *np, int octaves, double x, double y, double z)
@@ -220,7 +220,7 @@ void noise_turbulence3_block_at(int level, const noise_perm *np, int octaves, si
 void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const double *x,
                              const double *y, const double *z, double *out)
 {
-    noise_turbulence3_block_at(block_level(), np, octaves, n, x, y, z, out);
+    noise_turbulence3_block_at(noise_block_level(), np, octaves, n, x, y, z, out);
 }
 
 /* ---- The 2002 reference, transcribed literally (baseline and cross-check). */

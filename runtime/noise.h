@@ -55,10 +55,10 @@
  * SIMD (noise_simd.c). Several points at a time on three levels found at
  * run time (noise_simd_best: the highest level __builtin_cpu_supports
  * allows): SSE2 (the x86-64 baseline, four points), AVX2 (eight points; the
- * hash chains in integer registers, the arithmetic on 4-double vectors) and
- * AVX-512 (eight points in 8-double vectors, the permutation lookups as
- * byte-lane table permutes, vpermi2b). No level gathers from memory: the
- * gradient coefficients come from the hash by register table lookups. Every
+ * hash chains as 32-bit gathers from the permutation, the arithmetic on
+ * 4-double vectors) and AVX-512 (eight points in 8-double vectors, the
+ * permutation lookups as byte-lane table permutes, vpermi2b). The gradient
+ * coefficients come from the hash by register table lookups. Every
  * level gives bit for bit the scalar values (same operations in the same
  * order, no FMA), so a result never depends on the machine. The blocks use
  * the best level except SSE2, which measured slower than the per-point loop
@@ -95,6 +95,9 @@ void noise_turbulence3_block(const noise_perm *np, int octaves, size_t n, const 
 
 enum { NOISE_LEVEL_SCALAR, NOISE_LEVEL_SSE2, NOISE_LEVEL_AVX2, NOISE_LEVEL_AVX512 };
 int noise_simd_best(void);
+/* The level the *_block functions use: noise_simd_best(), except SSE2,
+ * where they run the per-point loop (NOISE_LEVEL_SCALAR). */
+int noise_block_level(void);
 void noise_perlin3_block_at(int level, const noise_perm *np, size_t n, const double *x,
                             const double *y, const double *z, double *out);
 void noise_fbm3_block_at(int level, const noise_perm *np, int octaves, double lacunarity,

@@ -3,8 +3,8 @@
  *   SSE2    four points (GCC/Clang vector extensions, each 4-double vector
  *           split into two 128-bit halves; noise_kernel.inc), hash lane by
  *           lane; the x86-64 baseline;
- *   AVX2    eight points, the hash chains in the integer registers, the
- *           arithmetic on 4-double vectors (target("avx2"));
+ *   AVX2    eight points, the hash chains as 32-bit gathers (vpgatherdd),
+ *           the arithmetic on 4-double vectors (target("avx2"));
  *   AVX-512 eight points in 8-double vectors, the hash chains as byte-lane
  *           table lookups (vpermi2b; F, BW, VL, DQ, VBMI).
  * Every lane performs exactly the scalar perlin()'s operations in the same
@@ -38,11 +38,34 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 
 #define ALWAYS_INLINE static inline __attribute__((always_inline))
 
+/* The per-point loop: the scalar level, the groups with a point a vector
+ * kernel cannot take, and the last few points (noise_kernel). */
+static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
+                          const double *zs, double s, double a, int mode, double *out)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (mode == NOISE_SET)
+            out[i] = perlin(p, xs[i], ys[i], zs[i]);
+        else if (mode == NOISE_ADD)
+            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
+        else
+            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
+    }
+}
+
 #define K(name) name##_sse2
 #include "noise_kernel.inc"
 #undef K
 
 #ifdef NOISE_X86
+/* the end of a target region (clang spells GCC's pop_options as an
+ * attribute pop) */
+#if defined(__clang__)
+#define NOISE_TARGET_POP _Pragma("clang attribute pop")
+#else
+#define NOISE_TARGET_POP _Pragma("GCC pop_options")
+#endif
+
 /* every function from here to the pop is compiled for AVX2 (clang spells
  * GCC's push_options/target pragma as an attribute pragma) */
 #if defined(__clang__)
@@ -51,10 +74,10 @@ typedef int32_t v4i __attribute__((vector_size(16)));
 #pragma GCC push_options
 #pragma GCC target("avx2")
 #endif
-/* Eight points at a time: the hash chain of each point runs in the integer
- * registers (perm_pair, as perlin() does it; those ports are otherwise
- * idle) while the floors, fades, gradients and lerps run on two 4-double
- * vectors per quantity. The gradient coefficients come from the hash bytes
+/* Eight points at a time: the hash chain runs in 32-bit lanes, one gather
+ * per level and corner pair (seven per eight points, instead of 56 scalar
+ * loads with their index arithmetic), while the floors, fades, gradients
+ * and lerps run on two 4-double vectors per quantity. The gradient coefficients come from the hash bytes
  * by a 16-entry byte table lookup (pshufb) and exact int8 -> int32 -> double
  * conversions: the values ±1 and 0 of noise_gpairs, no memory gather. */
 ALWAYS_INLINE v4d cvt4(const int8_t *c)
@@ -69,12 +92,6 @@ ALWAYS_INLINE v4d floor4(v4d v)
 {
     const v4d zero = {0, 0, 0, 0};
     return (v4d)_mm256_floor_pd((__m256d)v) + zero;
-}
-
-ALWAYS_INLINE void index4(v4d f, int32_t *ix)
-{
-    __m128i i = _mm_and_si128(_mm256_cvttpd_epi32((__m256d)f), _mm_set1_epi32(255));
-    _mm_storeu_si128((__m128i *)(void *)ix, i);
 }
 
 ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
@@ -100,18 +117,24 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
 }
 
 /* The gradient coefficients of the 64 corners of eight points from their
- * pairs' gradient numbers: hq[c][j] = p[512 + the pair index] (noise.h) of
- * corner pair c (AA, BA, AB, BB) of point j; cf[c][axis][l]: lanes l = 0..7
- * at z, 8..15 at z + 1. */
-ALWAYS_INLINE void coef8_avx2(const uint8_t hq[4][8], int8_t cf[4][3][16])
+ * pairs' gradient numbers: byte 3 of lane j of hq[c] = p[512 + the pair
+ * index] (noise.h) of corner pair c (AA, BA, AB, BB) of point j (as
+ * hash8_avx2 gathers them); cf[c][axis][l]: lanes l = 0..7 at z, 8..15 at
+ * z + 1. */
+ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
 {
     const __m128i low4 = _mm_set1_epi8(15);
 #define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
                              G(11), G(12), G(13), G(14), G(15))
     const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
 #undef T16
+    /* byte 3 of each lane to bytes 0..3 of its 128-bit half, the halves' low
+     * words side by side: the eight points' bytes in order */
+    const __m256i top = _mm256_setr_epi8(3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                         3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
     for (int c = 0; c < 4; c++) {
-        __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)hq[c]);
+        __m128i b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hq[c], top), join));
         __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
         _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
@@ -119,12 +142,56 @@ ALWAYS_INLINE void coef8_avx2(const uint8_t hq[4][8], int8_t cf[4][3][16])
     }
 }
 
+/* (int)floor & 255 of eight lanes given as two 4-double halves, and in
+ * fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
+ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
+{
+    v4d fa = floor4(a), fb = floor4(b);
+    fr[0] = a - fa, fr[1] = b - fb;
+    __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
+    return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
+}
+
+/* Chunks of up to CHUNK groups of eight points: stage one finds the cells,
+ * hashes and coefficients of every group, stage two does the arithmetic, so
+ * the second never waits on the first's stores. */
+enum { CHUNK = 8 };
+
+/* perlin()'s hash chain for the groups of eight points whose bit is set in
+ * okm, in 32-bit lanes, each level one gather per corner pair (4-byte
+ * loads; only the low bytes count): [P[X], P[X+1]], then [P[A], P[A+1]] and
+ * [P[B], P[B+1]], then the four pair bytes p[512 + AA] ... in byte 3 (that
+ * load starts 3 bytes early, so it never reads past p[1023]; every index
+ * is <= 510). Level by level over all groups: a gather's latency is long,
+ * and the groups' chains are independent. */
+ALWAYS_INLINE void hash_avx2(const uint8_t *p, size_t ng, unsigned okm, const __m256i *X,
+                             const __m256i *Y, const __m256i *Z, __m256i (*hq)[4])
+{
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pp = (const int *)(const void *)p, *pg = (const int *)(const void *)(p + 512 - 3);
+    __m256i hA[CHUNK], hB[CHUNK];
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            __m256i hx = _mm256_i32gather_epi32(pp, X[g], 1);
+            hA[g] = _mm256_add_epi32(_mm256_and_si256(hx, ff), Y[g]);
+            hB[g] = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y[g]);
+        }
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            hA[g] = _mm256_i32gather_epi32(pp, hA[g], 1);
+            hB[g] = _mm256_i32gather_epi32(pp, hB[g], 1);
+        }
+    for (size_t g = 0; g < ng; g++)
+        if (okm >> g & 1) {
+            hq[g][0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA[g], ff), Z[g]), 1);
+            hq[g][1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB[g], ff), Z[g]), 1);
+            hq[g][2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA[g], 8), ff), Z[g]), 1);
+            hq[g][3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB[g], 8), ff), Z[g]), 1);
+        }
+}
+
 ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
 ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
-
-/* Chunks of up to CHUNK groups of eight: stage one hashes every group, stage
- * two does the arithmetic, so the second never waits on the first's stores. */
-enum { CHUNK = 8 };
 
 ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                                 const double *zs, double s, double a, int mode, double *out)
@@ -132,15 +199,13 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
     const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     int8_t cf[CHUNK][4][3][16];
-    uint8_t hq[CHUNK][4][8];
-    const uint8_t *pg = p + 512;
-    int32_t X[CHUNK * 8], Y[CHUNK * 8], Z[CHUNK * 8];
+    __m256i X[CHUNK], Y[CHUNK], Z[CHUNK], hq[CHUNK][4];
+    v4d fr[CHUNK][3][2]; /* the fractions of x, y, z, points 0..3 and 4..7 */
     size_t i = 0;
     while (i + 8 <= n) {
         size_t ng = (n - i) / 8;
         ng = ng < CHUNK ? ng : CHUNK;
         unsigned okm = 0;
-        /* the passes are separate so that no load waits on a recent store */
         for (size_t g = 0; g < ng; g++) {
             size_t j = i + 8 * g;
             v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
@@ -152,44 +217,22 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
 #undef IN
             if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                index4(floor4(xa), X + 8 * g), index4(floor4(xb), X + 8 * g + 4);
-                index4(floor4(ya), Y + 8 * g), index4(floor4(yb), Y + 8 * g + 4);
-                index4(floor4(za), Z + 8 * g), index4(floor4(zb), Z + 8 * g + 4);
+                X[g] = cell8_avx2(xa, xb, fr[g][0]), Y[g] = cell8_avx2(ya, yb, fr[g][1]);
+                Z[g] = cell8_avx2(za, zb, fr[g][2]);
                 okm |= 1u << g;
             }
         }
-        for (size_t g = 0; g < ng; g++) {
-            if (!(okm >> g & 1))
-                continue;
-            for (int l = 0; l < 8; l++) {
-                size_t j = 8 * g + (size_t)l;
-                unsigned hx = perm_pair(p, (unsigned)X[j]);
-                unsigned hA = perm_pair(p, (hx & 255u) + (unsigned)Y[j]);
-                unsigned hB = perm_pair(p, (hx >> 8) + (unsigned)Y[j]);
-                hq[g][0][l] = pg[(hA & 255u) + (unsigned)Z[j]];
-                hq[g][1][l] = pg[(hB & 255u) + (unsigned)Z[j]];
-                hq[g][2][l] = pg[(hA >> 8) + (unsigned)Z[j]];
-                hq[g][3][l] = pg[(hB >> 8) + (unsigned)Z[j]];
-            }
-        }
+        hash_avx2(p, ng, okm, X, Y, Z, hq);
         for (size_t g = 0; g < ng; g++)
             if (okm >> g & 1)
                 coef8_avx2(hq[g], cf[g]);
         for (size_t g = 0; g < ng; g++, i += 8) {
-            v4d xa = ld4(xs + i), xb = ld4(xs + i + 4), ya = ld4(ys + i), yb = ld4(ys + i + 4);
-            v4d za = ld4(zs + i), zb = ld4(zs + i + 4), ra, rb;
-            if (mode != NOISE_SET) {
-                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+            if (!(okm >> g & 1)) {
+                kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
+                continue;
             }
-            if (okm >> g & 1) {
-                ra = half4(cf[g], 0, xa - floor4(xa), ya - floor4(ya), za - floor4(za));
-                rb = half4(cf[g], 1, xb - floor4(xb), yb - floor4(yb), zb - floor4(zb));
-            } else {
-                for (int l = 0; l < 4; l++) {
-                    ra[l] = perlin(p, xa[l], ya[l], za[l]);
-                    rb[l] = perlin(p, xb[l], yb[l], zb[l]);
-                }
-            }
+            v4d ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
+            v4d rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
             if (mode == NOISE_SET) {
                 st4(out + i, ra), st4(out + i + 4, rb);
                 continue;
@@ -201,35 +244,10 @@ ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, co
             st4(out + i + 4, ld4(out + i + 4) + a * rb);
         }
     }
-    for (; i < n; i++) { /* the last 0..7 points */
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
 }
 
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
+NOISE_TARGET_POP
 #endif
-#endif
-
-static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const double *ys,
-                          const double *zs, double s, double a, int mode, double *out)
-{
-    for (size_t i = 0; i < n; i++) {
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
-}
 
 static void kernel_sse2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                         const double *zs, double s, double a, int mode, double *out)
@@ -347,18 +365,17 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
         v8d x = (v8d)_mm512_loadu_pd(xs + i), y = (v8d)_mm512_loadu_pd(ys + i);
-        v8d z = (v8d)_mm512_loadu_pd(zs + i), r;
+        v8d z = (v8d)_mm512_loadu_pd(zs + i);
         if (mode != NOISE_SET)
             x *= s, y *= s, z *= s;
         __mmask8 ok = _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)x), (__m512d)big, _CMP_LT_OQ) &
                       _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)y), (__m512d)big, _CMP_LT_OQ) &
                       _mm512_cmp_pd_mask(_mm512_abs_pd((__m512d)z), (__m512d)big, _CMP_LT_OQ);
-        if (ok == 0xff) {
-            r = perlin8_avx512(&t, x, y, z);
-        } else {
-            for (int l = 0; l < 8; l++)
-                r[l] = perlin(p, x[l], y[l], z[l]);
+        if (ok != 0xff) {
+            kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
+            continue;
         }
+        v8d r = perlin8_avx512(&t, x, y, z);
         if (mode == NOISE_SET) {
             _mm512_storeu_pd(out + i, (__m512d)r);
             continue;
@@ -367,20 +384,8 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
             r = (v8d)_mm512_abs_pd((__m512d)r);
         _mm512_storeu_pd(out + i, (__m512d)((v8d)_mm512_loadu_pd(out + i) + a * r));
     }
-    for (; i < n; i++) { /* the last 0..7 points */
-        if (mode == NOISE_SET)
-            out[i] = perlin(p, xs[i], ys[i], zs[i]);
-        else if (mode == NOISE_ADD)
-            out[i] += a * perlin(p, xs[i] * s, ys[i] * s, zs[i] * s);
-        else
-            out[i] += a * fabs(perlin(p, xs[i] * s, ys[i] * s, zs[i] * s));
-    }
 }
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+NOISE_TARGET_POP
 #endif
 
 int noise_simd_best(void)
@@ -396,17 +401,19 @@ int noise_simd_best(void)
     return NOISE_LEVEL_SSE2;
 }
 
+/* The vector kernels take whole groups (of 8, or 4 for SSE2); the last
+ * points go through the per-point loop. */
 void noise_kernel(int level, const uint8_t *p, size_t n, const double *x, const double *y,
                   const double *z, double s, double a, int mode, double *out)
 {
-    if (level == NOISE_LEVEL_SCALAR)
-        kernel_scalar(p, n, x, y, z, s, a, mode, out);
+    size_t done = 0;
+    if (level == NOISE_LEVEL_SSE2)
+        kernel_sse2(p, done = n & ~(size_t)3, x, y, z, s, a, mode, out);
 #ifdef NOISE_X86
-    else if (level == NOISE_LEVEL_AVX512)
-        kernel_avx512(p, n, x, y, z, s, a, mode, out);
     else if (level == NOISE_LEVEL_AVX2)
-        kernel_avx2(p, n, x, y, z, s, a, mode, out);
+        kernel_avx2(p, done = n & ~(size_t)7, x, y, z, s, a, mode, out);
+    else if (level == NOISE_LEVEL_AVX512)
+        kernel_avx512(p, done = n & ~(size_t)7, x, y, z, s, a, mode, out);
 #endif
-    else
-        kernel_sse2(p, n, x, y, z, s, a, mode, out);
+    kernel_scalar(p, n - done, x + done, y + done, z + done, s, a, mode, out + done);
 }

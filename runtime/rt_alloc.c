@@ -119,6 +119,20 @@ void rt_free(void *p)
     raw(b, b->size + sizeof(blkhdr), 0);
 }
 
+#define HUGE_ALIGN ((size_t)2 << 20)
+void *rt_calloc_huge(size_t count, size_t size, void **mem)
+{
+    size_t bytes = size && count > SIZE_MAX / size ? SIZE_MAX : count * size;
+    if (bytes < 2 * HUGE_ALIGN || bytes > SIZE_MAX - 2 * HUGE_ALIGN)
+        return *mem = rt_calloc(count, size);
+    /* rt_calloc, not malloc + memset: a fresh block of this size comes from
+     * the kernel already zero, and calloc then skips the clearing */
+    char *p = *mem = rt_calloc(bytes + HUGE_ALIGN, 1);
+    if (!p)
+        return NULL;
+    return p + (HUGE_ALIGN - (uintptr_t)p % HUGE_ALIGN) % HUGE_ALIGN;
+}
+
 char *rt_strdup(const char *s)
 {
     size_t n = strlen(s) + 1;

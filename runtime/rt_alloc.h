@@ -74,6 +74,13 @@ void *rt_realloc(void *p, size_t n);
 void *rt_reallocn(void *p, size_t count, size_t size);
 void rt_free(void *p);
 char *rt_strdup(const char *s);
+/* count * size zero bytes for a big buffer that is filled soon after
+ * (histograms, images): from 4 MiB on, the array starts on a 2 MiB boundary
+ * inside a block 2 MiB larger, so all of it lies in huge pages (the plain
+ * rt_calloc block's unaligned head and tail would be ~520 faults of 4 KiB
+ * for 16 MiB). *mem gets the block to rt_free; returns NULL (and *mem NULL)
+ * when out of memory. The slack is never touched but counts in the budget. */
+void *rt_calloc_huge(size_t count, size_t size, void **mem);
 
 /* Checks a decoder makes before allocating for sizes a file declares:
  * RT_OK, or RT_ELIMIT with a message naming the limit ("image of 9000×9000

@@ -13,7 +13,7 @@ typedef struct step_ctx {
     const fset *fs;
     const superifs_opts *opts;
     uint64_t k;
-    size_t chunks_per_buf;
+    size_t first, chunks_per_buf; /* the point chunks first .. first + chunks_per_buf - 1 of every buffer */
     const int *nv;      /* V: IFS of each buffer this step */
     const int *input;   /* V * FSET_MAX_MAPS: K_{v,m} */
     const double *cum;  /* N * FSET_MAX_MAPS */
@@ -27,7 +27,7 @@ static void step_chunk(void *p, size_t chunk, int worker)
     step_ctx *c = p;
     size_t S = c->opts->points;
     int v = (int)(chunk / c->chunks_per_buf);
-    size_t ch = chunk % c->chunks_per_buf;
+    size_t ch = c->first + chunk % c->chunks_per_buf;
     size_t lo = ch * FSET_WALK_CHUNK, hi = lo + FSET_WALK_CHUNK < S ? lo + FSET_WALK_CHUNK : S;
     int n = c->nv[v];
     const fset_ifs *F = &c->fs->sets[n];
@@ -46,10 +46,8 @@ static void step_chunk(void *p, size_t chunk, int worker)
     }
 }
 
-rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
-                     superifs_state *out, const rt_run *run, rt_error *e)
+rt_code superifs_check(const fset *fs, const double *P, const superifs_opts *opts, rt_error *e)
 {
-    memset(out, 0, sizeof *out);
     rt_code code = fset_validate(fs, e);
     if (code)
         return code;
@@ -64,10 +62,39 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
         return rt_fail(e, RT_EINVAL, "super IFS has %d buffers (expected at least 1)", opts->V);
     if (opts->points < 1)
         return rt_fail(e, RT_EINVAL, "super IFS buffers have no points (expected at least 1)");
+    if (!rt_mul_size(rt_mul_size((size_t)opts->V, opts->points), 2))
+        return rt_fail(e, RT_EINVAL, "super IFS of %d buffers of %zu points is too large", opts->V, opts->points);
+    return RT_OK;
+}
+
+/* n_v and K_{v,m} of step k (the draws of superifs.h) */
+static void step_draws(const fset *fs, const double *P, const superifs_opts *opts, uint64_t k, int *nv, int *input)
+{
+    size_t V = (size_t)opts->V;
+    for (size_t v = 0; v < V; v++) {
+        nv[v] = fset_choose(P, fs->n, rng_hash3(opts->seed, k, v, 0));
+        for (int m = 0; input && m < fs->sets[nv[v]].n; m++)
+            input[v * FSET_MAX_MAPS + (size_t)m] = (int)(rng_hash3(opts->seed, k, v, 1 + (uint64_t)m) % V);
+    }
+}
+
+void superifs_last_ifs(const fset *fs, const double *P, const superifs_opts *opts, int *ifs_of)
+{
+    for (int v = 0; v < opts->V; v++)
+        ifs_of[v] = -1;
+    if (opts->steps)
+        step_draws(fs, P, opts, opts->steps - 1, ifs_of, NULL);
+}
+
+rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
+                     superifs_state *out, const rt_run *run, rt_error *e)
+{
+    memset(out, 0, sizeof *out);
+    rt_code code = superifs_check(fs, P, opts, e);
+    if (code)
+        return code;
     size_t V = (size_t)opts->V, S = opts->points;
-    size_t n = rt_mul_size(rt_mul_size(V, S), 2);
-    if (!n)
-        return rt_fail(e, RT_EINVAL, "super IFS of %zu buffers of %zu points is too large", V, S);
+    size_t n = V * S * 2;
     double *a = rt_malloc(n * sizeof *a), *b = rt_malloc(n * sizeof *b);
     double *cum = rt_malloc((size_t)fs->n * FSET_MAX_MAPS * sizeof *cum);
     int *nv = rt_malloc(V * sizeof *nv), *input = rt_malloc(V * FSET_MAX_MAPS * sizeof *input);
@@ -77,22 +104,25 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
     }
     for (int s = 0; s < fs->n; s++)
         fset_cumulative(fs->sets[s].p, fs->sets[s].n, cum + (size_t)s * FSET_MAX_MAPS);
-    for (size_t i = 0; i < V * S; i++) {
-        a[2 * i] = opts->start[0];
-        a[2 * i + 1] = opts->start[1];
+    for (size_t i = 0; i < V * S; i++) { /* both: a shard's other points stay defined */
+        a[2 * i] = b[2 * i] = opts->start[0];
+        a[2 * i + 1] = b[2 * i + 1] = opts->start[1];
     }
     for (size_t v = 0; v < V; v++)
         nv[v] = -1;
+    /* Split across processes by point chunks: point i of every buffer
+     * depends only on points i of the buffers of the step before, so a
+     * shard runs every step for its own chunks of points (in all V
+     * buffers) and hands each buffer's rows of points to the part. */
     size_t cpb = (S + FSET_WALK_CHUNK - 1) / FSET_WALK_CHUNK;
+    par_part pp;
+    if ((code = par_part_begin(&pp, run, "super IFS", cpb, e)))
+        goto done;
+    size_t mine = pp.hi - pp.lo;
     for (uint64_t k = 0; k < opts->steps; k++) {
-        for (size_t v = 0; v < V; v++) {
-            nv[v] = fset_choose(P, fs->n, rng_hash3(opts->seed, k, v, 0));
-            for (int m = 0; m < fs->sets[nv[v]].n; m++)
-                input[v * FSET_MAX_MAPS + (size_t)m] =
-                    (int)(rng_hash3(opts->seed, k, v, 1 + (uint64_t)m) % V);
-        }
-        step_ctx c = {fs, opts, k, cpb, nv, input, cum, a, b};
-        code = par_for(run, "super IFS", V * cpb, step_chunk, &c);
+        step_draws(fs, P, opts, k, nv, input);
+        step_ctx c = {fs, opts, k, pp.lo, mine, nv, input, cum, a, b};
+        code = mine ? par_for(run, "super IFS", V * mine, step_chunk, &c) : RT_OK;
         if (code) {
             rt_fail(e, code, "interrupted");
             goto done;
@@ -101,6 +131,10 @@ rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
         a = b;
         b = t;
     }
+    for (size_t v = 0; v < V && !code; v++) /* the final points, buffer by buffer */
+        code = par_part_rows(&pp, a + 2 * v * S, S * 2 * sizeof *a, FSET_WALK_CHUNK * 2 * sizeof *a, e);
+    if (code)
+        goto done;
     out->V = opts->V;
     out->points = S;
     out->pts = a;

@@ -25,6 +25,12 @@
  *
  * Maps must be 2-D. Work is chunked per (buffer, FSET_WALK_CHUNK points),
  * each chunk writing its own slice.
+ *
+ * Sharded (par.h): point i of every buffer depends only on points i of the
+ * step before, so a run splits by chunks of FSET_WALK_CHUNK point indices
+ * (the same in every buffer): a shard runs every step for its own chunks
+ * and records, buffer by buffer, their rows of final points (PAR_OP_ROWS);
+ * the merge places every shard's rows and has the single run's points.
  */
 #ifndef SUPERIFS_H
 #define SUPERIFS_H
@@ -51,6 +57,10 @@ typedef struct superifs_state {
     int *ifs_of; /* V: n_v chosen at the last step (0-based), -1 if none */
 } superifs_state;
 
+/* The errors superifs_run would give for these arguments, without running. */
+rt_code superifs_check(const fset *fs, const double *P, const superifs_opts *opts, rt_error *e);
+/* ifs_of (V values) of the state superifs_run makes, from the draws alone. */
+void superifs_last_ifs(const fset *fs, const double *P, const superifs_opts *opts, int *ifs_of);
 /* Run opts->steps steps from A_0. P: N probabilities or NULL (equal). */
 rt_code superifs_run(const fset *fs, const double *P, const superifs_opts *opts,
                      superifs_state *out, const rt_run *run, rt_error *e);

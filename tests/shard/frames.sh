@@ -1,9 +1,9 @@
 #!/bin/sh
 # frames.sh — `frac run --frames A..B --shard I/N` then `frac merge --frames
-# A..B` equals `frac run --frames A..B` byte for byte, for N = 2 and 3 over
+# A..B` equals `frac run --frames A..B` byte for byte, for N = 1, 2, 3 and 7 over
 # the 3 frames -1..3:2 of tests/shard/frames.frac (clock -> 0, 0.5, 1), the
 # shards run concurrently (tests/cli/shard_frames.cli). Prints the parts of
-# N = 3 and "ok frames N=2,3", or what differs; exits non-zero on a failure.
+# N = 3 and "ok frames N=1,2,3,7", or what differs; exits non-zero on a failure.
 set -u
 frac=${FRAC:-frac}
 here=$(dirname "$0")
@@ -13,7 +13,7 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL frames: $*"; exit 1; }
 r=-1..3:2
 "$frac" run -q --frames $r -o "$tmp/single" "$s" >"$tmp/single.out" 2>"$tmp/err" || fail "single: $(cat "$tmp/err")"
-for n in 2 3; do
+for n in 1 2 3 7; do
     i=0
     pids=
     while [ "$i" -lt "$n" ]; do
@@ -35,7 +35,7 @@ for n in 2 3; do
 done
 cmp -s "$tmp/single/a-1.png" "$tmp/single/a3.png" && fail "frames -1 and 3 are the same image"
 cat "$tmp/single.out"
-echo "ok frames N=2,3"
+echo "ok frames N=1,2,3,7"
 # a frame's parts given to another frame's merge, and a range that misses a part
 "$frac" merge -q --frames 1..1 -o "$tmp/x" "$s" "$tmp/p2"/frames.f1.*.part 2>&1 | sed "s|$tmp|TMP|g"
 "$frac" merge -q --frames -1..1:2 -o "$tmp/x" "$s" "$tmp/p2"/*.part 2>&1 | sed "s|$tmp|TMP|g"

@@ -8,29 +8,21 @@
 set -u
 frac=${FRAC:-frac}
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/recipe.sh"
 if ! command -v mpirun >/dev/null 2>&1; then
     echo "mpirun: skipped (mpirun is not installed; Debian: apt-get install openmpi-bin)"
     exit 0
 fi
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/frac-mpi-XXXXXX") || exit 1
-trap 'rm -rf "$tmp"' EXIT
-# the recipe calls `frac`: the one under test, first on PATH
-bin=$(mktemp -d "$tmp/bin-XXXXXX") && ln -s "$(command -v "$frac")" "$bin/frac" || exit 1
-PATH=$bin:$PATH
-export PATH
-cp "$here/small.frac" "$tmp/scene.frac" && cd "$tmp" || exit 1
+recipe_setup mpi
+cp "$here/small.frac" scene.frac || exit 1
 frac -q -o single scene.frac || exit 1
 # Open MPI refuses to run as root unless told so (docs/scale.md)
 if [ "$(id -u)" = 0 ]; then
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
     export OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
 fi
-# the recipe: the sh block after the marker naming this file in docs/scale.md
-awk '/tests\/shard\/mpi.sh runs these/ { on = 1; next } on && /^```sh/ { inb = 1; next }
-     inb && /^```/ { exit } inb { print }' "$here/../../docs/scale.md" >recipe.sh
+recipe_block "tests/shard/mpi.sh runs these" >recipe.sh
 grep -q '^mpirun ' recipe.sh || { echo "mpirun: FAIL (no mpirun recipe in docs/scale.md)"; exit 1; }
 sh -e recipe.sh >recipe.out 2>&1 || { echo "mpirun: FAIL (the recipe: $(tail -n 3 recipe.out))"; exit 1; }
-for f in a.png b.pfm; do
-    cmp -s "single/$f" "out/$f" || { echo "mpirun: FAIL ($f differs)"; exit 1; }
-done
+why=$(recipe_same single out) || { echo "mpirun: FAIL ($why)"; exit 1; }
 echo "mpirun: ok N=$(ls parts | wc -l), the recipe of docs/scale.md"

@@ -1,6 +1,7 @@
 """part.py — a reader of frac's part files that shares no code with frac:
 the format of docs/scale.md "The part file" read with struct and zlib's
-CRC-32, for the python3 parts of the scripts in tests/shard/.
+CRC-32, for the python3 parts of tests/shard/format.sh, share.sh,
+records.sh and sums.sh, and of tools/shard_plan.sh.
 
     PYTHONPATH=tests/shard python3 -c 'import part; p = part.read(PATH)'
 
@@ -15,7 +16,7 @@ import struct
 import zlib
 from types import SimpleNamespace
 
-FORMAT = 2  # the format number docs/scale.md gives; the scripts check parts carry it
+FORMAT = 3  # the format number docs/scale.md gives; the scripts check parts carry it
 
 
 class Bytes:

@@ -41,6 +41,11 @@ case_ "truncated" "$s" "$p-0-of-3.part" "$tmp/trunc.part" "$p-2-of-3.part"
 cp "$p-1-of-3.part" "$tmp/bad.part"
 printf 'Z' | dd of="$tmp/bad.part" bs=1 seek=400 conv=notrunc 2>/dev/null
 case_ "corrupt" "$s" "$p-0-of-3.part" "$tmp/bad.part" "$p-2-of-3.part"
+# a part of format 2 (the format field, after the magic, set to 2): made
+# by a frac before the window record
+cp "$p-1-of-3.part" "$tmp/v2.part"
+printf '\002' | dd of="$tmp/v2.part" bs=1 seek=8 conv=notrunc 2>/dev/null
+case_ "format 2" "$s" "$p-0-of-3.part" "$tmp/v2.part" "$p-2-of-3.part"
 case_ "not a part" "$s" "$p-0-of-3.part" "$s" "$p-2-of-3.part"
 case_ "unreadable" "$s" "$p-0-of-3.part" "$tmp/none.part" "$p-2-of-3.part"
 # --shard auto: each launcher's variables (the others unset)

@@ -458,6 +458,11 @@ static void test_tonemap(void)
     CHECK_NEAR(im.px[2], 0.5 - 0.5 / 7, 1e-6, "mean b toward bg");
     CHECK_NEAR(im.px[5], 5.0 / 7, 1e-6, "mean g at max");
     CHECK_NEAR(im.px[6], 4.0 / 7, 1e-6, "mean b at max");
+    /* alpha: over a half-transparent background, a + (1 - a) v */
+    o.bg[3] = 0.25f;
+    CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "mean over alpha 1/4");
+    CHECK_NEAR(im.px[3], 0.25 + 0.75 / 7, 1e-6, "alpha at v = 1/7");
+    CHECK_NEAR(im.px[7], 1.0, 1e-6, "alpha at max");
     image_free(&im);
     CHECK(image_init(&im, 3, 1, &e) == RT_OK, "image");
     CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_EINVAL &&
@@ -787,6 +792,138 @@ static void test_volume_inside(void)
     rifs_free(&r);
 }
 
+/* Where and in which colour a coloured hit lands, against facts of the
+ * maps alone (mutation table: chaos-colour-cell, chaos-blend-order,
+ * chaos-palette-round). */
+static void test_colour_hits(void)
+{
+    rt_error e;
+    double lo[2] = {0, 0}, hi[2] = {1, 1};
+    int th[2] = {1, 3};
+    /* one map x/2 + 0.05: every point at the fixed point (0.1, 0.1), which is
+     * column 0 and, counted from the top, row 3 of a 4×4 window: bin 12 */
+    affine one[1] = {affine_from_2d(0.5, 0, 0, 0.5, 0.05, 0.05)};
+    ifs f1;
+    CHECK(ifs_build(&f1, one, 1, NULL, 0, &e) == RT_OK, "one map");
+    chaos_sys s1 = {&f1, NULL};
+    /* colour 0.0015: palette entry round(0.0015 × 1023) = 2 (truncating gives 1) */
+    double c1[1] = {0.0015};
+    for (int t = 0; t < 2; t++) {
+        rt_run run = {th[t], NULL, 0};
+        chaos_opts o = {0};
+        o.points = 40000;
+        o.chunk = 1 << 12;
+        o.colour = CHAOS_COLOUR_LAST;
+        o.map_c = c1;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 4, 4, lo, hi, 1, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s1, &o, &hh, NULL, &run, &e) == RT_OK, "chaos");
+        CHECK(hh.count[12] == 40000, "%d thread(s): bin (0, 3) has %llu of 40000 hits", th[t],
+              (unsigned long long)hh.count[12]);
+        double mean = hh.csum[3 * 12] / 40000.0;
+        CHECK(fabs(mean - 2.0 / 1023) < 2e-5, "%d thread(s): colour 0.0015 gave %.6f, not palette entry 2 (%.6f)",
+              th[t], mean, 2.0 / 1023);
+        hist2_free(&hh);
+    }
+    ifs_free(&f1);
+    /* a chunk starts at the fixed point of map 0 (chaos.h), so without a
+     * burn-in a one-map orbit never leaves it: a map with a shear (b, c != 0,
+     * which a wrong inverse of I - A gets wrong) and t = (I - A) z, z the
+     * centre (6.5/64, 1 - 57.5/64) of bin (6, 57) of a 64×64 window, puts
+     * all its hits in that bin from the first one */
+    double ax = 0.5, bx = 0.3, cx = -0.2, dx = 0.5, z = 6.5 / 64;
+    affine sh[1] = {affine_from_2d(ax, bx, cx, dx, (1 - ax) * z - bx * z, -cx * z + (1 - dx) * z)};
+    CHECK(ifs_build(&f1, sh, 1, NULL, 0, &e) == RT_OK, "sheared map");
+    {
+        chaos_opts o = {0};
+        o.points = 40000;
+        o.chunk = 1 << 12;
+        o.burn = -1;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 64, 64, lo, hi, 0, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s1, &o, &hh, NULL, NULL, &e) == RT_OK, "chaos");
+        CHECK(hh.count[57 * 64 + 6] == 40000, "sheared map without burn-in: %llu of 40000 hits at its fixed point",
+              (unsigned long long)hh.count[57 * 64 + 6]);
+        hist2_free(&hh);
+    }
+    ifs_free(&f1);
+    /* x/2 and x/2 + 1/2 (y/2 both), colours 0 and 1, blended: a hit of the
+     * right map lands in x >= 1/2 with colour (c + 1)/2 >= 1/2, a hit of the
+     * left one in x < 1/2 with colour c/2 <= 1/2; c is 1/2 on average, so
+     * the mean colours of the two halves are 3/4 and 1/4 */
+    affine two[2] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0)};
+    ifs f2;
+    CHECK(ifs_build(&f2, two, 2, NULL, 0, &e) == RT_OK, "two maps");
+    chaos_sys s2 = {&f2, NULL};
+    double c2[2] = {0, 1}, lo2[2] = {0, -1}, hi2[2] = {1, 1};
+    for (int t = 0; t < 2; t++) {
+        rt_run run = {th[t], NULL, 0};
+        chaos_opts o = {0};
+        o.points = 200000;
+        o.seed = 3;
+        o.chunk = 1 << 12;
+        o.colour = CHAOS_COLOUR_BLEND;
+        o.map_c = c2;
+        hist2 hh;
+        CHECK(hist2_init(&hh, 2, 1, lo2, hi2, 1, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s2, &o, &hh, NULL, &run, &e) == RT_OK, "chaos");
+        CHECK(hh.count[0] + hh.count[1] == 200000 && hh.count[0] > 90000 && hh.count[1] > 90000,
+              "%d thread(s): halves %llu, %llu", th[t], (unsigned long long)hh.count[0],
+              (unsigned long long)hh.count[1]);
+        double ml = hh.csum[0] / (double)hh.count[0], mr = hh.csum[3] / (double)hh.count[1];
+        CHECK(fabs(ml - 0.25) < 0.01 && fabs(mr - 0.75) < 0.01,
+              "%d thread(s): mean colours %.4f (left, expected 1/4) and %.4f (right, 3/4)", th[t], ml, mr);
+        hist2_free(&hh);
+    }
+    ifs_free(&f2);
+}
+
+/* The 2-D colour loop counts outside points in its outside cell (flushed
+ * like every cell after 65536 hits) and derives inside from it. Right-angled
+ * Sierpinski, window y in [0, 0.5]: a point is inside when its last map is 0
+ * or 1 (map 2 adds 0.5 to y; y = 0.5 itself is never reached), 2/3 of the
+ * points, and ~100,000 of 300,007 outside, so each worker's outside cell
+ * flushes; ±1 % is ~12 binomial standard deviations. The counts-only loop on
+ * the same orbit must see the same inside, and the counts sum to it. */
+static void test_colour_inside(void)
+{
+    rt_error e;
+    ifs f;
+    affine m[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                   affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5)};
+    CHECK(ifs_build(&f, m, 3, NULL, 0, &e) == RT_OK, "build");
+    chaos_sys s = {&f, NULL};
+    double lo[2] = {0, 0}, hi[2] = {1, 0.5};
+    for (int t = 1; t <= 2; t++)
+        for (int ch = 0; ch < 2; ch++) {
+            uint64_t inside[2];
+            for (int col = 0; col < 2; col++) {
+                hist2 hs;
+                CHECK(hist2_init(&hs, 64, 32, lo, hi, col, &e) == RT_OK, "hist");
+                chaos_opts o = {0};
+                o.points = 300007;
+                o.seed = 3;
+                o.chunk = ch ? 7 : 0; /* 7 < the ring of 32 */
+                o.colour = col ? CHAOS_COLOUR_BLEND : CHAOS_COLOUR_NONE;
+                rt_run run = {t, NULL, 0};
+                chaos_stats st;
+                CHECK(chaos_hist2(&s, &o, &hs, &st, &run, &e) == RT_OK, "chaos: %s", e.msg);
+                uint64_t sum = 0;
+                for (size_t b = 0; b < 64 * 32; b++)
+                    sum += hs.count[b];
+                CHECK(sum == st.inside, "%d thread(s), chunk %u, colour %d: counts sum to %llu, inside %llu", t,
+                      o.chunk, col, (unsigned long long)sum, (unsigned long long)st.inside);
+                CHECK(st.inside > 198000 && st.inside < 202000, "inside %llu of 300007 (2/3: 200005)",
+                      (unsigned long long)st.inside);
+                inside[col] = st.inside;
+                hist2_free(&hs);
+            }
+            CHECK(inside[0] == inside[1], "colour and counts-only loops: inside %llu and %llu",
+                  (unsigned long long)inside[1], (unsigned long long)inside[0]);
+        }
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_sierpinski();
@@ -794,11 +931,13 @@ int main(void)
     test_rifs_measure();
     test_order2();
     test_threads();
+    test_colour_hits();
     test_3d_nondiagonal();
     test_tonemap();
     test_hist_adds();
     test_fit_quantiles();
     test_no_copies();
     test_volume_inside();
+    test_colour_inside();
     return check_done("test_chaos");
 }

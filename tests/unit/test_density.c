@@ -199,11 +199,34 @@ static void test_dmfs(void)
     CHECK(bad == 0, "%d DMF block mismatches", bad);
 }
 
+/* density_sdf's zero set is the level set {D = level}: from a point at
+ * distance t along a ray out of the centre, the surface is t - sdf away
+ * (exact for a sphere, and for a box and a torus along an axis), and D
+ * there is the level. */
+static void test_sdf_levels(void)
+{
+    density_kind kinds[3] = {DENSITY_SPHERE, DENSITY_TORUS, DENSITY_BOX};
+    double levels[3] = {0.25, 0.6, 0.9};
+    for (int k = 0; k < 3; k++)
+        for (int l = 0; l < 3; l++) {
+            density_shape d = shape(kinds[k]);
+            d.c[0] = 1, d.c[1] = -2, d.c[2] = 0.5, d.r = 0.7, d.R = 2, d.s = 0.4;
+            d.h[0] = d.h[1] = d.h[2] = 0.8;
+            double base = kinds[k] == DENSITY_TORUS ? d.R : 0; /* the tube's centre line on +x */
+            double t = 1.5, x = d.c[0] + base + t;
+            double rho = t - density_sdf(&d, levels[l], x, d.c[1], d.c[2]);
+            double D = density_eval(&d, d.c[0] + base + rho, d.c[1], d.c[2]);
+            CHECK(fabs(D - levels[l]) < 1e-12, "%s, level %g: D = %.15g where the sdf is 0",
+                  density_name(kinds[k]), levels[l], D);
+        }
+}
+
 int main(void)
 {
     test_sphere();
     test_other_shapes();
     test_validation();
     test_dmfs();
+    test_sdf_levels();
     return check_done("test_density");
 }

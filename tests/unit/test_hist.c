@@ -95,9 +95,29 @@ static void test_alignment(void)
     hist2_free(&hs);
 }
 
+/* hist_zeroed's array lies inside the block it asked for, however far the
+ * 2 MiB boundary is from the block's start, and a size the slack would
+ * wrap past SIZE_MAX is refused, not served from a small block. */
+static void test_zeroed_block(void)
+{
+    void *mem;
+    check_limits(-1, -1, -1); /* records the largest block asked for */
+    size_t bytes = (size_t)5 << 20;
+    unsigned char *p = hist_zeroed(bytes, 1, &mem);
+    size_t asked = check_hs.peak;
+    check_limits_off();
+    CHECK(p != NULL, "5 MiB");
+    CHECK(p && (unsigned char *)mem <= p && p + bytes <= (unsigned char *)mem + asked,
+          "array [%p, +%zu) outside its block [%p, +%zu)", (void *)p, bytes, mem, asked);
+    rt_free(mem);
+    CHECK(hist_zeroed(SIZE_MAX - 1, 1, &mem) == NULL, "SIZE_MAX - 1 bytes were served");
+    rt_free(mem);
+}
+
 int main(void)
 {
     test_alignment();
+    test_zeroed_block();
     test_bins();
     test_measure();
     test_choose_uniform();

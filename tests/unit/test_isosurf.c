@@ -172,6 +172,54 @@ static void test_sphere(void)
     mesh_free(&m);
 }
 
+/* Grid normals from a quadratic density R² - |p - c|²: its central
+ * differences are exact, -2(node - c), and blending the two nodes' values
+ * (1 - s, s) at the crossing gives -2(vertex - c), so every normal is the
+ * radial direction at its own vertex (up to the float samples), not at a
+ * point elsewhere on the edge. */
+typedef struct quad {
+    double c[3], r2;
+} quad;
+
+static void quad_fn(const void *ctx, size_t n, const double *x, const double *y, const double *z, double *out)
+{
+    const quad *q = ctx;
+    for (size_t i = 0; i < n; i++) {
+        double dx = x[i] - q->c[0], dy = y[i] - q->c[1], dz = z[i] - q->c[2];
+        out[i] = q->r2 - (dx * dx + dy * dy + dz * dz);
+    }
+}
+
+static void test_grid_normals(void)
+{
+    quad q = {{0.03, -0.05, 0.02}, 0.5};
+    double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    volume v;
+    rt_error e;
+    CHECK(volume_init(&v, 24, 24, 24, lo, hi, &e) == RT_OK, "vol");
+    CHECK(iso_sample_field(quad_fn, &q, &v, NULL, &e) == RT_OK, "sample");
+    iso_opts o = {0};
+    o.normals = 1;
+    mesh m;
+    CHECK(iso_from_volume(&v, &o, NULL, &m, &e) == RT_OK, "%s", e.msg);
+    double worst = 0;
+    for (size_t i = 0; i < m.nv; i++) {
+        double d[3], l = 0, err = 0;
+        for (int a = 0; a < 3; a++) {
+            d[a] = m.pos[3 * i + a] - q.c[a];
+            l += d[a] * d[a];
+        }
+        l = sqrt(l);
+        for (int a = 0; a < 3; a++)
+            err += fabs(m.nrm[3 * i + a] - d[a] / l);
+        worst = err > worst ? err : worst;
+    }
+    CHECK(m.nv > 100 && worst < 1e-4, "%zu vertices: a grid normal is %g off the radial direction at its vertex",
+          m.nv, worst);
+    mesh_free(&m);
+    volume_free(&v);
+}
+
 static void test_topologies(void)
 {
     double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
@@ -330,6 +378,7 @@ static void test_errors(void)
 int main(void)
 {
     test_sphere();
+    test_grid_normals();
     test_topologies();
     test_threads_and_colour();
     test_errors();

@@ -423,6 +423,35 @@ static void test_shapes(void)
             }
             printf("noisy blob: %zu centre vertices\n", centres);
             CHECK(centres > 0, "the noisy blob was expected to need centre vertices");
+            /* a centre vertex is the mean of its cycle, and its fan's
+             * triangles are its only ones: each cycle vertex is in two of
+             * them, so the mean of the other corners over the fan is that mean */
+            double *nb = calloc(4 * m.nv, sizeof *nb);
+            CHECK(nb != NULL, "memory");
+            for (size_t ti = 0; nb && ti < m.nt; ti++)
+                for (int c = 0; c < 3; c++) {
+                    size_t v0 = m.tri[3 * ti + c];
+                    for (int o2 = 1; o2 < 3; o2++) {
+                        size_t w = m.tri[3 * ti + (c + o2) % 3];
+                        for (int a = 0; a < 3; a++)
+                            nb[4 * v0 + a] += m.pos[3 * w + a];
+                        nb[4 * v0 + 3] += 1;
+                    }
+                }
+            size_t off = 0;
+            for (size_t i = 0; nb && i < m.nv; i++) {
+                int on = 0;
+                for (int a = 0; a < 3; a++) {
+                    double g = (m.pos[3 * i + a] + 1) * grid[k] / 2 - 0.5;
+                    on += fabs(g - floor(g + 0.5)) < 1e-4;
+                }
+                if (on >= 2)
+                    continue;
+                for (int a = 0; a < 3; a++)
+                    off += !(fabs(nb[4 * i + a] / nb[4 * i + 3] - m.pos[3 * i + a]) < 1e-5);
+            }
+            CHECK(off == 0, "noisy blob: %zu centre vertex coordinates are not the mean of their cycle", off);
+            free(nb);
             for (int th = 2; th <= 3; th++) {
                 rt_run run = {th, NULL, 0};
                 mesh m2;

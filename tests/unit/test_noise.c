@@ -80,6 +80,19 @@ static void test_properties(void)
     for (int i = 0; i < 256; i++)
         dup += seen[a.p[i]]++ != 0 || a.p[i] != a.p[i + 256];
     CHECK(dup == 0, "seeded table is not a doubled permutation");
+    /* A uniform shuffle (Fisher–Yates: j in [0, i]) leaves some entries in
+     * place: a random permutation of 256 has no fixed point with probability
+     * about 1/e, so 16 seeds without one would be a 1-in-10^7 event. The
+     * off-by-one j in [0, i) (Sattolo's algorithm) makes one 256-cycle, never
+     * a fixed point. */
+    int fixed = 0;
+    for (uint64_t seed = 1; seed <= 16; seed++) {
+        noise_perm q;
+        noise_perm_init(&q, seed);
+        for (int i = 0; i < 256; i++)
+            fixed += q.p[i] == i;
+    }
+    CHECK(fixed > 0, "16 seeded permutations without a fixed point: not a uniform shuffle");
 
     /* Zero at every integer lattice point (also negative and far ones). */
     int nz = 0;
@@ -222,6 +235,9 @@ static void test_simd_levels(void)
     noise_perm_init(&np, 12345);
     int best = noise_simd_best();
     CHECK(best >= NOISE_LEVEL_SSE2, "an x86-64 machine has at least SSE2 (level %d)", best);
+    int bl = noise_block_level();
+    CHECK(bl == (best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR),
+          "the blocks use the best level but SSE2 (per-point loop instead): %d of best %d", bl, best);
     for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
         size_t lens[5] = {N, N - 1, N - 2, N - 5, 5};
         for (int li = 0; li < 5; li++) {

@@ -1,11 +1,14 @@
 /* test_rt_calloc.c — rt_calloc through the hook's zalloc (rt_alloc.h): the
  * block is zeroed, counted like any allocation, and a hook without zalloc
  * still gets zeroed blocks (alloc + memset), also where the memory was
- * dirty before. */
+ * dirty before. rt_calloc_huge: big arrays start on a 2 MiB boundary (so
+ * images and histograms lie in huge pages), zeroed, inside a block the hook
+ * sees 2 MiB larger; small ones are plain blocks. */
 #include <stdint.h>
 #include <string.h>
 
 #include "check.h"
+#include "image.h"
 
 static size_t n_alloc, n_zalloc, live;
 
@@ -76,6 +79,33 @@ int main(void)
     CHECK(n_alloc == 1 && n_zalloc == 0, "no zalloc: alloc used (%zu alloc)", n_alloc);
     rt_free(d);
     CHECK(live == 0, "freed (%zu left)", live);
+
+    /* rt_calloc_huge through the zalloc hook, over dirty memory around it */
+    rt_alloc_set_hook(&hz);
+    const size_t two = (size_t)2 << 20;
+    void *mem = NULL, *mem2 = NULL;
+    unsigned char *h = rt_calloc_huge(big / 4, 4, &mem), *s2 = rt_calloc_huge(small, 4, &mem2);
+    CHECK(h && mem && (uintptr_t)h % two == 0, "a 9 MiB array starts on a 2 MiB boundary (%p)", (void *)h);
+    CHECK(h && h >= (unsigned char *)mem && h < (unsigned char *)mem + two, "it lies in its block's first 2 MiB");
+    CHECK(h && all_zero(h, big), "and is zero");
+    CHECK(s2 && s2 == mem2 && all_zero(s2, 4 * small), "a small array is its own block, zeroed");
+    CHECK(live >= big + two + 4 * small && live < big + two + 4 * small + 256,
+          "the hook counts the 2 MiB slack (%zu bytes for %zu)", live, big + 4 * small);
+    rt_free(mem);
+    rt_free(mem2);
+    CHECK(live == 0, "freed through mem (%zu left)", live);
+    CHECK(rt_calloc_huge(SIZE_MAX / 2, 4, &mem) == NULL && mem == NULL, "an overflowing size fails");
+
+    /* images use it: a 1024² image (16 MiB) is aligned, a 10×10 one is not padded */
+    rt_error e;
+    image im, sm;
+    CHECK(image_init(&im, 1024, 1024, &e) == RT_OK && (uintptr_t)im.px % two == 0,
+          "a 1024² image starts on a 2 MiB boundary");
+    CHECK(image_init(&sm, 10, 10, &e) == RT_OK && (void *)sm.px == sm.mem, "a 10×10 image is its own block");
+    CHECK(all_zero((const unsigned char *)im.px, (size_t)1024 * 1024 * 16), "the image is transparent black");
+    image_free(&im);
+    image_free(&sm);
+    CHECK(live == 0, "images freed (%zu left)", live);
     rt_alloc_set_hook(NULL);
     return check_done("test_rt_calloc");
 }

@@ -208,5 +208,22 @@ int main(void)
     image_free(&out);
     image_free(&src);
     tops_free(&st);
+
+    /* One map: every orbit point is the map's fixed point (the orbit starts
+     * there, eq. (6) with the address 000…), so exactly one pixel is hit. A
+     * map with a shear (b c != 0) whose fixed point (0.8387, 0.0645) solves
+     * x = 0.5x + 0.3y + 0.4, y = -0.2x + 0.5y + 0.2. */
+    affine one[1] = {affine_from_2d(0.5, 0.3, -0.2, 0.5, 0.4, 0.2)};
+    fset_ifs f1 = {1, one, NULL};
+    tops_opts o1 = {20000, 1, 0};
+    tops_buf t1;
+    CHECK(tops_run(&f1, &v, &o1, &t1, NULL, &e) == RT_OK, "one-map tops: %s", e.msg);
+    int hits = 0, at = -1;
+    for (int i = 0; i < W * W; i++)
+        if (t1.cell[i].hit)
+            hits++, at = i;
+    /* the pixel of (0.8387, 0.0645) in the 32×32 view of the unit square: column floor(32x) = 26, row floor(32(1 - y)) = 29 */
+    CHECK(hits == 1 && at == 29 * W + 26, "one map: %d pixels hit (expected 1, pixel (26, 29)), last %d", hits, at);
+    tops_free(&t1);
     return check_done("test_tops");
 }
