@@ -62,6 +62,11 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libfracrt.a tests/unit/check.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -o $@
 
+# test_fileio_fsync sees (and fails) every fsync of the runtime through --wrap.
+$(BUILD)/tests/test_fileio_fsync: tests/unit/test_fileio_fsync.c $(BUILD)/libfracrt.a tests/unit/check.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests/unit $< $(BUILD)/libfracrt.a $(LDLIBS) -Wl,--wrap=fsync -o $@
+
 # test_lexer compiles interp/lexer.c into itself (the scanner needs only rt_alloc)
 $(BUILD)/tests/test_lexer: interp/lexer.c interp/lexer.h
 
@@ -114,6 +119,13 @@ FUZZ_SAN = -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 FUZZ_FLAGS = -timeout=10 -rss_limit_mb=1536 -malloc_limit_mb=1024 -print_final_stats=1
 FUZZ_SCRIPT_OBJ := $(filter-out $(BUILD)/interp/main.o $(BUILD)/interp/cli_%.o,$(IN_OBJ))
 FUZZ_DIR := build-fuzz
+# test_fuzz_script runs the script harness's own code (tests/fuzz/fuzz_script.c) without
+# libFuzzer, linked as the harness is, to check its work caps in make test.
+$(BUILD)/tests/test_fuzz_script: tests/unit/test_fuzz_script.c tests/fuzz/fuzz_script.c $(FUZZ_SCRIPT_OBJ) \
+                                 $(BUILD)/libfracrt.a tests/unit/check.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests/unit $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) \
+	    -Wl,--wrap=fileio_write_atomic,--wrap=fileio_read_all -o $@
 .PHONY: fuzz fuzz-build fuzz-bins fuzz-seeds fuzz-smoke $(FUZZ_HARNESSES:%=fuzz-%)
 # a changed ignorelist rebuilds the fuzz objects (it decides what is instrumented)
 $(RT_SRC:%.c=$(FUZZ_DIR)/%.o) $(IN_SRC:%.c=$(FUZZ_DIR)/%.o): tests/fuzz/engines.ignorelist

@@ -98,6 +98,9 @@ static int b_fit(interp *I, value *a, int n, value *out)
         return -1;
     if (a[A_TIME].k == V_NUM)
         o.time_s = a[A_TIME].u.n;
+    double cap = I->lim.max_fit_seconds; /* the fuzz harness's work cap covers fit's time budget */
+    if (cap > 0 && (o.time_s <= 0 || o.time_s > cap))
+        o.time_s = cap;
     affine *start = NULL;
     if (a[A_START].k != V_NIL) {
         const lang_ifs *s = lang_as_ifs(a[A_START]);

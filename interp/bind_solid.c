@@ -234,14 +234,17 @@ static void frac_release(void *ctx)
 
 static const char *roman[5] = {"auto", "I", "II", "III", "IV"};
 
-/* Largest R2 <= R whose Type I array (4 (2^R2+1)^3 bytes) fits in limit; -1 if none. */
-static int largest_r2(int R, size_t limit)
+/* The automatic strategy's byte budget: 64 MiB, or --max-memory if less. */
+static size_t auto_budget(const interp *I)
 {
-    int best = -1;
-    for (int r2 = 0; r2 <= R; r2++)
-        if (mpd_type1_bytes(r2) && mpd_type1_bytes(r2) <= limit)
-            best = r2;
-    return best;
+    return AUTO_BUDGET < I->lim.max_memory ? AUTO_BUDGET : I->lim.max_memory;
+}
+
+/* Lattice nodes of a Type I array at level R: (2^R + 1)^3. */
+static double lattice_nodes(int R)
+{
+    double n = ldexp(1.0, R) + 1;
+    return n * n * n;
 }
 
 /* R is declared TY_R: a whole number 1 .. MPD_MAX_R. */
@@ -285,29 +288,34 @@ static int b_fractal(interp *I, value *a, int n, value *out)
     if (lang_get_box(I, a[6], a[7], lo, hi, W))
         return -1;
 
-    /* The automatic strategy: Type I when its array fits the budget, else
-     * Type IV with the largest array that does (Type III if none). */
+    /* The automatic strategy: Type I when its array fits the budget and
+     * --max-voxels, else Type IV with the largest array that does (Type III
+     * if none). */
     size_t maxmem = I->lim.max_memory;
-    size_t budget = AUTO_BUDGET < maxmem ? AUTO_BUDGET : maxmem;
+    size_t budget = auto_budget(I);
+    double maxnodes = I->lim.max_voxels;
     if (type == MPD_AUTO) {
-        if (mpd_type1_bytes(p.R) <= budget) {
+        if (mpd_type1_bytes(p.R) <= budget && lattice_nodes(p.R) <= maxnodes) {
             type = MPD_TYPE1;
         } else {
-            R2 = largest_r2(p.R, budget);
+            R2 = mpd_largest_r2(p.R, budget, maxnodes);
             type = R2 >= 0 ? MPD_TYPE4 : MPD_TYPE3;
         }
     }
     if (type == MPD_TYPE4 && R2 < 0)
-        R2 = largest_r2(p.R, budget) < 0 ? 0 : largest_r2(p.R, budget);
+        R2 = mpd_largest_r2(p.R, budget, maxnodes) < 0 ? 0 : mpd_largest_r2(p.R, budget, maxnodes);
     p.type = type;
     p.R2 = R2;
     p.mem_limit = maxmem;
     p.budget = budget;
+    p.max_nodes = maxnodes;
     size_t bytes = type == MPD_TYPE1 ? mpd_type1_bytes(p.R) : type == MPD_TYPE4 ? mpd_type1_bytes(R2) : 0;
-    /* Arrays beyond --max-memory are refused by mpd_init with a message that
-     * names the strategy that fits; within it, check the budget first for a
-     * clear message (the allocation hook counts the array itself). */
-    if (bytes && bytes <= maxmem) {
+    double nodes = type == MPD_TYPE1 ? lattice_nodes(p.R) : type == MPD_TYPE4 ? lattice_nodes(R2) : 0;
+    /* Arrays beyond --max-memory or --max-voxels are refused by mpd_init
+     * with a message that names the strategy that fits; within them, check
+     * the budget first for a clear message (the allocation hook counts the
+     * array itself). */
+    if (bytes && bytes <= maxmem && nodes <= maxnodes) {
         char what[64];
         snprintf(what, sizeof what, "fractal: the Type %s array", roman[type]);
         if (mem_precheck(I, (double)bytes, what))
@@ -328,6 +336,8 @@ static int b_fractal(interp *I, value *a, int n, value *out)
         mem_free(I, c);
         if (rc == RT_EINVAL && bytes > maxmem) /* the array is over --max-memory */
             return err_at(I, NULL, ERR_LIMIT, "fractal: %s (the limit is --max-memory)", e.msg);
+        if (rc == RT_EINVAL && nodes > maxnodes) /* the array is over --max-voxels */
+            return err_at(I, NULL, ERR_LIMIT, "fractal: %s (the limit is --max-voxels)", e.msg);
         return lang_rt_error(I, rc, &e, W);
     }
     c->I = I;
@@ -359,7 +369,7 @@ static int b_fractal_memory(interp *I, value *a, int n, value *out)
     int R = (int)a[0].u.n;
     int R2;
     if (a[1].k == V_NIL) {
-        R2 = largest_r2(R, AUTO_BUDGET < I->lim.max_memory ? AUTO_BUDGET : I->lim.max_memory);
+        R2 = mpd_largest_r2(R, auto_budget(I), I->lim.max_voxels);
         if (R2 < 0)
             R2 = 0;
     } else {
@@ -647,7 +657,8 @@ static const builtin solid_builtins[] = {
             "The 3-D random fractal D(P) of seed 000 (midpoint displacement to level R, L(n) = exp(-(n-1) beta)) "
             "as a field over the box lo..hi, trilinear between lattice nodes. strategy: \"auto\", 1 (Type I: whole "
             "array), 2 (Type II: memoised parents), 3 (Type III: octree descent), 4 (Type IV: array to level R2, "
-            "descent below); all give identical values. corners: 8 numbers (index x + 2y + 4z) or one."),
+            "descent below); all give identical values. Arrays count against --max-memory and --max-voxels (a lattice "
+            "node is a voxel); \"auto\" picks within both. corners: 8 numbers (index x + 2y + 4z) or one."),
     BUILTIN("fractal_memory", b_fractal_memory, p_fmem,
             "Bytes each strategy needs at level R: {type1, type3, type4, R2, nodes} (Type IV with array level R2; "
             "default: the automatic choice)."),

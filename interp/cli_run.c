@@ -84,6 +84,12 @@ static int read_script(interp *I, const char *path, unsigned char **text, size_t
                 cap *= 2;
             }
         }
+        if (ferror(stdin)) { /* a read error is not the end of the script (issue 11) */
+            int err = errno;
+            rt_free(buf);
+            fprintf(stderr, "frac: error: cannot read the script from standard input: %s\n", strerror(err));
+            return EX_IO;
+        }
         buf[n] = 0;
         *text = buf;
         *len = n;

@@ -78,6 +78,8 @@ typedef struct limits {
     double max_points;   /* chaos game points, samples (--max-points) */
     double max_voxels;   /* per volume (--max-voxels) */
     double max_list;     /* list length (--max-list) */
+    double max_fit_seconds; /* > 0: fit()'s time budget is at most this (and fit stops after it
+                             * even without time:); no flag, set by the fuzz harness; 0 = none */
 } limits;
 
 typedef struct param_override {

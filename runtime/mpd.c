@@ -297,12 +297,22 @@ static double lattice_bytes_d(int res)
     return n * n * n * (double)sizeof(float);
 }
 
-/* Largest R2 <= R whose array fits in limit (-1 if not even R2 = 0). */
-static int largest_r2(int R, size_t limit)
+static double lattice_nodes_d(int res)
+{
+    double n = ldexp(1.0, res) + 1.0;
+    return n * n * n;
+}
+
+static int nodes_fit(int res, double max_nodes)
+{
+    return max_nodes <= 0 || lattice_nodes_d(res) <= max_nodes;
+}
+
+int mpd_largest_r2(int R, size_t bytes, double nodes)
 {
     int best = -1;
     for (int r2 = 0; r2 <= R; r2++)
-        if (lattice_bytes_d(r2) <= (double)limit)
+        if (lattice_bytes_d(r2) <= (double)bytes && nodes_fit(r2, nodes))
             best = r2;
     return best;
 }
@@ -315,6 +325,14 @@ void mpd_params_default(mpd_params *p)
     p->seed = 1;
     p->type = MPD_AUTO;
     p->R2 = -1;
+}
+
+/* "Type I at R = 9 needs 513^3 = 135005697 lattice nodes (limit 1000)". */
+static void fmt_nodes(char *buf, size_t len, int res, const char *where, double max_nodes)
+{
+    double side = ldexp(1.0, res) + 1.0;
+    snprintf(buf, len, "%.0f^3 = %.0f lattice nodes%s (limit %.0f)", side, side * side * side, where,
+             max_nodes);
 }
 
 rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
@@ -334,49 +352,58 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
     size_t budget = p->budget ? p->budget : ((size_t)64 << 20);
     if (budget > limit)
         budget = limit;
-    char need[64], lim[64];
+    double maxn = p->max_nodes > 0 ? p->max_nodes : 0;
+    char need[96], lim[64];
     int R = p->R, type = p->type, R2 = p->R2;
 
     if (type == MPD_AUTO) {
-        double nodes = ldexp(1.0, R) + 1.0;
-        nodes = nodes * nodes * nodes;
-        int many = p->npoints_hint == 0 || (double)p->npoints_hint >= nodes / 8.0;
-        if (many && lattice_bytes_d(R) <= (double)limit)
+        int many = p->npoints_hint == 0 || (double)p->npoints_hint >= lattice_nodes_d(R) / 8.0;
+        if (many && lattice_bytes_d(R) <= (double)limit && nodes_fit(R, maxn))
             type = MPD_TYPE1;
         else {
             type = MPD_TYPE4;
-            R2 = largest_r2(R, budget);
+            R2 = mpd_largest_r2(R, budget, maxn);
             if (R2 < 0)
                 type = MPD_TYPE3, R2 = 0;
         }
     }
     if (type == MPD_TYPE1) {
-        if (lattice_bytes_d(R) > (double)limit) {
-            fmt_bytes(need, sizeof need, lattice_bytes_d(R));
-            fmt_limit(lim, sizeof lim, limit);
-            int r2 = largest_r2(R, limit);
+        int over_bytes = lattice_bytes_d(R) > (double)limit;
+        if (over_bytes || !nodes_fit(R, maxn)) {
+            if (over_bytes) {
+                fmt_bytes(need, sizeof need, lattice_bytes_d(R));
+                fmt_limit(lim, sizeof lim, limit);
+                snprintf(need + strlen(need), sizeof need - strlen(need), " (limit %s)", lim);
+            } else
+                fmt_nodes(need, sizeof need, R, "", maxn);
+            int r2 = mpd_largest_r2(R, limit, maxn);
             if (r2 >= 0)
                 return rt_fail(e, RT_EINVAL,
-                               "Type I at R = %d needs %s (limit %s); use Type IV (strategy: 4) "
+                               "Type I at R = %d needs %s; use Type IV (strategy: 4) "
                                "with R2 = %d, or Type III (strategy: 3)",
-                               R, need, lim, r2);
-            return rt_fail(e, RT_EINVAL,
-                           "Type I at R = %d needs %s (limit %s); use Type III (strategy: 3)", R,
-                           need, lim);
+                               R, need, r2);
+            return rt_fail(e, RT_EINVAL, "Type I at R = %d needs %s; use Type III (strategy: 3)", R, need);
         }
         R2 = R;
     } else if (type == MPD_TYPE4) {
         if (R2 < 0)
-            R2 = largest_r2(R, budget);
+            R2 = mpd_largest_r2(R, budget, maxn);
         if (R2 < 0 || R2 > R)
             return rt_fail(e, RT_EINVAL, "R2 = %d is out of range for Type IV (expected 0 .. R = %d)",
                            R2, R);
-        if (lattice_bytes_d(R2) > (double)limit) {
-            fmt_bytes(need, sizeof need, lattice_bytes_d(R2));
-            fmt_limit(lim, sizeof lim, limit);
-            return rt_fail(e, RT_EINVAL,
-                           "Type IV with R2 = %d needs %s for its array (limit %s); use R2 <= %d", R2,
-                           need, lim, largest_r2(R, limit));
+        int over_bytes = lattice_bytes_d(R2) > (double)limit;
+        if (over_bytes || !nodes_fit(R2, maxn)) {
+            if (over_bytes) {
+                fmt_bytes(need, sizeof need, lattice_bytes_d(R2));
+                fmt_limit(lim, sizeof lim, limit);
+                snprintf(need + strlen(need), sizeof need - strlen(need), " for its array (limit %s)", lim);
+            } else
+                fmt_nodes(need, sizeof need, R2, " in its array", maxn);
+            int r2 = mpd_largest_r2(R, limit, maxn);
+            if (r2 >= 0)
+                return rt_fail(e, RT_EINVAL, "Type IV with R2 = %d needs %s; use R2 <= %d", R2, need, r2);
+            return rt_fail(e, RT_EINVAL, "Type IV with R2 = %d needs %s; use Type III (strategy: 3)", R2,
+                           need);
         }
     } else
         R2 = 0;
@@ -385,6 +412,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
     m->type = type;
     m->R2 = R2;
     m->seed = p->seed;
+    m->max_nodes = maxn;
     m->beta = p->beta;
     for (int i = 0; i < 8; i++)
         m->corner[i] = (double)(float)p->corner[i]; /* node values are floats */
@@ -532,6 +560,25 @@ static uint64_t finest_corners(const mpd *m, path *pa, const uint32_t fc[3], flo
     return cnt;
 }
 
+/* Node g (0 .. 2^R per axis) by a descent from the root, for any type. */
+static float descent_node(const mpd *m, const uint32_t g[3], uint64_t *nodes)
+{
+    uint32_t N = 1u << m->R;
+    uint32_t c[3];
+    int q = 0;
+    for (int ax = 0; ax < 3; ax++) {
+        c[ax] = g[ax] < N ? g[ax] : N - 1;
+        q |= (int)(g[ax] - c[ax]) << ax;
+    }
+    path pa;
+    pa.valid = 0;
+    float v[8];
+    uint64_t k = finest_corners(m, &pa, c, v);
+    if (nodes)
+        *nodes += k;
+    return v[q];
+}
+
 /* ---- Type II memo -------------------------------------------------------- */
 
 typedef struct memo {
@@ -584,13 +631,22 @@ static float *memo_find(memo *mm, uint64_t key, int *found)
     return &mm->vals[i];
 }
 
-static void memo_insert(memo *mm, uint64_t key, float val)
+#define MEMO_FIRST 1024 /* slots of a fresh memo */
+
+/* The memo may hold at most max_nodes slots (0: no limit); a memo that
+ * cannot start is not used (the descent gives the same values). */
+static int memo_allowed(const mpd *m)
+{
+    return m->max_nodes <= 0 || (double)MEMO_FIRST <= m->max_nodes;
+}
+
+static void memo_insert(memo *mm, uint64_t key, float val, double max_nodes)
 {
     if (mm->broken)
         return;
     if (2 * (mm->used + 1) > mm->cap) {
         memo old = *mm;
-        if (memo_alloc(mm, old.cap * 2)) {
+        if ((max_nodes > 0 && (double)old.cap * 2 > max_nodes) || memo_alloc(mm, old.cap * 2)) {
             *mm = old;
             mm->broken = 1;
             return;
@@ -626,6 +682,8 @@ static float t2_get(const mpd *m, memo *mm, const uint32_t c[3], uint64_t *nodes
     float *slot = memo_find(mm, key, &found);
     if (found)
         return *slot;
+    if (mm->broken) /* the memo is full: walking parents unmemoised would cost exponential time */
+        return descent_node(m, c, nodes);
     int k = 0;
     while (!(low >> k & 1))
         k++;
@@ -644,7 +702,7 @@ static float t2_get(const mpd *m, memo *mm, const uint32_t c[3], uint64_t *nodes
     }
     float v = combine(cnt, p, node_g(m->seed, n, c[0] >> k, c[1] >> k, c[2] >> k) * m->L[n]);
     (*nodes)++;
-    memo_insert(mm, key, v);
+    memo_insert(mm, key, v, m->max_nodes);
     return v;
 }
 
@@ -724,7 +782,7 @@ static void eval_block(const mpd *m, evaluator *ev, scratch *sc, size_t n, const
     radix_sort(sc->key, sc->idx, sc->tk, sc->ti, n, 3 * R);
     int use_memo = 0;
     if (m->type == MPD_TYPE2) {
-        if (!ev->mm.keys && memo_alloc(&ev->mm, 1024) == 0)
+        if (!ev->mm.keys && memo_allowed(m) && memo_alloc(&ev->mm, MEMO_FIRST) == 0)
             ev->mm.broken = 0;
         use_memo = ev->mm.keys != NULL;
     }
@@ -770,17 +828,7 @@ double mpd_node(const mpd *m, uint32_t i, uint32_t j, uint32_t k)
         size_t S1 = (size_t)N + 1;
         return m->arr[g[0] + S1 * (g[1] + S1 * (size_t)g[2])];
     }
-    uint32_t c[3];
-    int q = 0;
-    for (int ax = 0; ax < 3; ax++) {
-        c[ax] = g[ax] < N ? g[ax] : N - 1;
-        q |= (int)(g[ax] - c[ax]) << ax;
-    }
-    path pa;
-    pa.valid = 0;
-    float v[8];
-    finest_corners(m, &pa, c, v);
-    return v[q];
+    return descent_node(m, g, NULL);
 }
 
 /* ---- parallel evaluation ------------------------------------------------ */
@@ -955,7 +1003,7 @@ static void grid_tile(void *ctx, size_t chunk, int worker)
                 } else if (m->type == MPD_TYPE1) {
                     array_corners(m->arr, R, c, v);
                 } else {
-                    if (!ev->mm.keys && memo_alloc(&ev->mm, 1024) != 0) {
+                    if (!ev->mm.keys && (!memo_allowed(m) || memo_alloc(&ev->mm, MEMO_FIRST) != 0)) {
                         ev->nodes += finest_corners(m, &ev->pa, c, v);
                         j->out[row + ix] = trilinear(v, t);
                         continue;

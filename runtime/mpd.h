@@ -54,9 +54,18 @@
  *      and points are visited in Morton order so that neighbours share it.
  *   4  Type IV: Type I for levels <= R2 (an array of (2^R2+1)^3, eq. (16)),
  *      Type III below.
- *   0  automatic: Type I if it fits in mem_limit and the expected number of
- *      points (npoints_hint, 0 = unknown = many) is at least N^3/8; else
- *      Type IV with the largest R2 whose array fits in budget.
+ *   0  automatic: Type I if it fits in mem_limit and max_nodes and the
+ *      expected number of points (npoints_hint, 0 = unknown = many) is at
+ *      least N^3/8; else Type IV with the largest R2 whose array fits in
+ *      budget and max_nodes; else Type III.
+ * Node limit. max_nodes (the interpreter passes --max-voxels) bounds every
+ * store of lattice nodes that grows with R: an explicit Type I or IV whose
+ * array has more nodes is refused (RT_EINVAL, the message names the
+ * strategy that fits), the automatic choice stays within it, and Type II's
+ * memo stops growing at max_nodes slots (points past that are computed by
+ * the descent, with the same values). The fixed per-thread buffers — a
+ * Type III path, a grid tile of (2^MPD_TILE_LOG+1)^3 floats — are working
+ * memory, counted only as bytes.
  * Grid evaluation (mpd_eval_grid) of Types III and IV works per tile — a
  * cell of side 2^MPD_TILE_LOG lattice steps: its corners come from the
  * array or a descent, the nodes inside are filled level by level into a
@@ -93,6 +102,7 @@ typedef struct mpd_params {
     size_t mem_limit;       /* bytes allowed for a Type I/IV array; 0 = 4 GiB */
     size_t budget;          /* automatic Type IV array budget in bytes; 0 = 64 MiB */
     size_t npoints_hint;    /* automatic strategy: expected number of points; 0 = unknown */
+    double max_nodes;       /* lattice nodes allowed in an array or a memo; 0 = no limit */
 } mpd_params;
 
 /* Defaults: R = 6, beta = 0.5, seed 1, corners 0, automatic. */
@@ -106,6 +116,7 @@ typedef struct mpd {
     double L[MPD_MAX_R + 1];/* L(n) = exp(-(n-1) beta), n >= 1 */
     float *arr;             /* Type I (R2 = R) / Type IV: (2^R2+1)^3 nodes, x fastest */
     size_t arr_bytes;
+    double max_nodes;       /* from mpd_params: caps Type II's memo (0 = no limit) */
 } mpd;
 
 /* Validate, choose the type, allocate and fill the array (Types I, IV).
@@ -154,5 +165,8 @@ double mpd_normal(uint64_t h);
 size_t mpd_type1_bytes(int R);
 size_t mpd_path_bytes(int levels);
 size_t mpd_type4_bytes(int R, int R2);
+/* Largest R2 <= R whose array fits in bytes and has at most nodes lattice
+ * nodes (nodes 0 = no node limit); -1 if not even R2 = 0 fits. */
+int mpd_largest_r2(int R, size_t bytes, double nodes);
 
 #endif

@@ -666,6 +666,7 @@ static void run_lang_dir(const char *frac, const char *dir)
  * "# stderr: TEXT" (a whole line of stderr), "# stderr contains: TEXT" (a
  * substring of a line that is not a source echo),
  * "# stdout-to: PATH" (stdout goes to that file, e.g. /dev/full),
+ * "# stdin-from: PATH" (stdin is read from that file, e.g. a folder),
  * "# exec: PATH" (run PATH, a shebang script, instead of frac, with frac's
  * folder first on PATH; the args follow it), "# file: NAME: TEXT" (the file
  * $TMP/NAME must contain TEXT). In all of them $TMP stands for a fresh empty
@@ -723,7 +724,7 @@ static void run_cli_dir(const char *frac)
         char *text = read_file(path, NULL);
         buf in = {0}, why = {0}, argb = {0}, want_out = {0};
         int err_contains[32];
-        char *outs[32], *errs[32], *files[32], stdout_to[4096] = "", exec_path[4096] = "";
+        char *outs[32], *errs[32], *files[32], stdout_to[4096] = "", stdin_from[4096] = "", exec_path[4096] = "";
         int nout = 0, nerr = 0, nfile = 0, exit_code = 0;
         char tmpl[] = "/tmp/frac-cli-XXXXXX";
         char *tmp = text && (strstr(text, "$TMP") || strstr(text, "# file: ")) ? mkdtemp(tmpl) : NULL;
@@ -735,6 +736,8 @@ static void run_cli_dir(const char *frac)
                 add_subst(&argb, p + 8, l - 8, tmp);
             } else if (strncmp(p, "# stdout-to: ", 13) == 0)
                 snprintf(stdout_to, sizeof stdout_to, "%.*s", (int)(l - 13), p + 13);
+            else if (strncmp(p, "# stdin-from: ", 14) == 0)
+                snprintf(stdin_from, sizeof stdin_from, "%.*s", (int)(l - 14), p + 14);
             else if (strncmp(p, "# exec: ", 8) == 0)
                 snprintf(exec_path, sizeof exec_path, "%.*s", (int)(l - 8), p + 8);
             else if (strncmp(p, "# stdin: ", 9) == 0) {
@@ -778,10 +781,11 @@ static void run_cli_dir(const char *frac)
         snprintf(fracdir, sizeof fracdir, "%s", frac);
         if (strrchr(fracdir, '/'))
             *strrchr(fracdir, '/') = 0;
+        child_stdin = stdin_from[0] ? stdin_from : NULL;
         child_stdout = stdout_to[0] ? stdout_to : NULL;
         child_path_dir = exec_path[0] ? fracdir : NULL;
         int rc = run(argv, in.d ? in.d : "", &out, &err, 60);
-        child_stdout = child_path_dir = NULL;
+        child_stdin = child_stdout = child_path_dir = NULL;
         int ok = rc == exit_code;
         if (!ok)
             buf_fmt(&why, "  exit code %d, expected %d\n", rc, exit_code);

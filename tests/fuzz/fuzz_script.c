@@ -5,9 +5,12 @@
  *
  * Caps (the interpreter's own limits, set small): 4 MiB of interpreter
  * memory, call depth 40, 1024 pixels per image, 2000 points, 1024 voxels,
- * lists of 1e4, one thread, and a CPU-time budget of 0.5 s per input after which the
- * interpreter's interrupt flag is raised (the script ends with "interrupted",
- * not a libFuzzer timeout).
+ * lists of 1e4, fit()'s time budget 0.05 s (also without time:, so
+ * fit(time: 1e6) returns and the script goes on), one thread, and a
+ * CPU-time budget of 0.5 s per input after which the interpreter's
+ * interrupt flag is raised (the script ends with "interrupted", not a
+ * libFuzzer timeout). tests/unit/test_fuzz_script.c runs this file's
+ * LLVMFuzzerTestOneInput without libFuzzer to check the caps.
  *
  * Files: the harness is linked with -Wl,--wrap=fileio_write_atomic,--wrap=
  * fileio_read_all, so nothing touches the disk. Writes go to a small
@@ -162,6 +165,9 @@ static int known_ub(const char *t)
 
 /* ---- the per-input work budget ----------------------------------------- */
 
+#define FUZZ_CPU_US 500000   /* CPU time per input before the interrupt flag is raised */
+#define FUZZ_FIT_SECONDS 0.05 /* fit()'s time budget: a tenth of the input's */
+
 static volatile sig_atomic_t stop_flag;
 static FILE *devnull; /* where print() goes */
 static FILE *times;   /* FRAC_FUZZ_TIMES=FILE: one line per input, "CPU-microseconds bytes interrupted" */
@@ -218,6 +224,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     st.lim.max_points = 2e3;
     st.lim.max_voxels = 1024;
     st.lim.max_list = 1e4;
+    st.lim.max_fit_seconds = FUZZ_FIT_SECONDS;
     st.threads = 1;
     st.quiet = 1;
     st.progress = 0;
@@ -226,7 +233,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     st.interrupt = &stop_flag;
     st.out = devnull ? devnull : stdout;
     long t0 = times ? cpu_us() : 0;
-    struct itimerval budget = {{0, 0}, {0, 500000}}, off = {{0, 0}, {0, 0}};
+    struct itimerval budget = {{0, 0}, {0, FUZZ_CPU_US}}, off = {{0, 0}, {0, 0}};
     setitimer(ITIMER_VIRTUAL, &budget, NULL);
     if (session_setup(&st) == 0)
         session_run(&st, "<fuzz>", text, len, 0, NULL);

@@ -337,6 +337,71 @@ static void test_validation(void)
           "%s", e.msg);
 }
 
+/* max_nodes bounds every store of lattice nodes: explicit arrays over it
+ * are refused (9^3 = 729 <= 1000 < 17^3 = 4913, so R2 <= 3), the automatic
+ * choice stays within it, and Type II's memo stops growing at max_nodes
+ * slots (it doubles from 1024: 1024, 2048, 4096 <= 5000 < 8192) while its
+ * values stay those of the descent. */
+static void test_node_limit(void)
+{
+    mpd m;
+    mpd_params p;
+    rt_error e = {0};
+    mpd_params_default(&p);
+    p.R = 4;
+    p.type = MPD_TYPE1;
+    p.max_nodes = 1000;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_EINVAL &&
+              strstr(e.msg, "Type I at R = 4 needs 17^3 = 4913 lattice nodes (limit 1000); use Type IV "
+                            "(strategy: 4) with R2 = 3"),
+          "%s", e.msg);
+    p.R = 3;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_OK && m.type == MPD_TYPE1, "R = 3 fits: %s", e.msg);
+    mpd_free(&m);
+    p.R = 9;
+    p.type = MPD_TYPE4;
+    p.R2 = 4;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_EINVAL &&
+              strstr(e.msg, "Type IV with R2 = 4 needs 17^3 = 4913 lattice nodes in its array (limit 1000); use R2 <= 3"),
+          "%s", e.msg);
+    p.max_nodes = 7; /* not even R2 = 0 (8 corners) */
+    p.R2 = 0;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_EINVAL && strstr(e.msg, "use Type III (strategy: 3)"), "%s", e.msg);
+    p.type = MPD_AUTO;
+    p.R2 = -1;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_OK && m.type == MPD_TYPE3 && m.arr == NULL, "auto, 7 nodes: type %d",
+          m.type);
+    mpd_free(&m);
+    p.max_nodes = 1000;
+    CHECK(mpd_init(&m, &p, NULL, &e) == RT_OK && m.type == MPD_TYPE4 && m.R2 == 3, "auto, 1000 nodes: type %d R2 %d",
+          m.type, m.R2);
+    mpd_free(&m);
+
+    /* Type II at R = 20 over 4096 scattered points: unlimited, the memo
+     * grows well past 4096 slots; limited, it stops at 4096 and the values
+     * are still Type III's */
+    enum { NP = 4096 };
+    static double x[NP], y[NP], z[NP], o2[NP], o3[NP], ol[NP];
+    rng r;
+    rng_init(&r, 77, 0);
+    for (int i = 0; i < NP; i++) {
+        x[i] = rng_uniform(&r);
+        y[i] = rng_uniform(&r);
+        z[i] = rng_uniform(&r);
+    }
+    mpd m2 = make(20, MPD_TYPE2, -1, 3, 0.5, 1), m3 = make(20, MPD_TYPE3, -1, 3, 0.5, 1);
+    mpd_stats s2, sl;
+    CHECK(mpd_eval_points(&m2, NULL, NP, x, y, z, o2, &s2, NULL) == RT_OK, "Type II unlimited");
+    CHECK(mpd_eval_points(&m3, NULL, NP, x, y, z, o3, NULL, NULL) == RT_OK, "Type III");
+    m2.max_nodes = 5000;
+    CHECK(mpd_eval_points(&m2, NULL, NP, x, y, z, ol, &sl, NULL) == RT_OK, "Type II limited");
+    CHECK(s2.work_bytes > 4096 * 12, "unlimited memo %zu bytes", s2.work_bytes);
+    CHECK(sl.work_bytes == 4096 * 12, "limited memo %zu bytes (4096 slots of 12 bytes)", sl.work_bytes);
+    CHECK(memcmp(o2, o3, sizeof o2) == 0 && memcmp(ol, o3, sizeof ol) == 0, "Type II = Type III with and without limit");
+    mpd_free(&m2);
+    mpd_free(&m3);
+}
+
 /* Byte-identical output for 1, 2 and 4 threads (array fill, points, grid). */
 static void test_threads(void)
 {
@@ -377,6 +442,7 @@ int main(void)
     test_level_statistics();
     test_memory();
     test_validation();
+    test_node_limit();
     test_threads();
     return check_done("test_mpd");
 }
