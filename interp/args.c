@@ -71,6 +71,6 @@ int lang_join_path(interp *I, const node *at, const char *dir, const char *p, si
 
 int lang_script_path(interp *I, value v, char *buf, size_t n, const char *what)
 {
-    const char *dir = I->cur && I->cur->src >= 0 ? I->srcs[I->cur->src].dir : ".";
+    const char *dir = I->cur ? I->srcs[I->cur->src].dir : ".";
     return lang_join_path(I, NULL, dir, AS_STR(v)->s, AS_STR(v)->len, buf, n, what);
 }

@@ -552,7 +552,7 @@ static cpos pos_of(const node *n)
 cpos contract_name_pos(interp *I, const node *v)
 {
     cpos p = pos_of(NULL);
-    if (!v || v->src < 0 || v->src >= I->nsrc)
+    if (!v || v->src >= I->nsrc)
         return p;
     const char *text = I->srcs[v->src].text;
     /* the offset of the value: line v->line, column v->col (1-based) */

@@ -1030,7 +1030,7 @@ __attribute__((noinline)) static int exec_param(interp *I, env *e, const node *n
     value ov;
     /* -D overrides the params of the script run, not those of the
      * modules it imports */
-    int r = n->src >= 0 && I->srcs[n->src].is_module ? 0 : apply_param_override(I, n, def, &ov);
+    int r = I->srcs[n->src].is_module ? 0 : apply_param_override(I, n, def, &ov);
     if (r < 0) {
         val_unref(I, def);
         return -1;
@@ -1153,7 +1153,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     unsigned char *filedata = NULL;
     size_t filelen = 0;
     if (is_file_import(name)) {
-        const char *dir = at && at->src >= 0 ? I->srcs[at->src].dir : ".";
+        const char *dir = at ? I->srcs[at->src].dir : ".";
         if (lang_join_path(I, at, dir, name, strlen(name), key, sizeof key, "import"))
             return -1;
     } else {
@@ -1198,7 +1198,7 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
         if (fileio_read_all(key, 64u << 20, &filedata, &filelen, &re))
             return err_at(I, at, lang_rt_kind(re.code), "cannot import \"%s\": %s", name, re.msg);
         text = (const char *)filedata;
-        const char *dir = at && at->src >= 0 ? I->srcs[at->src].dir : ".";
+        const char *dir = at ? I->srcs[at->src].dir : ".";
         if (name[0] == '/')
             snprintf(display, sizeof display, "%s", name);
         else if (strcmp(dir, ".") == 0)

@@ -196,21 +196,41 @@ static int scan_number(const char *p, double *out)
     return (int)(p - s);
 }
 
-int lex_all(const char *text, int src, int first_line, token_list *out)
+void lex_init(lexer *L, const char *text, int src, int first_line)
 {
-    const char *p = text;
-    int line = first_line;
-    const char *line_start = text;
-    int space = 1;
-    out->toks = NULL;
-    out->n = out->cap = 0;
-    token *toks = NULL;
-    size_t n = 0, cap = 0;
+    L->text = text;
+    L->p = text;
+    L->line_start = text;
+    L->src = src;
+    L->first_line = first_line;
+    L->line = first_line;
+    L->space = 1;
+    L->done = 0;
     /* A shebang line is a comment. */
-    if (p[0] == '#' && p[1] == '!')
-        while (*p && *p != '\n')
-            p++;
+    if (text[0] == '#' && text[1] == '!')
+        while (*L->p && *L->p != '\n')
+            L->p++;
+}
+
+int lex_next(lexer *L, token *toks, int max)
+{
+    if (L->done)
+        return 0;
+    /* the state is read into locals and written back on the way out, so the
+     * loop keeps it in registers (-fno-strict-aliasing: a store into a
+     * token may alias anything in memory for the compiler) */
+    const char *text = L->text, *p = L->p, *line_start = L->line_start;
+    int line = L->line, space = L->space, first_line = L->first_line;
+    unsigned short src = (unsigned short)L->src;
+    int n = 0;
     for (;;) {
+        if (n == max) {
+            L->p = p;
+            L->line_start = line_start;
+            L->line = line;
+            L->space = space;
+            return n;
+        }
         /* white space and comments */
         while (cls[(unsigned char)*p] & C_SKIP) {
             if (*p == '#') {
@@ -230,17 +250,8 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             }
             space = 1;
         }
-        /* the list is read through locals, since stores into a token may
-         * alias it for the compiler (-fno-strict-aliasing) */
-        if (n == cap) {
-            out->n = n;
-            if (grow(out))
-                return -1;
-            toks = out->toks;
-            cap = out->cap;
-        }
         token *t = &toks[n++];
-        t->src = (unsigned short)src;
+        t->src = src;
         t->line = line;
         t->col = (int)(p - line_start) + 1;
         t->start = p;
@@ -257,10 +268,8 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
         } else if (k & C_DIGIT || (c == '.' && is_digit(p[1]))) {
             t->type = T_NUMBER;
             t->len = scan_number(p, &t->num);
-            if (t->len < 0) {
-                out->n = n - 1;
+            if (t->len < 0)
                 return -1;
-            }
             p += t->len;
             if (cls[(unsigned char)*p] & C_ALPHA) {
                 t->type = T_ERROR;
@@ -295,8 +304,8 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
             }
             t->type = T_EOF;
             t->len = 0;
-            out->n = n;
-            return 0;
+            L->done = 1;
+            return n;
         } else if (c == '"') {
             p++;
             while (*p && *p != '"' && *p != '\n') {
@@ -376,5 +385,23 @@ int lex_all(const char *text, int src, int first_line, token_list *out)
                 p += t->len;
             }
         }
+    }
+}
+
+int lex_all(const char *text, int src, int first_line, token_list *out)
+{
+    lexer L;
+    lex_init(&L, text, src, first_line);
+    out->toks = NULL;
+    out->n = out->cap = 0;
+    for (;;) {
+        if (out->n == out->cap && grow(out))
+            return -1;
+        int k = lex_next(&L, out->toks + out->n, (int)(out->cap - out->n));
+        if (k < 0)
+            return -1;
+        out->n += (size_t)k;
+        if (L.done)
+            return 0;
     }
 }

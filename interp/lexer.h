@@ -1,7 +1,10 @@
 /* lexer.h — turns script text into tokens.
  *
- * The whole source is tokenised up front into an array (the parser needs a
- * little lookahead for lambdas and table rows). Newlines are tokens: they end
+ * lex_next hands out the tokens a batch at a time, as the parser asks for
+ * them: it keeps only a window of tokens around the one it is at (parser.c),
+ * not the whole script's, which for a large script was megabytes of memory
+ * touched once. lex_all tokenises a whole text into one array, for code that
+ * scans every token (resolve.c, the lexer's tests). Newlines are tokens: they end
  * statements and separate the rows of a table literal; the parser skips them
  * inside brackets. Each token remembers whether white space came before it,
  * which is how a table row tells `1 -2` (two entries) from `1 - 2` (one).
@@ -43,8 +46,20 @@ typedef struct token_list {
     size_t n, cap;
 } token_list;
 
-/* Tokenise text (NUL-terminated). Returns 0, or -1 if out of memory. The
- * list always ends with T_EOF; lexical errors are T_ERROR tokens. */
+/* The scanner's place in a text (NUL-terminated). */
+typedef struct lexer {
+    const char *text, *p, *line_start;
+    int src, first_line, line, space, done;
+} lexer;
+
+void lex_init(lexer *L, const char *text, int src, int first_line);
+/* Up to max (>= 1) more tokens into toks: returns how many, the last being
+ * T_EOF when the text ended (then done is set, and later calls return 0), or
+ * -1 if out of memory (a number literal of 128 characters or more needs a
+ * buffer). Lexical errors are T_ERROR tokens. */
+int lex_next(lexer *L, token *toks, int max);
+/* Tokenise the whole text. Returns 0, or -1 if out of memory. The list
+ * always ends with T_EOF. */
 int lex_all(const char *text, int src, int first_line, token_list *out);
 void lex_free(token_list *tl);
 const char *lex_name(tok_type t); /* human name for messages: "')'", "number" */

@@ -15,20 +15,132 @@
 
 #include "lexer.h"
 
+/* A token kept by value, with its number in the script (tokens are numbered
+ * from 0), for what must outlive the window: the construct an error at the
+ * end of the input names. */
+typedef struct tokmark {
+    token t;
+    size_t at;
+} tokmark;
+
+#define NO_TOKEN ((size_t)-1)
+
+/* Tokens come from the lexer as the parser reaches them, into a window that
+ * holds the next token and those after it the parser has looked at; tokens
+ * before the next one are dropped when the window moves on (PARSE_WINDOW
+ * tokens at first; it doubles while a lookahead needs more). So a token
+ * pointer (peek, ahead) is good only until the parser moves: what a
+ * production keeps for later (where it started, its opening bracket) it keeps
+ * by value, a token or a tokmark. */
+#ifndef PARSE_WINDOW
+#define PARSE_WINDOW 2048
+#endif
+#define MAX_OPEN 64
+
 typedef struct parser {
     interp *I;
-    token_list tl;
-    token *cur;     /* the next token, in tl */
+    lexer lx;
+    token *buf;     /* the window: token number base is buf[0] */
+    token *cur;     /* the next token, in buf */
+    token *end;     /* past the last token lexed */
+    size_t cap;     /* tokens buf holds */
+    size_t base;
+    token first;    /* the script's first token (the top block's position) */
+    token eof;      /* the rest of the input when the window could not move */
     int skip_nl;    /* newlines are insignificant here */
     int table_mode; /* parsing an entry of a table row */
     int closing;    /* the error being reported is a missing closer */
-    const token *construct; /* innermost 'if', 'fn' or 'for' being parsed */
+    tokmark construct; /* innermost 'if', 'fn' or 'for' being parsed (at NO_TOKEN: none) */
     int failed;
     int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
     const struct oprow *row[2][T_COUNT]; /* ops[] indexed by fix and token (op_index) */
+    struct pending *items; /* the open lists' items (nodevec), reused for every list */
+    size_t nitems, cap_items;
 } parser;
 
 /* ---- token access ---------------------------------------------------------- */
+
+static token *fill(parser *p, size_t k);
+
+/* The k-th token after the next one (0: the next one), lexing on as needed;
+ * k never reaches past T_EOF (the parser stops there). */
+static inline token *ahead(parser *p, size_t k)
+{
+    if (k < (size_t)(p->end - p->cur))
+        return p->cur + k;
+    return fill(p, k);
+}
+
+/* Past the next token (never past T_EOF). */
+static inline void advance(parser *p)
+{
+    if (++p->cur == p->end)
+        fill(p, 0);
+}
+
+/* +1 for the tokens that open a bracket or block, -1 for those that close one */
+static const signed char nesting[T_COUNT] = {
+    [T_LPAREN] = 1, [T_LBRACKET] = 1, [T_LBRACE] = 1, [T_DO] = 1,
+    [T_RPAREN] = -1, [T_RBRACKET] = -1, [T_RBRACE] = -1, [T_END] = -1,
+};
+
+static int is_opener(tok_type k) { return nesting[k] > 0; }
+
+static inline size_t tok_number(const parser *p, const token *t) { return p->base + (size_t)(t - p->buf); }
+
+static tokmark mark(const parser *p, const token *t) { return (tokmark){*t, tok_number(p, t)}; }
+
+/* The window could not grow, or the lexer ran out of memory: the parser
+ * sees the end of the input and reports nothing more (failed); parse_source
+ * says where (the script's start) and why. */
+static token *window_failed(parser *p)
+{
+    if (!p->failed)
+        mem_engine_error(p->I, NULL, "out of memory"); /* the hook's reason, if no error came first */
+    p->failed = 1;
+    p->eof = (token){.start = "", .line = p->lx.line, .col = 1, .src = (unsigned short)p->lx.src, .type = T_EOF};
+    p->cur = &p->eof;
+    p->end = p->cur + 1;
+    p->lx.done = 1;
+    return p->cur;
+}
+
+/* The slow path of ahead and advance: moves the window to start at the next
+ * token (a new block, the old one freed, so under ASan a token pointer kept
+ * across a move is caught), doubling it while k needs more room, and lexes
+ * on until the k-th token after the next one is in it. */
+static token *fill(parser *p, size_t k)
+{
+    while (k >= (size_t)(p->end - p->cur)) {
+        if (p->lx.done) {
+            if (p->cur == p->end) /* not reached: the parser stops at T_EOF */
+                p->cur--;
+            return p->end - 1;
+        }
+        if (p->end == p->buf + p->cap) {
+            size_t keep = (size_t)(p->end - p->cur);
+            size_t cap = p->cap ? p->cap : PARSE_WINDOW;
+            while (keep + k + 1 > cap / 2)
+                cap *= 2;
+            token *nb = mem_alloc(p->I, cap * sizeof *nb);
+            if (!nb)
+                return window_failed(p);
+            if (keep)
+                memcpy(nb, p->cur, keep * sizeof *nb);
+            p->base += (size_t)(p->cur - p->buf);
+            mem_free(p->I, p->buf);
+            p->buf = p->cur = nb;
+            p->end = nb + keep;
+            p->cap = cap;
+        }
+        token *from = p->end;
+        int got = lex_next(&p->lx, from, (int)(p->buf + p->cap - from));
+        if (got < 0)
+            return window_failed(p);
+        p->end += got;
+    }
+    return p->cur + k;
+}
 
 static inline token *peek_raw(parser *p) { return p->cur; }
 
@@ -36,30 +148,50 @@ static inline token *peek(parser *p)
 {
     if (p->skip_nl)
         while (p->cur->type == T_NEWLINE)
-            p->cur++;
+            advance(p);
     return p->cur;
 }
 
-static token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
+static token *peek2_slow(parser *p);
+
+static inline token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
 {
-    token *save = p->cur;
-    peek(p);
-    size_t i = (size_t)(p->cur - p->tl.toks) + 1;
-    p->cur = save;
-    if (p->tl.toks[i - 1].type == T_EOF)
-        return &p->tl.toks[i - 1];
-    if (p->skip_nl)
-        while (p->tl.toks[i].type == T_NEWLINE)
-            i++;
-    return &p->tl.toks[i];
+    token *t = p->cur;
+    if (t + 1 < p->end && t->type != T_NEWLINE && t->type != T_EOF && t[1].type != T_NEWLINE)
+        return t + 1;
+    return peek2_slow(p);
 }
 
-static inline token *next(parser *p)
+static token *peek2_slow(parser *p)
 {
-    token *t = peek(p);
-    if (t->type != T_EOF)
-        p->cur++;
+    size_t k = 0;
+    if (p->skip_nl)
+        while (ahead(p, k)->type == T_NEWLINE)
+            k++;
+    if (ahead(p, k)->type == T_EOF)
+        return ahead(p, k);
+    k++;
+    if (p->skip_nl)
+        while (ahead(p, k)->type == T_NEWLINE)
+            k++;
+    return ahead(p, k);
+}
+
+/* The next token, by value (the window may move on past it), and past it. */
+static inline token next(parser *p)
+{
+    token t = *peek(p);
+    if (t.type != T_EOF)
+        advance(p);
     return t;
+}
+
+/* next, with the token's number */
+static tokmark next_mark(parser *p)
+{
+    tokmark m = mark(p, peek(p));
+    next(p);
+    return m;
 }
 
 static int check(parser *p, tok_type t) { return peek(p)->type == t; }
@@ -76,38 +208,48 @@ static int match(parser *p, tok_type t)
 static void skip_newlines(parser *p)
 {
     while (peek_raw(p)->type == T_NEWLINE || peek_raw(p)->type == T_SEMI)
-        p->cur++;
+        advance(p);
 }
 
-/* The innermost bracket or 'do' still open before token index `upto`
- * (closers pop whatever is open, so a mismatch is reported elsewhere). */
-static const token *innermost_open(const parser *p, size_t upto)
+/* The innermost bracket or 'do' still open at the end of the input (closers
+ * pop whatever is open, so a mismatch is reported elsewhere): 1 and *out, or
+ * 0 if none. Only an error at the end of the input asks, so the text is lexed
+ * again from its start rather than the parser tracking every token. */
+static int innermost_open(const parser *p, tokmark *out)
 {
-    const token *stack[64];
-    size_t n = 0, deeper = 0;
-    for (size_t i = 0; i < upto; i++) {
-        const token *t = &p->tl.toks[i];
-        tok_type k = t->type;
-        if (k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO) {
-            if (n < 64)
-                stack[n++] = t;
-            else
-                deeper++;
-        } else if (k == T_RPAREN || k == T_RBRACKET || k == T_RBRACE || k == T_END) {
-            if (deeper)
-                deeper--;
-            else if (n)
-                n--;
+    lexer L;
+    lex_init(&L, p->lx.text, p->lx.src, p->lx.first_line);
+    tokmark stack[MAX_OPEN];
+    size_t n = 0, deeper = 0, num = 0;
+    token batch[256];
+    int got;
+    while ((got = lex_next(&L, batch, (int)(sizeof batch / sizeof batch[0]))) > 0) {
+        for (int i = 0; i < got; i++, num++) {
+            int d = nesting[batch[i].type];
+            if (d > 0) {
+                if (n < MAX_OPEN)
+                    stack[n++] = (tokmark){batch[i], num};
+                else
+                    deeper++;
+            } else if (d < 0) {
+                if (deeper)
+                    deeper--;
+                else if (n)
+                    n--;
+            }
         }
     }
-    return n ? stack[n - 1] : NULL;
+    if (got < 0 || !n) /* out of memory (a long number literal): no note */
+        return 0;
+    *out = stack[n - 1];
+    return 1;
 }
 
 static void note_opened_here(parser *p, const token *open)
 {
     err_state *e = &p->I->err;
     tok_type k = open->type;
-    int bracket = k == T_LPAREN || k == T_LBRACKET || k == T_LBRACE || k == T_DO;
+    int bracket = is_opener(k);
     snprintf(e->note, sizeof e->note, "%s %s here", lex_name(k), bracket ? "opened" : "started");
     e->note_src = open->src;
     e->note_line = open->line;
@@ -131,20 +273,21 @@ static int syntax_error(parser *p, const token *t, const char *fmt, const char *
         p->I->err.incomplete = 1;
         /* input that ends inside a construct names where it opened (an
          * expected closer says so itself, see expect_close) */
-        const token *open = p->closing ? NULL : innermost_open(p, (size_t)(t - p->tl.toks));
-        const token *c = p->closing ? NULL : p->construct;
-        if (c && (!open || c > open)) {
+        tokmark opened;
+        const tokmark *open = !p->closing && innermost_open(p, &opened) ? &opened : NULL;
+        const tokmark *c = p->closing || p->construct.at == NO_TOKEN ? NULL : &p->construct;
+        if (c && (!open || c->at > open->at)) {
             err_state *e = &p->I->err;
             size_t l = strlen(e->msg);
-            snprintf(e->msg + l, sizeof e->msg - l, " (%s at line %d is not finished)", lex_name(c->type),
-                     c->line);
-            note_opened_here(p, c);
+            snprintf(e->msg + l, sizeof e->msg - l, " (%s at line %d is not finished)", lex_name(c->t.type),
+                     c->t.line);
+            note_opened_here(p, &c->t);
         } else if (open) {
             err_state *e = &p->I->err;
             size_t l = strlen(e->msg);
             snprintf(e->msg + l, sizeof e->msg - l, " (%s opened at line %d is not closed)",
-                     lex_name(open->type), open->line);
-            note_opened_here(p, open);
+                     lex_name(open->t.type), open->t.line);
+            note_opened_here(p, &open->t);
         }
     }
     return -1;
@@ -286,42 +429,80 @@ static node *mk2(parser *p, node_kind k, const token *at, node *a, node *b)
     return n;
 }
 
+/* The items of a list being parsed (arguments, parameters, fields, rows,
+ * entries, statements) wait on one stack in the parser, and only the finished
+ * list is copied into the arena at its exact size (nv_close), so no array is
+ * left in the syntax tree half empty or outgrown. Lists nest last in, first
+ * out: an inner list is closed before its outer list takes its next item. */
+typedef struct pending {
+    node *n;
+    const char *name;
+} pending;
+
 typedef struct nodevec {
-    node **v;
-    const char **names;
-    int n, cap;
+    size_t base; /* its first item in p->items */
+    int n;
 } nodevec;
 
-static int nv_grow(parser *p, nodevec *nv);
+static inline nodevec nv_open(const parser *p) { return (nodevec){p->nitems, 0}; }
+
+static int nv_grow(parser *p);
 
 static inline int nv_push(parser *p, nodevec *nv, node *n, const char *name)
 {
-    if (nv->n == nv->cap && nv_grow(p, nv))
+    if (p->nitems == p->cap_items && nv_grow(p))
         return -1;
-    nv->v[nv->n] = n;
-    nv->names[nv->n] = name;
+    p->items[p->nitems++] = (pending){n, name};
     nv->n++;
     return 0;
 }
 
-/* Double a nodevec's room (the old arrays stay in the arena). */
-static int nv_grow(parser *p, nodevec *nv)
+static inline const pending *nv_item(const parser *p, const nodevec *nv, int i) { return &p->items[nv->base + (size_t)i]; }
+
+/* Double the stack (through the allocation hook; freed by parse_source). */
+static int nv_grow(parser *p)
 {
-    int nc = nv->cap ? nv->cap * 2 : 8;
-    /* the nodes, then the names, in one piece; items past n are never read */
-    node **a = mem_arena_raw(p->I, (size_t)nc * (sizeof *a + sizeof(const char *)));
+    size_t nc = p->cap_items ? p->cap_items * 2 : 256;
+    pending *a = mem_realloc(p->I, p->items, nc * sizeof *a);
     if (!a) {
         p->failed = 1;
         return -1;
     }
-    const char **b = (const char **)(a + nc);
-    if (nv->n) {
-        memcpy(a, nv->v, (size_t)nv->n * sizeof *a);
-        memcpy(b, nv->names, (size_t)nv->n * sizeof *b);
+    p->items = a;
+    p->cap_items = nc;
+    return 0;
+}
+
+/* Move a list's items into the arena after `lead` leading slots (a call's
+ * callee), as kids and, when names is not NULL, their names in the same
+ * piece; pops them. An empty list with no lead has NULL arrays. */
+static int nv_close(parser *p, nodevec *nv, int lead, node ***kids, const char ***names)
+{
+    size_t k = (size_t)lead + (size_t)nv->n;
+    *kids = NULL;
+    if (names)
+        *names = NULL;
+    if (k) {
+        node **a = mem_arena_raw(p->I, k * (names ? sizeof(node *) + sizeof(char *) : sizeof(node *)));
+        if (!a) {
+            p->failed = 1;
+            return -1;
+        }
+        const pending *it = &p->items[nv->base];
+        if (names) {
+            const char **b = (const char **)(a + k);
+            for (int i = 0; i < nv->n; i++) {
+                a[lead + i] = it[i].n;
+                b[lead + i] = it[i].name;
+            }
+            *names = b;
+        } else {
+            for (int i = 0; i < nv->n; i++)
+                a[lead + i] = it[i].n;
+        }
+        *kids = a;
     }
-    nv->v = a;
-    nv->names = b;
-    nv->cap = nc;
+    p->nitems = nv->base;
     return 0;
 }
 
@@ -437,16 +618,20 @@ static const oprow *op_row(const parser *p, tok_type t, int fix) { return p->row
 /* The level of the right operand of row r. */
 static int operand_level(const oprow *r) { return r->assoc == RIGHT ? r->prec : r->prec + 1; }
 
-/* The infix operator at t, or NULL. In a table row a '+' or '-' with space
+/* The infix operator at the next token, or NULL. In a table row a '+' or '-' with space
  * before it and none after starts a new entry instead (`1 -2`). */
-static const oprow *infix_at(parser *p, const token *t)
+static const oprow *infix_in_row(parser *p, const oprow *r)
 {
+    const token *after = ahead(p, 1);
+    return !after->space_before && after->type != T_NEWLINE ? NULL : r;
+}
+
+static inline const oprow *infix_at(parser *p)
+{
+    const token *t = peek(p);
     const oprow *r = op_row(p, t->type, INFIX);
-    if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before) {
-        const token *after = t + 1;
-        if (!after->space_before && after->type != T_NEWLINE)
-            return NULL;
-    }
+    if (r && p->table_mode && (t->type == T_PLUS || t->type == T_MINUS) && t->space_before)
+        return infix_in_row(p, r);
     return r;
 }
 
@@ -456,12 +641,13 @@ static void skip_to_leading_op(parser *p)
 {
     if (p->table_mode || peek_raw(p)->type != T_NEWLINE)
         return;
-    size_t i = (size_t)(p->cur - p->tl.toks);
-    while (p->tl.toks[i].type == T_NEWLINE)
+    size_t i = 1;
+    while (ahead(p, i)->type == T_NEWLINE)
         i++;
-    const oprow *r = op_row(p, p->tl.toks[i].type, INFIX);
+    const oprow *r = op_row(p, ahead(p, i)->type, INFIX);
     if (r && r->leads)
-        p->cur = &p->tl.toks[i];
+        while (i--)
+            advance(p);
 }
 
 
@@ -469,7 +655,7 @@ static void skip_to_leading_op(parser *p)
 
 static node *parse_expr(parser *p);
 static node *parse_block_until(parser *p, const token *open);
-static node *parse_lambda_rest(parser *p, const token *at, const char *name);
+static node *parse_lambda_rest(parser *p, const tokmark *at, const char *name);
 
 /* The parser's line mode: inside brackets newlines are skipped; a block
  * (do … end, a function body) reads them as statement ends; neither is in a
@@ -535,7 +721,8 @@ static int parse_arg(parser *p, void *ctx)
     args_ctx *c = ctx;
     const char *name = NULL;
     if (check(p, T_IDENT) && peek2(p)->type == T_COLON) {
-        name = tok_name(p, next(p));
+        token t = next(p);
+        name = tok_name(p, &t);
         next(p);
         c->named_seen = 1;
     } else if (c->named_seen) {
@@ -549,9 +736,9 @@ static int parse_arg(parser *p, void *ctx)
 /* args -> '(' [arg {',' arg}] ')' */
 static int parse_args(parser *p, nodevec *args)
 {
-    token *open = next(p); /* '(' */
+    token open = next(p); /* '(' */
     args_ctx c = {args, 0};
-    return parse_comma_list(p, open, T_RPAREN, parse_arg, &c);
+    return parse_comma_list(p, &open, T_RPAREN, parse_arg, &c);
 }
 
 static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
@@ -566,16 +753,10 @@ static node *make_call(parser *p, node *callee, nodevec *args, const token *at)
         c->col = callee->col;
     }
     c->nkids = args->n + 1;
-    c->kids = mem_arena_raw(p->I, (size_t)c->nkids * (sizeof(node *) + sizeof(char *)));
-    if (!c->kids)
+    if (nv_close(p, args, 1, &c->kids, &c->names))
         return NULL;
-    c->names = (const char **)(c->kids + c->nkids);
     c->kids[0] = callee;
     c->names[0] = NULL;
-    for (int i = 0; i < args->n; i++) {
-        c->kids[i + 1] = args->v[i];
-        c->names[i + 1] = args->names[i];
-    }
     return c;
 }
 
@@ -585,48 +766,51 @@ static node *parse_brace(parser *p);
 static node *parse_postfix(parser *p, node *e)
 {
     for (;;) {
-        token *t = peek_raw(p);
-        if (p->skip_nl && t->type == T_NEWLINE)
-            t = peek(p);
-        if (p->table_mode && t->space_before)
+        const token *at = peek_raw(p);
+        if (p->skip_nl && at->type == T_NEWLINE)
+            at = peek(p);
+        if (p->table_mode && at->space_before)
             return e;
-        if (t->type == T_LPAREN) {
-            nodevec args = {0};
+        tok_type k = at->type;
+        if (k != T_LPAREN && k != T_LBRACKET && k != T_DOT &&
+            !(k == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)))
+            return e;
+        token t = *at; /* kept: the window may move on while the suffix is parsed */
+        if (t.type == T_LPAREN) {
+            nodevec args = nv_open(p);
             if (parse_args(p, &args))
                 return NULL;
-            e = make_call(p, e, &args, t);
-        } else if (t->type == T_LBRACKET) {
-            token *open = next(p);
-            node *ix = parse_enclosed(p, T_RBRACKET, open);
+            e = make_call(p, e, &args, &t);
+        } else if (t.type == T_LBRACKET) {
+            next(p);
+            node *ix = parse_enclosed(p, T_RBRACKET, &t);
             if (!ix)
                 return NULL;
-            e = mk2(p, N_INDEX, open, e, ix);
-        } else if (t->type == T_DOT) {
+            e = mk2(p, N_INDEX, &t, e, ix);
+        } else if (t.type == T_DOT) {
             next(p);
-            token *name = peek(p);
-            if (name->type != T_IDENT) {
+            token name = *peek(p);
+            if (name.type != T_IDENT) {
                 char buf[64];
-                syntax_error(p, name, "expected a field name after '.', found %s",
-                             tok_desc(name, buf, sizeof buf));
+                syntax_error(p, &name, "expected a field name after '.', found %s",
+                             tok_desc(&name, buf, sizeof buf));
                 return NULL;
             }
             next(p);
-            node *n = mk1(p, N_FIELD, t, e);
+            node *n = mk1(p, N_FIELD, &t, e);
             if (!n)
                 return NULL;
-            n->str = tok_name(p, name);
+            n->str = tok_name(p, &name);
             e = n;
-        } else if (t->type == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)) {
+        } else if (t.type == T_LBRACE && (e->kind == N_NAME || e->kind == N_FIELD)) {
             /* `ifs { rows }` is `ifs({ rows })` */
             node *arg = parse_brace(p);
             if (!arg)
                 return NULL;
-            nodevec args = {0};
+            nodevec args = nv_open(p);
             if (nv_push(p, &args, arg, NULL))
                 return NULL;
-            e = make_call(p, e, &args, t);
-        } else {
-            return e;
+            e = make_call(p, e, &args, &t);
         }
         if (!e)
             return NULL;
@@ -638,25 +822,25 @@ static node *parse_postfix(parser *p, node *e)
 static int parse_param(parser *p, void *ctx)
 {
     nodevec *params = ctx;
-    token *t = peek(p);
-    if (t->type != T_IDENT) {
+    token t = *peek(p);
+    if (t.type != T_IDENT) {
         char buf[64];
-        syntax_error(p, t, "expected a parameter name, found %s", tok_desc(t, buf, sizeof buf));
+        syntax_error(p, &t, "expected a parameter name, found %s", tok_desc(&t, buf, sizeof buf));
         return -1;
     }
     next(p);
-    const char *name = tok_name(p, t);
+    const char *name = tok_name(p, &t);
     for (int i = 0; i < params->n; i++)
-        if (params->names[i] == name) {
-            syntax_error(p, t, "duplicate parameter '%s'", name);
+        if (nv_item(p, params, i)->name == name) {
+            syntax_error(p, &t, "duplicate parameter '%s'", name);
             return -1;
         }
     node *def = NULL;
     if (match(p, T_ASSIGN)) {
         if (!(def = parse_expr(p)))
             return -1;
-    } else if (params->n && params->v[params->n - 1]) {
-        syntax_error(p, t, "parameter '%s' without a default follows one with a default", name);
+    } else if (params->n && nv_item(p, params, params->n - 1)->n) {
+        syntax_error(p, &t, "parameter '%s' without a default follows one with a default", name);
         return -1;
     }
     return nv_push(p, params, def, name) ? -1 : 0;
@@ -665,10 +849,10 @@ static int parse_param(parser *p, void *ctx)
 /* params -> '(' [param {',' param}] ')' */
 static int parse_params(parser *p, nodevec *params)
 {
-    token *open = peek(p);
+    token open = *peek(p);
     if (expect(p, T_LPAREN, "to start the parameter list"))
         return -1;
-    return parse_comma_list(p, open, T_RPAREN, parse_param, params);
+    return parse_comma_list(p, &open, T_RPAREN, parse_param, params);
 }
 
 static node *make_lambda(parser *p, const token *at, nodevec *params, node *body, const char *name)
@@ -678,51 +862,51 @@ static node *make_lambda(parser *p, const token *at, nodevec *params, node *body
         return NULL;
     l->nparams = params->n;
     l->nkids = params->n;
-    l->kids = params->v;
-    l->names = params->names;
+    if (nv_close(p, params, 0, &l->kids, &l->names))
+        return NULL;
     l->body = body;
     l->str = name;
     return l;
 }
 
 /* lambda_body -> '=' expr | 'do' block 'end' | '=>' expr */
-static node *parse_lambda_rest(parser *p, const token *at, const char *name)
+static node *parse_lambda_rest(parser *p, const tokmark *at, const char *name)
 {
-    const token *save_c = p->construct;
-    if (at->type == T_FN)
-        p->construct = at;
-    nodevec params = {0};
+    tokmark save_c = p->construct;
+    if (at->t.type == T_FN)
+        p->construct = *at;
+    nodevec params = nv_open(p);
     if (parse_params(p, &params))
         return NULL;
     node *body;
-    token *t = peek(p);
-    if (t->type == T_ASSIGN || t->type == T_ARROW) {
+    token t = *peek(p);
+    if (t.type == T_ASSIGN || t.type == T_ARROW) {
         next(p);
         body = parse_expr(p);
-    } else if (t->type == T_DO) {
+    } else if (t.type == T_DO) {
         next(p);
-        body = parse_block_until(p, t);
-        if (body && expect_close(p, T_END, t))
+        body = parse_block_until(p, &t);
+        if (body && expect_close(p, T_END, &t))
             return NULL;
     } else {
         char buf[64];
-        syntax_error(p, t, "expected '=' or 'do' after the parameter list, found %s",
-                     tok_desc(t, buf, sizeof buf));
+        syntax_error(p, &t, "expected '=' or 'do' after the parameter list, found %s",
+                     tok_desc(&t, buf, sizeof buf));
         return NULL;
     }
     if (!body)
         return NULL;
     p->construct = save_c;
-    return make_lambda(p, at, &params, body, name);
+    return make_lambda(p, &at->t, &params, body, name);
 }
 
 /* Is the '(' at pos the start of `(a, b) => …`? */
 static int is_paren_lambda(parser *p)
 {
-    size_t i = (size_t)(p->cur - p->tl.toks);
+    size_t i = 0;
     int depth = 0;
     for (;; i++) {
-        tok_type t = p->tl.toks[i].type;
+        tok_type t = ahead(p, i)->type;
         if (t == T_EOF)
             return 0;
         if (t == T_LPAREN || t == T_LBRACKET || t == T_LBRACE)
@@ -733,25 +917,25 @@ static int is_paren_lambda(parser *p)
         }
     }
     i++;
-    while (p->tl.toks[i].type == T_NEWLINE && p->skip_nl)
+    while (ahead(p, i)->type == T_NEWLINE && p->skip_nl)
         i++;
-    return p->tl.toks[i].type == T_ARROW;
+    return ahead(p, i)->type == T_ARROW;
 }
 
 /* field -> (NAME | STRING) ':' expr   (unique keys) */
 static int parse_field(parser *p, void *ctx)
 {
     nodevec *fields = ctx;
-    token *k = peek(p);
+    token k = *peek(p);
     const char *key;
-    if (k->type == T_IDENT) {
-        key = tok_name(p, k);
-    } else if (k->type == T_STRING) {
-        node *s = string_node(p, k);
+    if (k.type == T_IDENT) {
+        key = tok_name(p, &k);
+    } else if (k.type == T_STRING) {
+        node *s = string_node(p, &k);
         key = s ? interp_intern(p->I, s->str, s->slen) : NULL;
     } else {
         char buf[64];
-        syntax_error(p, k, "expected a field name in record, found %s", tok_desc(k, buf, sizeof buf));
+        syntax_error(p, &k, "expected a field name in record, found %s", tok_desc(&k, buf, sizeof buf));
         return -1;
     }
     next(p);
@@ -761,8 +945,8 @@ static int parse_field(parser *p, void *ctx)
     if (!v)
         return -1;
     for (int j = 0; j < fields->n; j++)
-        if (fields->names[j] == key) {
-            syntax_error(p, k, "duplicate field '%s' in record", key);
+        if (nv_item(p, fields, j)->name == key) {
+            syntax_error(p, &k, "duplicate field '%s' in record", key);
             return -1;
         }
     return nv_push(p, fields, v, key) ? -1 : 0;
@@ -771,34 +955,32 @@ static int parse_field(parser *p, void *ctx)
 /* brace -> '{' '}' | '{' NAME ':' expr {',' NAME ':' expr} '}' | '{' rows '}' */
 static node *parse_brace(parser *p)
 {
-    token *open = next(p);
+    token open = next(p);
     parse_mode m = enter_mode(p, p->skip_nl);
     /* look past newlines to decide between record and table */
-    size_t i = (size_t)(p->cur - p->tl.toks);
-    while (p->tl.toks[i].type == T_NEWLINE)
+    size_t i = 0;
+    while (ahead(p, i)->type == T_NEWLINE)
         i++;
-    tok_type first = p->tl.toks[i].type;
-    int is_record = first == T_RBRACE || (first == T_IDENT && p->tl.toks[i + 1].type == T_COLON) ||
-                    (first == T_STRING && p->tl.toks[i + 1].type == T_COLON);
+    tok_type first = ahead(p, i)->type;
+    int is_record = first == T_RBRACE || (first == T_IDENT && ahead(p, i + 1)->type == T_COLON) ||
+                    (first == T_STRING && ahead(p, i + 1)->type == T_COLON);
     node *n;
     if (is_record) {
-        n = mk(p, N_RECORD, open);
-        nodevec fields = {0};
-        if (n && !parse_comma_list(p, open, T_RBRACE, parse_field, &fields)) {
-            n->kids = fields.v;
-            n->names = fields.names;
+        n = mk(p, N_RECORD, &open);
+        nodevec fields = nv_open(p);
+        if (n && !parse_comma_list(p, &open, T_RBRACE, parse_field, &fields)) {
             n->nkids = fields.n;
+            nv_close(p, &fields, 0, &n->kids, &n->names);
         }
     } else {
         /* table: rows separated by newlines or ';', entries by white space or ',' */
         p->skip_nl = 0;
-        n = mk(p, N_TABLE, open);
-        nodevec rows = {0};
+        n = mk(p, N_TABLE, &open);
+        nodevec rows = nv_open(p);
         skip_newlines(p);
         while (n && !p->failed && !check(p, T_RBRACE) && !check(p, T_EOF)) {
-            token *rt = peek(p);
-            node *row = mk(p, N_ROW, rt);
-            nodevec entries = {0};
+            node *row = mk(p, N_ROW, peek(p));
+            nodevec entries = nv_open(p);
             while (row && !p->failed) {
                 tok_type t = peek_raw(p)->type;
                 if (t == T_NEWLINE || t == T_SEMI || t == T_RBRACE || t == T_EOF)
@@ -812,16 +994,15 @@ static node *parse_brace(parser *p)
             }
             if (p->failed || !row)
                 break;
-            row->kids = entries.v;
             row->nkids = entries.n;
-            if (nv_push(p, &rows, row, NULL))
+            if (nv_close(p, &entries, 0, &row->kids, NULL) || nv_push(p, &rows, row, NULL))
                 break;
             skip_newlines(p);
         }
         if (n && !p->failed) {
-            expect_close(p, T_RBRACE, open);
-            n->kids = rows.v;
+            expect_close(p, T_RBRACE, &open);
             n->nkids = rows.n;
+            nv_close(p, &rows, 0, &n->kids, NULL);
         }
     }
     restore_mode(p, m);
@@ -844,10 +1025,10 @@ static int parse_list_item(parser *p, void *ctx)
     if (c->items.n || !check(p, T_FOR))
         return nv_push(p, &c->items, e, NULL) ? -1 : 0;
     next(p);
-    token *var = peek(p);
-    if (var->type != T_IDENT) {
+    token var = *peek(p);
+    if (var.type != T_IDENT) {
         char buf[64];
-        syntax_error(p, var, "expected a variable name after 'for', found %s", tok_desc(var, buf, sizeof buf));
+        syntax_error(p, &var, "expected a variable name after 'for', found %s", tok_desc(&var, buf, sizeof buf));
         return -1;
     }
     next(p);
@@ -859,7 +1040,7 @@ static int parse_list_item(parser *p, void *ctx)
         return -1;
     node *n = c->n;
     n->kind = N_COMP;
-    n->str = tok_name(p, var);
+    n->str = tok_name(p, &var);
     n->nkids = 3;
     if (!(n->kids = mem_arena_alloc(p->I, 3 * sizeof(node *))))
         return -1;
@@ -872,13 +1053,14 @@ static int parse_list_item(parser *p, void *ctx)
 /* list -> '[' ']' | '[' expr {',' expr} [','] ']' | '[' expr 'for' NAME 'in' expr ['if' expr] ']' */
 static node *parse_list(parser *p)
 {
-    token *open = next(p);
-    list_ctx c = {mk(p, N_LIST, open), {0}};
-    if (!c.n || parse_comma_list(p, open, T_RBRACKET, parse_list_item, &c))
+    token open = next(p);
+    list_ctx c = {mk(p, N_LIST, &open), nv_open(p)};
+    if (!c.n || parse_comma_list(p, &open, T_RBRACKET, parse_list_item, &c))
         return NULL;
     if (c.n->kind == N_LIST) {
-        c.n->kids = c.items.v;
         c.n->nkids = c.items.n;
+        if (nv_close(p, &c.items, 0, &c.n->kids, NULL))
+            return NULL;
     }
     return c.n;
 }
@@ -888,13 +1070,13 @@ static node *parse_list(parser *p)
  * one before), so a long chain is not nesting. */
 static node *parse_if(parser *p)
 {
-    token *at = next(p);
+    tokmark at = next_mark(p);
     int save_tm = p->table_mode;
-    const token *save_c = p->construct;
+    tokmark save_c = p->construct;
     p->table_mode = 0;
     node *first = NULL, **slot = &first;
     for (;;) {
-        node *n = mk(p, N_IF, at);
+        node *n = mk(p, N_IF, &at.t);
         if (!n)
             return NULL;
         n->nkids = 3;
@@ -910,23 +1092,23 @@ static node *parse_if(parser *p)
         if (!n->kids[1])
             return NULL;
         /* 'else' may start the next line */
-        token *save = p->cur;
-        while (peek_raw(p)->type == T_NEWLINE)
-            p->cur++;
-        token *t = peek_raw(p);
-        if (t->type == T_ELIF) {
-            next(p);
-            at = t;
+        size_t k = 0;
+        while (ahead(p, k)->type == T_NEWLINE)
+            k++;
+        tok_type t = ahead(p, k)->type;
+        if (t == T_ELIF || t == T_ELSE)
+            while (k--)
+                advance(p);
+        if (t == T_ELIF) {
+            at = next_mark(p);
             slot = &n->kids[2];
             continue;
         }
-        if (t->type == T_ELSE) {
+        if (t == T_ELSE) {
             next(p);
             n->kids[2] = parse_expr(p);
             if (!n->kids[2])
                 return NULL;
-        } else {
-            p->cur = save;
         }
         break;
     }
@@ -938,20 +1120,20 @@ static node *parse_if(parser *p)
 /* literal -> NUMBER | STRING | 'true' | 'false' | 'nil' */
 static node *parse_literal(parser *p)
 {
-    token *t = next(p);
+    token t = next(p);
     node *n;
-    switch (t->type) {
+    switch (t.type) {
     case T_NUMBER:
-        if ((n = mk(p, N_NUM, t)))
-            n->num = t->num;
+        if ((n = mk(p, N_NUM, &t)))
+            n->num = t.num;
         return n;
     case T_STRING:
-        return string_node(p, t);
+        return string_node(p, &t);
     case T_NIL:
-        return mk(p, N_NIL, t);
+        return mk(p, N_NIL, &t);
     default: /* 'true' | 'false' */
-        if ((n = mk(p, N_BOOL, t)))
-            n->num = t->type == T_TRUE;
+        if ((n = mk(p, N_BOOL, &t)))
+            n->num = t.type == T_TRUE;
         return n;
     }
 }
@@ -959,46 +1141,45 @@ static node *parse_literal(parser *p)
 /* name -> NAME | NAME '=>' expr   (a one-parameter lambda; not in a table row) */
 static node *parse_name(parser *p)
 {
-    token *t = peek(p);
     if (peek2(p)->type == T_ARROW && !p->table_mode) {
+        token t = next(p);
         next(p);
-        next(p);
-        nodevec params = {0};
-        if (nv_push(p, &params, NULL, tok_name(p, t)))
+        nodevec params = nv_open(p);
+        if (nv_push(p, &params, NULL, tok_name(p, &t)))
             return NULL;
         node *body = parse_expr(p);
-        return body ? make_lambda(p, t, &params, body, NULL) : NULL;
+        return body ? make_lambda(p, &t, &params, body, NULL) : NULL;
     }
-    next(p);
-    node *n = mk(p, N_NAME, t);
+    token t = next(p);
+    node *n = mk(p, N_NAME, &t);
     if (n)
-        n->str = tok_name(p, t);
+        n->str = tok_name(p, &t);
     return n;
 }
 
 /* paren -> params '=>' expr | '(' expr ')'   (newlines are white space inside) */
 static node *parse_paren(parser *p)
 {
-    token *t = peek(p);
+    token t = *peek(p);
     if (is_paren_lambda(p)) {
-        nodevec params = {0};
+        nodevec params = nv_open(p);
         if (parse_params(p, &params) || expect(p, T_ARROW, "after the parameter list"))
             return NULL;
         node *body = parse_expr(p);
-        return body ? make_lambda(p, t, &params, body, NULL) : NULL;
+        return body ? make_lambda(p, &t, &params, body, NULL) : NULL;
     }
     next(p);
-    return parse_enclosed(p, T_RPAREN, t);
+    return parse_enclosed(p, T_RPAREN, &t);
 }
 
 /* doblock -> 'do' block 'end' */
 static node *parse_do(parser *p)
 {
-    token *t = next(p);
+    token t = next(p);
     parse_mode m = enter_mode(p, 0);
-    node *b = parse_block_until(p, t);
+    node *b = parse_block_until(p, &t);
     restore_mode(p, m);
-    if (b && expect_close(p, T_END, t))
+    if (b && expect_close(p, T_END, &t))
         return NULL;
     return b;
 }
@@ -1006,9 +1187,9 @@ static node *parse_do(parser *p)
 /* fnexpr -> 'fn' params lambda_body   (an anonymous function) */
 static node *parse_fn_expr(parser *p)
 {
-    token *t = next(p);
+    tokmark t = next_mark(p);
     parse_mode m = enter_mode(p, 0);
-    node *l = parse_lambda_rest(p, t, NULL);
+    node *l = parse_lambda_rest(p, &t, NULL);
     restore_mode(p, m);
     return l;
 }
@@ -1051,7 +1232,7 @@ static node *parse_subexpr(parser *p, int level);
  * argument, `x |> f(a)` is `f(x, a)` and `x |> f` is `f(x)` */
 static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 {
-    nodevec args = {0};
+    nodevec args = nv_open(p);
     if (nv_push(p, &args, left, NULL))
         return NULL;
     if (rhs->kind != N_CALL)
@@ -1065,16 +1246,14 @@ static node *make_pipe(parser *p, const token *op, node *left, node *rhs)
 /* prefixexp -> PREFIXOP subexpr(level of the operator) | primary postfix */
 static node *parse_operand(parser *p, int level)
 {
-    token *t = peek(p);
-    const oprow *r = op_row(p, t->type, PREFIX);
-    if (!r || r->prec < level) /* `a * not b`: the primary reports 'not' */
-        {
+    const oprow *r = op_row(p, peek(p)->type, PREFIX);
+    if (!r || r->prec < level) { /* `a * not b`: the primary reports 'not' */
         node *e = parse_primary(p);
         return e ? parse_postfix(p, e) : NULL;
     }
-    next(p);
+    token t = next(p);
     node *a = parse_subexpr(p, operand_level(r));
-    node *n = a ? mk1(p, r->kind, t, a) : NULL;
+    node *n = a ? mk1(p, r->kind, &t, a) : NULL;
     if (n)
         n->op = r->op;
     return n;
@@ -1091,27 +1270,26 @@ static node *parse_subexpr(parser *p, int level)
     node *left = parse_operand(p, level);
     while (left) {
         skip_to_leading_op(p);
-        token *op = peek(p);
-        const oprow *r = infix_at(p, op);
+        const oprow *r = infix_at(p);
         if (!r || r->prec < level)
             break;
-        next(p);
+        token op = next(p);
         while (peek_raw(p)->type == T_NEWLINE) /* the operand may start the next line */
-            p->cur++;
+            advance(p);
         node *rhs = parse_subexpr(p, operand_level(r));
         if (!rhs) {
             left = NULL;
             break;
         }
         if (r->kind == N_CALL) {
-            left = make_pipe(p, op, left, rhs);
+            left = make_pipe(p, &op, left, rhs);
             continue;
         }
-        left = mk2(p, r->kind, op, left, rhs);
+        left = mk2(p, r->kind, &op, left, rhs);
         if (!left)
             break;
         left->op = r->op;
-        const oprow *again = r->assoc == NONE ? infix_at(p, peek(p)) : NULL;
+        const oprow *again = r->assoc == NONE ? infix_at(p) : NULL;
         if (again && again->prec == r->prec) {
             syntax_error(p, peek(p), "%s", CHAIN_ERROR);
             left = NULL;
@@ -1143,8 +1321,9 @@ static const char *expect_name(parser *p, const char *what)
         syntax_error(p, t, msg, tok_desc(t, buf, sizeof buf));
         return NULL;
     }
+    const char *name = tok_name(p, t); /* before next: the window may move on */
     next(p);
-    return tok_name(p, t);
+    return name;
 }
 
 /* Trailing comment on the line of token t (for param docs). */
@@ -1170,58 +1349,58 @@ static const char *trailing_comment(parser *p, const token *t)
 /* letstat -> 'let' NAME '=' expr   (a lambda takes the name) */
 static node *parse_let(parser *p)
 {
-    token *t = next(p);
+    token t = next(p);
     const char *name = expect_name(p, "a name after 'let'");
     if (!name || expect(p, T_ASSIGN, "after the name in 'let'"))
         return NULL;
     node *v = parse_expr(p);
     if (v && v->kind == N_LAMBDA && !v->str)
         v->str = name;
-    return v ? one_kid(p, N_LET, t, v, name) : NULL;
+    return v ? one_kid(p, N_LET, &t, v, name) : NULL;
 }
 
 /* paramstat -> 'param' NAME '=' expr ['#' doc]   (the default is required) */
 static node *parse_param_decl(parser *p)
 {
-    token *t = next(p);
+    token t = next(p);
     const char *name = expect_name(p, "a name after 'param'");
     if (!name || expect(p, T_ASSIGN, "after the name in 'param' (a default value is required)"))
         return NULL;
     node *v = parse_expr(p);
-    node *n = v ? one_kid(p, N_PARAM, t, v, name) : NULL;
+    node *n = v ? one_kid(p, N_PARAM, &t, v, name) : NULL;
     if (n)
-        n->doc = trailing_comment(p, t);
+        n->doc = trailing_comment(p, &t);
     return n;
 }
 
 /* fnstat -> 'fn' NAME params lambda_body   (one nesting level) */
 static node *parse_fndef(parser *p)
 {
-    token *t = next(p);
+    tokmark t = next_mark(p);
     const char *name = expect_name(p, "a function name");
     if (!name || enter_level(p))
         return NULL;
-    node *l = parse_lambda_rest(p, t, name);
+    node *l = parse_lambda_rest(p, &t, name);
     p->depth--;
-    return l ? one_kid(p, N_FNDEF, t, l, name) : NULL;
+    return l ? one_kid(p, N_FNDEF, &t.t, l, name) : NULL;
 }
 
 /* importstat -> 'import' STRING ['as' NAME] */
 static node *parse_import(parser *p)
 {
-    token *t = next(p);
-    token *s = peek(p);
-    if (s->type != T_STRING) {
+    token t = next(p);
+    token s = *peek(p);
+    if (s.type != T_STRING) {
         char buf[64];
-        syntax_error(p, s, "expected a module name in quotes after 'import', found %s",
-                     tok_desc(s, buf, sizeof buf));
+        syntax_error(p, &s, "expected a module name in quotes after 'import', found %s",
+                     tok_desc(&s, buf, sizeof buf));
         return NULL;
     }
     next(p);
-    node *sn = string_node(p, s);
+    node *sn = string_node(p, &s);
     if (!sn)
         return NULL;
-    node *n = mk(p, N_IMPORT, t);
+    node *n = mk(p, N_IMPORT, &t);
     if (!n)
         return NULL;
     n->str = sn->str;
@@ -1240,8 +1419,8 @@ static node *parse_import(parser *p)
 /* forstat -> 'for' NAME 'in' expr 'do' block 'end'   (the body is one nesting level) */
 static node *parse_for(parser *p)
 {
-    token *t = next(p);
-    const token *save_c = p->construct;
+    tokmark t = next_mark(p);
+    tokmark save_c = p->construct;
     p->construct = t;
     const char *var = expect_name(p, "a variable name after 'for'");
     if (!var || expect(p, T_IN, "after the loop variable"))
@@ -1249,15 +1428,15 @@ static node *parse_for(parser *p)
     node *it = parse_expr(p);
     if (!it)
         return NULL;
-    token *d = peek(p);
+    token d = *peek(p);
     if (expect(p, T_DO, "to start the body of 'for'") || enter_level(p))
         return NULL;
-    node *body = parse_block_until(p, d);
+    node *body = parse_block_until(p, &d);
     p->depth--;
-    if (!body || expect_close(p, T_END, d))
+    if (!body || expect_close(p, T_END, &d))
         return NULL;
     p->construct = save_c;
-    node *n = mk2(p, N_FOR, t, it, body);
+    node *n = mk2(p, N_FOR, &t.t, it, body);
     if (n)
         n->str = var;
     return n;
@@ -1266,18 +1445,18 @@ static node *parse_for(parser *p)
 /* assignstat -> NAME '=' expr */
 static node *parse_assign(parser *p)
 {
-    token *t = next(p);
+    token t = next(p);
     next(p); /* '=' */
     node *v = parse_expr(p);
-    return v ? one_kid(p, N_ASSIGN, t, v, tok_name(p, t)) : NULL;
+    return v ? one_kid(p, N_ASSIGN, &t, v, tok_name(p, &t)) : NULL;
 }
 
 /* exprstat -> expr */
 static node *parse_expr_statement(parser *p)
 {
-    token *t = peek(p);
+    token t = *peek(p);
     node *e = parse_expr(p);
-    return e ? one_kid(p, N_EXPR, t, e, NULL) : NULL;
+    return e ? one_kid(p, N_EXPR, &t, e, NULL) : NULL;
 }
 
 /* statement -> letstat | paramstat | fnstat | importstat | forstat | assignstat | exprstat
@@ -1307,8 +1486,8 @@ static node *parse_statement(parser *p)
 static node *parse_block_until(parser *p, const token *open)
 {
     parse_mode m = enter_mode(p, 0);
-    node *b = mk(p, N_BLOCK, open ? open : &p->tl.toks[0]);
-    nodevec stmts = {0};
+    node *b = mk(p, N_BLOCK, open ? open : &p->first);
+    nodevec stmts = nv_open(p);
     for (;;) {
         skip_newlines(p);
         tok_type t = peek_raw(p)->type;
@@ -1333,9 +1512,8 @@ static node *parse_block_until(parser *p, const token *open)
     restore_mode(p, m);
     if (p->failed || !b)
         return NULL;
-    b->kids = stmts.v;
     b->nkids = stmts.n;
-    return b;
+    return nv_close(p, &stmts, 0, &b->kids, NULL) ? NULL : b;
 }
 
 int parse_source(interp *I, int src, node **out)
@@ -1345,20 +1523,29 @@ int parse_source(interp *I, int src, node **out)
     p.I = I;
     op_index(&p);
     *out = NULL;
-    if (lex_all(I->srcs[src].text, src, I->srcs[src].first_line, &p.tl)) {
-        /* the token array goes through the hook: say why it was refused (the
-         * memory limit, --fail-alloc or the system), at the script's start */
-        lex_free(&p.tl); /* the tokens made before the refusal */
-        mem_engine_error(I, "reading the script", "out of memory");
-        I->err.src = src, I->err.line = I->srcs[src].first_line, I->err.col = 1;
-        return -1;
+    p.construct.at = NO_TOKEN;
+    lex_init(&p.lx, I->srcs[src].text, src, I->srcs[src].first_line);
+    node *b = NULL;
+    if (fill(&p, 0), !p.failed) { /* the first window */
+        p.first = *p.cur;
+        b = parse_block_until(&p, NULL);
     }
-    p.cur = p.tl.toks;
-    node *b = parse_block_until(&p, NULL);
-    lex_free(&p.tl);
+    mem_free(I, p.buf);
+    mem_free(I, p.items);
     if (!b || p.failed) {
-        if (!I->err.active)
+        err_state *e = &I->err;
+        if (!e->active) {
             err_pos(I, src, 1, 1, ERR_MEMORY, "out of memory while parsing");
+        } else if ((e->kind == ERR_LIMIT || e->kind == ERR_MEMORY) && e->src < 0) {
+            /* the tree, the window or a name was refused (the memory limit,
+             * --fail-alloc or the system): say so at the script's start */
+            static const char what[] = "reading the script: ";
+            size_t l = strnlen(e->msg, sizeof e->msg - sizeof what);
+            memmove(e->msg + sizeof what - 1, e->msg, l);
+            memcpy(e->msg, what, sizeof what - 1);
+            e->msg[sizeof what - 1 + l] = 0;
+            e->src = src, e->line = I->srcs[src].first_line, e->col = 1;
+        }
         return -1;
     }
     *out = b;

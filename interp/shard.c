@@ -444,7 +444,7 @@ static int is_full(const shard *s, uint32_t seq)
 
 static void where(interp *I, const node *n, char *buf, size_t size)
 {
-    if (n && n->src >= 0 && n->src < I->nsrc)
+    if (n && n->src < I->nsrc)
         snprintf(buf, size, "%s:%d:%d", I->srcs[n->src].name, n->line + I->srcs[n->src].first_line - 1, n->col);
     else
         buf[0] = 0;

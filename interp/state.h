@@ -208,9 +208,11 @@ void *mem_arena_alloc(interp *I, size_t n);
 /* The same piece of the arena, not zeroed: for the parser's nodes and arrays,
  * which it fills entirely. Inline, as the parser takes one per node: the
  * arena is a list of blocks of at least 64 KiB, handed out in multiples of
- * 16 bytes from the newest one; mem_arena_grow starts a new block. */
+ * 16 bytes from the newest one; mem_arena_grow starts a new block (4× the
+ * last, up to 8 MiB). */
 typedef struct arena_block {
     struct arena_block *next;
+    void *mem; /* what was allocated (the block may start inside it, state.c) */
     size_t used, cap;
     max_align_t data[];
 } arena_block;
