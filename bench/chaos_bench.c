@@ -77,6 +77,19 @@ static const double T1[64] = {
 static const double OCT[8][3] = {{0, 0, 0},   {128, 0, 0},   {128, 0, 128}, {0, 0, 128},
                                  {0, 128, 0}, {128, 128, 0}, {0, 128, 128}, {128, 128, 128}};
 
+/* one step of the plain 3-D loops: the next map k from state s's row of
+ * the RIFS (alias choice), the point halved towards octant k's corner;
+ * returns k, the new state */
+static inline uint32_t oct_step(const rifs *rf, rng *r, uint32_t s, double *x, double *y, double *z)
+{
+    uint64_t w = rng_next(r);
+    const ifs_alias *al = &rf->row[s];
+    uint32_t col = (uint32_t)(((w >> 32) * 8) >> 32);
+    uint32_t k = al->sel[2 * col + ((uint32_t)w < al->thresh[col])];
+    *x = 0.5 * *x + OCT[k][0], *y = 0.5 * *y + OCT[k][1], *z = 0.5 * *z + OCT[k][2];
+    return k;
+}
+
 static uint64_t plain3(uint64_t npts, const rifs *rf, uint32_t *cnt)
 {
     rng r;
@@ -85,12 +98,7 @@ static uint64_t plain3(uint64_t npts, const rifs *rf, uint32_t *cnt)
     uint32_t s = 0;
     uint64_t inside = 0;
     for (uint64_t i = 0; i < npts; i++) {
-        uint64_t w = rng_next(&r);
-        const ifs_alias *al = &rf->row[s];
-        uint32_t col = (uint32_t)(((w >> 32) * 8) >> 32);
-        uint32_t k = al->sel[2 * col + ((uint32_t)w < al->thresh[col])];
-        s = k;
-        x = 0.5 * x + OCT[k][0], y = 0.5 * y + OCT[k][1], z = 0.5 * z + OCT[k][2];
+        s = oct_step(rf, &r, s, &x, &y, &z);
         double fx = x, fy = y, fz = z; /* box [0,256]³, 256 voxels: scale 1 */
         if (fx >= 0 && fx < 256 && fy >= 0 && fy < 256 && fz >= 0 && fz < 256) {
             cnt[(size_t)(int)fx + 256 * ((size_t)(int)fy + 256 * (size_t)(int)fz)]++;
@@ -115,12 +123,7 @@ static uint64_t plain3p(uint64_t npts, const rifs *rf, uint32_t *cnt)
     uint32_t s = 0;
     uint64_t inside = 0;
     for (uint64_t i = 0; i < npts; i++) {
-        uint64_t w = rng_next(&r);
-        const ifs_alias *al = &rf->row[s];
-        uint32_t col = (uint32_t)(((w >> 32) * 8) >> 32);
-        uint32_t k = al->sel[2 * col + ((uint32_t)w < al->thresh[col])];
-        s = k;
-        x = 0.5 * x + OCT[k][0], y = 0.5 * y + OCT[k][1], z = 0.5 * z + OCT[k][2];
+        s = oct_step(rf, &r, s, &x, &y, &z);
         size_t b = trash;
         if (x >= 0 && x < 256 && y >= 0 && y < 256 && z >= 0 && z < 256) {
             b = (size_t)(int)x + 256 * ((size_t)(int)y + 256 * (size_t)(int)z);

@@ -99,7 +99,11 @@ typedef struct result {
     size_t bytes;
 } result;
 
-static result exp1_run(int R, int type, int R2, double *out)
+/* Best of 3 runs of Type `type` at level R: the (2^R+1)^3 lattice points of
+ * experiment 1 when x is NULL, else the n points x, y, z of experiment 2.
+ * A run over 20 s ends the repeats (Type II on the large spheres). */
+static result exp_run(int R, int type, int R2, size_t n, const double *x, const double *y, const double *z,
+                      double *out)
 {
     result r = {1e30, 0};
     int N = (1 << R) + 1;
@@ -109,54 +113,8 @@ static result exp1_run(int R, int type, int R2, double *out)
         mpd m = make(R, type, R2);
         mpd_stats st;
         rt_error e;
-        if (mpd_eval_grid(&m, &RUN, lo, hi, N, N, N, out, &st, &e)) {
-            fprintf(stderr, "%s\n", e.msg);
-            exit(1);
-        }
-        double t = (now() - t0) * 1e3;
-        if (t < r.ms)
-            r.ms = t;
-        r.bytes = st.array_bytes + st.work_bytes * st.workers;
-        mpd_free(&m);
-    }
-    return r;
-}
-
-static void table1(int maxR)
-{
-    printf("\n## 1. Experiment 1: all (2^R+1)^3 lattice points (time ms / engine memory)\n\n");
-    printf("| R | Type I | Type II | Type III | Type IV (R2 = R-3) | IV/I time | IV/I memory |\n|---|---|---|---|---|---|---|\n");
-    for (int R = 4; R <= maxR && R <= 8; R++) {
-        size_t N = ((size_t)1 << R) + 1;
-        double *out = malloc(N * N * N * sizeof *out);
-        result r1 = exp1_run(R, MPD_TYPE1, 0, out);
-        result r2 = {0, 0};
-        if (R <= 6)
-            r2 = exp1_run(R, MPD_TYPE2, 0, out);
-        result r3 = exp1_run(R, MPD_TYPE3, 0, out);
-        result r4 = exp1_run(R, MPD_TYPE4, R - 3 > 0 ? R - 3 : 0, out);
-        char c2[64];
-        if (R <= 6)
-            snprintf(c2, sizeof c2, "%.1f / %.1f MB", r2.ms, r2.bytes / 1e6);
-        else
-            snprintf(c2, sizeof c2, "-");
-        printf("| %d | %.1f / %.2f MB | %s | %.1f / %.3f MB | %.1f / %.3f MB | %.2f | 1/%.0f |\n", R, r1.ms,
-               r1.bytes / 1e6, c2, r3.ms, r3.bytes / 1e6, r4.ms, r4.bytes / 1e6, r4.ms / r1.ms,
-               (double)r1.bytes / r4.bytes);
-        free(out);
-    }
-}
-
-static result exp2_run(int R, int type, int R2, size_t n, const double *x, const double *y, const double *z,
-                       double *out)
-{
-    result r = {1e30, 0};
-    for (int rep = 0; rep < 3; rep++) {
-        double t0 = now();
-        mpd m = make(R, type, R2);
-        mpd_stats st;
-        rt_error e;
-        if (mpd_eval_points(&m, &RUN, n, x, y, z, out, &st, &e)) {
+        if (x ? mpd_eval_points(&m, &RUN, n, x, y, z, out, &st, &e)
+              : mpd_eval_grid(&m, &RUN, lo, hi, N, N, N, out, &st, &e)) {
             fprintf(stderr, "%s\n", e.msg);
             exit(1);
         }
@@ -169,6 +127,31 @@ static result exp2_run(int R, int type, int R2, size_t n, const double *x, const
             break;
     }
     return r;
+}
+
+static void table1(int maxR)
+{
+    printf("\n## 1. Experiment 1: all (2^R+1)^3 lattice points (time ms / engine memory)\n\n");
+    printf("| R | Type I | Type II | Type III | Type IV (R2 = R-3) | IV/I time | IV/I memory |\n|---|---|---|---|---|---|---|\n");
+    for (int R = 4; R <= maxR && R <= 8; R++) {
+        size_t N = ((size_t)1 << R) + 1;
+        double *out = malloc(N * N * N * sizeof *out);
+        result r1 = exp_run(R, MPD_TYPE1, 0, 0, NULL, NULL, NULL, out);
+        result r2 = {0, 0};
+        if (R <= 6)
+            r2 = exp_run(R, MPD_TYPE2, 0, 0, NULL, NULL, NULL, out);
+        result r3 = exp_run(R, MPD_TYPE3, 0, 0, NULL, NULL, NULL, out);
+        result r4 = exp_run(R, MPD_TYPE4, R - 3 > 0 ? R - 3 : 0, 0, NULL, NULL, NULL, out);
+        char c2[64];
+        if (R <= 6)
+            snprintf(c2, sizeof c2, "%.1f / %.1f MB", r2.ms, r2.bytes / 1e6);
+        else
+            snprintf(c2, sizeof c2, "-");
+        printf("| %d | %.1f / %.2f MB | %s | %.1f / %.3f MB | %.1f / %.3f MB | %.2f | 1/%.0f |\n", R, r1.ms,
+               r1.bytes / 1e6, c2, r3.ms, r3.bytes / 1e6, r4.ms, r4.bytes / 1e6, r4.ms / r1.ms,
+               (double)r1.bytes / r4.bytes);
+        free(out);
+    }
 }
 
 static void table2(int maxR)
@@ -206,12 +189,12 @@ static void table2(int maxR)
             }
         }
         double *out = malloc(n * sizeof *out);
-        result a = exp2_run(R, MPD_TYPE1, 0, n, x, y, z, out);
+        result a = exp_run(R, MPD_TYPE1, 0, n, x, y, z, out);
         result b = {0, 0};
         if (R <= 7)
-            b = exp2_run(R, MPD_TYPE2, 0, n, x, y, z, out);
-        result c3 = exp2_run(R, MPD_TYPE3, 0, n, x, y, z, out);
-        result d = exp2_run(R, MPD_TYPE4, 6, n, x, y, z, out);
+            b = exp_run(R, MPD_TYPE2, 0, n, x, y, z, out);
+        result c3 = exp_run(R, MPD_TYPE3, 0, n, x, y, z, out);
+        result d = exp_run(R, MPD_TYPE4, 6, n, x, y, z, out);
         char cb[64];
         if (R <= 7)
             snprintf(cb, sizeof cb, "%.1f / %.1f MB", b.ms, b.bytes / 1e6);

@@ -337,6 +337,27 @@ static int is_literal(const node *n)
 
 static int resolve_kid(resolver *r, scope *s, const node *k);
 
+/* The loop of a for or a comprehension: `iter` resolves in s, then the loop
+ * variable `name` is declared in a scope of its own inside s, where `first`
+ * and then `second` (either may be NULL) resolve. */
+static int resolve_loop(resolver *r, scope *s, const char *name, const node *iter, const node *first,
+                        const node *second)
+{
+    if (resolve_node(r, s, iter))
+        return -1;
+    scope inner = {0};
+    inner.parent = s;
+    int rc = declare(r, &inner, name);
+    if (rc == 0)
+        rc = bind(r, name, NULL);
+    if (rc == 0)
+        rc = resolve_node(r, &inner, first);
+    if (rc == 0)
+        rc = resolve_node(r, &inner, second);
+    scope_free(r->I, &inner);
+    return rc;
+}
+
 static int resolve_node(resolver *r, scope *s, const node *n)
 {
     if (!n)
@@ -356,21 +377,8 @@ static int resolve_node(resolver *r, scope *s, const node *n)
         scope_free(r->I, &inner);
         return rc;
     }
-    case N_COMP: {
-        if (resolve_node(r, s, n->kids[1]))
-            return -1;
-        scope inner = {0};
-        inner.parent = s;
-        int rc = declare(r, &inner, n->str);
-        if (rc == 0)
-            rc = bind(r, n->str, NULL);
-        if (rc == 0)
-            rc = resolve_node(r, &inner, n->kids[2]);
-        if (rc == 0)
-            rc = resolve_node(r, &inner, n->kids[0]);
-        scope_free(r->I, &inner);
-        return rc;
-    }
+    case N_COMP: /* [kids[0] for str in kids[1] if kids[2]] */
+        return resolve_loop(r, s, n->str, n->kids[1], n->kids[2], n->kids[0]);
     case N_FIELD:
         return resolve_node(r, s, n->kids[0]);
     case N_CALL:
@@ -440,21 +448,10 @@ static int resolve_block(resolver *r, scope *s, const node *b)
             if (module_names(r, s, st))
                 return -1;
             break;
-        case N_FOR: {
-            if (resolve_node(r, s, st->kids[0]))
-                return -1;
-            scope inner = {0};
-            inner.parent = s;
-            int rc = declare(r, &inner, st->str);
-            if (rc == 0)
-                rc = bind(r, st->str, NULL);
-            if (rc == 0)
-                rc = resolve_node(r, &inner, st->kids[1]);
-            scope_free(r->I, &inner);
-            if (rc)
+        case N_FOR:
+            if (resolve_loop(r, s, st->str, st->kids[0], st->kids[1], NULL))
                 return -1;
             break;
-        }
         case N_EXPR:
             if (resolve_node(r, s, st->kids[0]))
                 return -1;
@@ -650,6 +647,25 @@ static int slots_block(interp *I, rscope *s, const node *b)
     return slots_defs(I, s, b) || slots_stmts(I, s, b) ? -1 : 0;
 }
 
+/* The slots of a for (body; an N_BLOCK's statements share the loop
+ * variable's scope) or a comprehension (its condition cond, then its
+ * element elem): iter in s, then the loop variable in a scope of its own. */
+static int slots_loop(interp *I, rscope *s, const char *name, node *iter, node *body, node *cond, node *elem)
+{
+    if (slots_node(I, s, iter))
+        return -1;
+    rscope inner = {.parent = s};
+    int rc = rs_define(I, &inner, name);
+    if (rc == 0 && body)
+        rc = body->kind == N_BLOCK ? slots_block(I, &inner, body) : slots_node(I, &inner, body);
+    if (rc == 0)
+        rc = slots_node(I, &inner, cond);
+    if (rc == 0)
+        rc = slots_node(I, &inner, elem);
+    rs_free(I, &inner);
+    return rc;
+}
+
 static int slots_stmts(interp *I, rscope *s, const node *b)
 {
     if (cstack_exhausted())
@@ -671,19 +687,10 @@ static int slots_stmts(interp *I, rscope *s, const node *b)
             break;
         case N_IMPORT:
             break;
-        case N_FOR: {
-            if (slots_node(I, s, st->kids[0]))
-                return -1;
-            rscope inner = {.parent = s};
-            int rc = rs_define(I, &inner, st->str);
-            if (rc == 0)
-                rc = st->kids[1]->kind == N_BLOCK ? slots_block(I, &inner, st->kids[1])
-                                                  : slots_node(I, &inner, st->kids[1]);
-            rs_free(I, &inner);
-            if (rc)
+        case N_FOR:
+            if (slots_loop(I, s, st->str, st->kids[0], st->kids[1], NULL, NULL))
                 return -1;
             break;
-        }
         default:
             if (slots_node(I, s, st))
                 return -1;
@@ -722,18 +729,8 @@ static int slots_node(interp *I, rscope *s, node *n)
         rs_free(I, &inner);
         return rc;
     }
-    case N_COMP: {
-        if (slots_node(I, s, n->kids[1]))
-            return -1;
-        rscope inner = {.parent = s};
-        rc = rs_define(I, &inner, n->str);
-        if (rc == 0)
-            rc = slots_node(I, &inner, n->kids[2]);
-        if (rc == 0)
-            rc = slots_node(I, &inner, n->kids[0]);
-        rs_free(I, &inner);
-        return rc;
-    }
+    case N_COMP:
+        return slots_loop(I, s, n->str, n->kids[1], NULL, n->kids[2], n->kids[0]);
     default:
         for (int i = 0; i < n->nkids && rc == 0; i++)
             rc = slots_node(I, s, n->kids[i]);

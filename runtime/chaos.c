@@ -383,6 +383,25 @@ INLINE void add_cell(worker *w, const uint32_t *cnt, uint32_t *cell, const uint3
         flush_cell(w, cnt, cell, nbins);
 }
 
+/* The start of a hot loop's chunk: its point count and its orbit after the
+ * burn-in, in dim 2 or 3 with the loop's kind and colour (with
+ * CHAOS_COLOUR_BLEND the burn-in moves the colour coordinate too). */
+INLINE void chunk_orbit(const job *j, size_t chunk, orbit *ob, uint64_t *count, const int dim, const int kind,
+                        const int colour)
+{
+    const sysdata *d = j->d;
+    chunk_range(j, chunk, count);
+    orbit_start(ob, d, j->o->seed, chunk);
+    for (uint64_t i = 0; i < j->burn; i++) {
+        if (dim == 2)
+            orbit_step2(ob, d, kind);
+        else
+            orbit_step3(ob, d, kind);
+        if (colour == CHAOS_COLOUR_BLEND)
+            (void)orbit_colour(ob, d, colour);
+    }
+}
+
 /* Hits of the outside colour cell so far: its count and what flushes moved
  * into the side sums. */
 INLINE uint64_t out_hits(const worker *w, const uint32_t *out, size_t nbins)
@@ -406,14 +425,8 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const sysdata *d = j->d;
     worker *w = &j->w[wid];
     uint64_t count;
-    chunk_range(j, chunk, &count);
     orbit ob;
-    orbit_start(&ob, d, j->o->seed, chunk);
-    for (uint64_t i = 0; i < j->burn; i++) {
-        orbit_step2(&ob, d, kind);
-        if (colour == CHAOS_COLOUR_BLEND)
-            (void)orbit_colour(&ob, d, colour);
-    }
+    chunk_orbit(j, chunk, &ob, &count, 2, kind, colour);
     const double lox = j->lox, hiy = j->hiy, sx = j->sx, sy = j->sy;
     const double fw = j->hw, fh = j->hh;
     const size_t hw = (size_t)j->hw;
@@ -528,11 +541,8 @@ INLINE void vol_chunk(const job *j, size_t chunk, int wid, const int kind, const
     const sysdata *d = j->d;
     worker *w = &j->w[wid];
     uint64_t count;
-    chunk_range(j, chunk, &count);
     orbit ob;
-    orbit_start(&ob, d, j->o->seed, chunk);
-    for (uint64_t i = 0; i < j->burn; i++)
-        orbit_step3(&ob, d, kind);
+    chunk_orbit(j, chunk, &ob, &count, 3, kind, CHAOS_COLOUR_NONE);
     const double lx = j->lo3[0], ly = j->lo3[1], lz = j->lo3[2];
     const double sx = j->s3[0], sy = j->s3[1], sz = j->s3[2];
     const double fx_n = j->nx, fy_n = j->ny, fz_n = j->nz;

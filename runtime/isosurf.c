@@ -40,6 +40,11 @@
 #include "par.h"
 
 #define SLAB 4
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#else
+#define INLINE static inline
+#endif
 #define S_EPS 1e-3
 
 /* The case table, generated here from the cube's topology (no table is
@@ -492,6 +497,37 @@ static void write_normal(iso_job *j, uint32_t id, double nv[3], const int p[3], 
         N[a] = (float)(nv[a] / l);
 }
 
+/* Where the level crosses an edge whose ends hold fp and fq, as a fraction
+ * of the edge from the fp end, kept S_EPS off both ends (0.5 when the ends
+ * are equal or not finite). */
+static inline double edge_fraction(double level, double fp, double fq)
+{
+    double s = 0.5;
+    if (isfinite(fp) && isfinite(fq) && fq != fp) {
+        s = (level - fp) / (fq - fp);
+        if (!(s >= S_EPS))
+            s = S_EPS;
+        if (s > 1 - S_EPS)
+            s = 1 - S_EPS;
+    }
+    return s;
+}
+
+/* Vertex id: its edge (p, axis d) when edges are kept, and its position
+ * the fraction s of the way from node p to node q. */
+static inline void put_vertex(iso_job *j, uint32_t id, int d, const int p[3], const int q[3], double s)
+{
+    if (j->edges) {
+        int32_t *E = j->edges + 4 * (size_t)id;
+        E[0] = p[0], E[1] = p[1], E[2] = p[2], E[3] = d;
+    }
+    float *O = j->pos + 3 * (size_t)id;
+    for (int a = 0; a < 3; a++) {
+        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
+        O[a] = (float)(cp + s * (cq - cp));
+    }
+}
+
 /* make_vertex for an edge whose two ends are at least one node from the
  * grid's border on every axis (most edges): the same arithmetic without
  * the border cases, so the compiler can overlap the divisions. */
@@ -499,25 +535,10 @@ static void make_vertex_inner(iso_job *j, int x, int y, int z, int d, uint32_t i
 {
     int p[3] = {x, y, z}, q[3] = {x + (d & 1), y + (d >> 1 & 1), z + (d >> 2 & 1)};
     const float *P = volume_at(j->vol, x, y, z), *Q = P + j->stride[d >> 1];
-    double fp = *P, fq = *Q, s = 0.5;
+    double fp = *P, fq = *Q, s = edge_fraction(j->level, fp, fq);
     int pin = fp >= j->level;
-    if (isfinite(fp) && isfinite(fq) && fq != fp) {
-        s = (j->level - fp) / (fq - fp);
-        if (!(s >= S_EPS))
-            s = S_EPS;
-        if (s > 1 - S_EPS)
-            s = 1 - S_EPS;
-    }
     j->cap[id] = 0;
-    if (j->edges) {
-        int32_t *E = j->edges + 4 * (size_t)id;
-        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
-    }
-    float *O = j->pos + 3 * (size_t)id;
-    for (int a = 0; a < 3; a++) {
-        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
-        O[a] = (float)(cp + s * (cq - cp));
-    }
+    put_vertex(j, id, d, p, q, s);
     if (j->want_normals) {
         double g0[3], g1[3], nv[3];
         for (int a = 0; a < 3; a++) {
@@ -546,20 +567,14 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
         const float *fpp = volume_at(j->vol, p[0], p[1], p[2]), *fqp = volume_at(j->vol, q[0], q[1], q[2]);
         double fp = *fpp, fq = *fqp;
         pin = fp >= j->level;
-        if (isfinite(fp) && isfinite(fq) && fq != fp) {
-            s = (j->level - fp) / (fq - fp);
-            if (!(s >= S_EPS))
-                s = S_EPS;
-            if (s > 1 - S_EPS)
-                s = 1 - S_EPS;
-        }
+        s = edge_fraction(j->level, fp, fq);
+        j->cap[id] = 0;
         if (j->want_normals) {
             for (int a = 0; a < 3; a++) {
                 double g0 = grid_grad(j, fpp, p[a], a), g1 = grid_grad(j, fqp, q[a], a);
                 nv[a] = -((1 - s) * g0 + s * g1);
             }
         }
-        j->cap[id] = 0;
     } else {
         /* One end is padding: the vertex is on the box face; normal = the
          * outward normal of the face(s) the padding node lies beyond. */
@@ -568,15 +583,7 @@ static void make_vertex(iso_job *j, int x, int y, int z, int d, uint32_t id)
             nv[a] = pad[a] < 0 ? -1.0 : pad[a] >= j->n[a] ? 1.0 : 0.0;
         j->cap[id] = 1;
     }
-    if (j->edges) {
-        int32_t *E = j->edges + 4 * (size_t)id;
-        E[0] = x, E[1] = y, E[2] = z, E[3] = d;
-    }
-    float *P = j->pos + 3 * (size_t)id;
-    for (int a = 0; a < 3; a++) {
-        double cp = j->crd[a][p[a] + 1], cq = j->crd[a][q[a] + 1];
-        P[a] = (float)(cp + s * (cq - cp));
-    }
+    put_vertex(j, id, d, p, q, s);
     if (j->want_normals)
         write_normal(j, id, nv, p, q, pin);
 }
@@ -624,6 +631,78 @@ static const mc_case *cell_case(const iso_job *j, int x, int y, int z, int mask)
     return &j->tb.cases[ci];
 }
 
+/* What the two passes carry while they walk the cells: pass 1 counts the
+ * triangles and centre vertices; pass 2 writes them, the next triangle at
+ * T and the next centre record at CR, centre ids from cen0 on, edge ids
+ * from ids[0] (cell layer z's bottom node layer) and ids[1] (its top). */
+typedef struct cell_acc {
+    size_t ntri, ncen;
+    uint32_t *T, *CR, **ids;
+    size_t cen0;
+} cell_acc;
+
+INLINE void count_cell(cell_acc *a, const mc_case *K)
+{
+    a->ntri += K->nt;
+    for (int k = 0; k < K->nc; k++)
+        a->ntri += K->ck[k];
+    a->ncen += K->nc;
+}
+
+/* the triangles of the cell at layer index idx, and its centre vertices
+ * (each with a fan of triangles around it) */
+INLINE void build_cell(iso_job *j, cell_acc *a, size_t idx, const mc_case *K)
+{
+    uint32_t *T = a->T, *const *ids = a->ids;
+    for (int ti = 0; ti < K->nt; ti++, T += 3)
+        for (int r = 0; r < 3; r++) {
+            int e = K->e[ti][r];
+            T[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+        }
+    for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
+        uint32_t *rec = a->CR;
+        int n = K->ck[k];
+        a->CR += CEN_REC;
+        rec[0] = (uint32_t)(a->cen0 + a->ncen++);
+        rec[1] = (uint32_t)n;
+        for (int r = 0; r < n; r++) {
+            int e = K->ce[at + r];
+            rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
+        }
+        for (int r = 0; r < n; r++, T += 3) {
+            T[0] = rec[2 + r];
+            T[1] = rec[2 + (r + 1) % n];
+            T[2] = rec[0];
+        }
+        j->cap[rec[0]] = 2;
+    }
+    a->T = T;
+}
+
+/* The cells of cell layer z that the surface crosses (corners not all
+ * alike), in (y, x) order: counted (build 0, pass 1) or written (1). */
+INLINE void walk_cells(iso_job *j, int z, cell_acc *a, const int build)
+{
+    int W = j->W;
+    for (int y = -1; y < j->n[1]; y++) {
+        const uint64_t *R[4];
+        if (!cell_rows(j, y, z, R))
+            continue;
+        for (int w = 0; w < W; w++) {
+            uint64_t v[8], act = cell_words(R, w, W, v);
+            while (act) {
+                int b = __builtin_ctzll(act), x = 64 * w + b - 1;
+                act &= act - 1;
+                const mc_case *K = cell_case(j, x, y, z, cell_mask(v, b));
+                if (build)
+                    build_cell(j, a, lidx(j, x, y), K);
+                else
+                    count_cell(a, K);
+            }
+        }
+    }
+}
+
 /* Pass 1: the chunk's crossing edges (node layers z0 .. z1-1), and the
  * triangles and centre vertices of its cell layers. */
 static void pass_count(void *ctx, size_t c, int worker)
@@ -632,7 +711,8 @@ static void pass_count(void *ctx, size_t c, int worker)
     iso_job *j = ctx;
     int z0, z1, W = j->W;
     chunk_range(j, c, &z0, &z1);
-    size_t cnt = 0, ncen = 0, ntri = 0;
+    size_t cnt = 0;
+    cell_acc a = {0};
     for (int z = z0; z < z1; z++) {
         for (int y = -1; y <= j->n[1]; y++) {
             if (!row_has_crossings(j, y, z))
@@ -644,28 +724,12 @@ static void pass_count(void *ctx, size_t c, int worker)
                                 __builtin_popcountll(e[2]));
             }
         }
-        for (int y = -1; y < j->n[1]; y++) {
-            const uint64_t *R[4];
-            if (!cell_rows(j, y, z, R))
-                continue;
-            for (int w = 0; w < W; w++) {
-                uint64_t v[8], act = cell_words(R, w, W, v);
-                while (act) {
-                    int b = __builtin_ctzll(act);
-                    act &= act - 1;
-                    const mc_case *K = cell_case(j, 64 * w + b - 1, y, z, cell_mask(v, b));
-                    ntri += K->nt;
-                    for (int k = 0; k < K->nc; k++)
-                        ntri += K->ck[k];
-                    ncen += K->nc;
-                }
-            }
-        }
+        walk_cells(j, z, &a, 0);
     }
     j->nedge[c] = cnt;
-    j->ncen[c] = ncen;
-    j->ntri[c] = ntri;
-    j->counts[c] = cnt + ncen;
+    j->ncen[c] = a.ncen;
+    j->ntri[c] = a.ntri;
+    j->counts[c] = cnt + a.ncen;
 }
 
 /* The asymptotic decider on face f of the cell at (x, y, z): the bilinear
@@ -738,12 +802,15 @@ static void pass_centres(void *ctx, size_t c, int worker)
 static void pass_build(void *ctx, size_t c, int worker)
 {
     iso_job *j = ctx;
-    int z0, z1, W = j->W;
+    int z0, z1;
     chunk_range(j, c, &z0, &z1);
     uint32_t *ids[2] = {j->scratch[worker], j->scratch[worker] + j->lsz * 3};
-    size_t counter = 0, ncen = 0, base = j->counts[c];
-    uint32_t *T = j->tri + 3 * j->tri_at[c];
-    uint32_t *CR = j->cen + CEN_REC * j->cen_at[c];
+    size_t counter = 0, base = j->counts[c];
+    cell_acc a = {0};
+    a.T = j->tri + 3 * j->tri_at[c];
+    a.CR = j->cen + CEN_REC * j->cen_at[c];
+    a.ids = ids;
+    a.cen0 = base + j->nedge[c];
     number_layer(j, z0, ids[0], base, &counter, 1);
     for (int z = z0; z < z1; z++) {
         /* ids[0] = layer z; number layer z+1 (the next chunk's first layer
@@ -754,42 +821,7 @@ static void pass_build(void *ctx, size_t c, int worker)
             size_t c2 = 0, nb = c + 1 < j->nchunks ? j->counts[c + 1] : 0;
             number_layer(j, z + 1, ids[1], nb, &c2, 0);
         }
-        for (int y = -1; y < j->n[1]; y++) {
-            const uint64_t *R[4];
-            if (!cell_rows(j, y, z, R))
-                continue;
-            for (int w = 0; w < W; w++) {
-                uint64_t v[8], act = cell_words(R, w, W, v);
-                while (act) {
-                    int b = __builtin_ctzll(act), x = 64 * w + b - 1;
-                    act &= act - 1;
-                    size_t idx = lidx(j, x, y);
-                    const mc_case *K = cell_case(j, x, y, z, cell_mask(v, b));
-                    for (int ti = 0; ti < K->nt; ti++, T += 3)
-                        for (int r = 0; r < 3; r++) {
-                            int e = K->e[ti][r];
-                            T[r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
-                        }
-                    for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
-                        uint32_t *rec = CR;
-                        int n = K->ck[k];
-                        CR += CEN_REC;
-                        rec[0] = (uint32_t)(base + j->nedge[c] + ncen++);
-                        rec[1] = (uint32_t)n;
-                        for (int r = 0; r < n; r++) {
-                            int e = K->ce[at + r];
-                            rec[2 + r] = ids[j->tb.elo[e] >> 2][idx * 3 + j->eoff[e]];
-                        }
-                        for (int r = 0; r < n; r++, T += 3) {
-                            T[0] = rec[2 + r];
-                            T[1] = rec[2 + (r + 1) % n];
-                            T[2] = rec[0];
-                        }
-                        j->cap[rec[0]] = 2;
-                    }
-                }
-            }
-        }
+        walk_cells(j, z, &a, 1);
         uint32_t *t = ids[0];
         ids[0] = ids[1];
         ids[1] = t;

@@ -531,14 +531,22 @@ static inline void unslot_translation(int n, int m, int j, int piece, int *i, in
         *p = 2 * m - r + d;
 }
 
-static double inv_closed(const ist *t, int i, double r)
+/* r in [0, 1), an offset in units of h, as one of the t->s slots of an
+ * interval (the slot number) and the remainder within that slot, in slots */
+static inline uint64_t slot_of(const ist *t, double r, double *rem)
 {
-    /* r in [0, 1): offset in units of h */
     double y = r * (double)t->s;
     uint64_t idx = (uint64_t)y;
     if (idx >= t->s)
         idx = t->s - 1;
-    double rem = y - (double)idx;
+    *rem = y - (double)idx;
+    return idx;
+}
+
+static double inv_closed(const ist *t, int i, double r)
+{
+    double rem;
+    uint64_t idx = slot_of(t, r, &rem);
     uint64_t b = (uint64_t)t->b, src = 0;
     int j;
     /* away from the ends of a translation axis (K·M intervals) the slots are
@@ -584,11 +592,8 @@ static double inv_closed(const ist *t, int i, double r)
 
 static double fwd_closed(const ist *t, int j, double r)
 {
-    double y = r * (double)t->s;
-    uint64_t idx = (uint64_t)y;
-    if (idx >= t->s)
-        idx = t->s - 1;
-    double rem = y - (double)idx;
+    double rem;
+    uint64_t idx = slot_of(t, r, &rem);
     uint64_t b = (uint64_t)t->b;
     int dig[IST_MAX_K]; /* source digits s_1..s_K = t_K..t_1 */
     for (int q = t->k - 1; q >= 0; q--) {

@@ -335,6 +335,26 @@ static void fmt_nodes(char *buf, size_t len, int res, const char *where, double 
              max_nodes);
 }
 
+/* 1 if the lattice array of level res is over the byte limit or the node
+ * cap (--max-voxels), with what it needs in buf: its bytes, then bytes_where
+ * and the limit; or its nodes (fmt_nodes, with nodes_where). */
+static int array_over(char *buf, size_t len, int res, size_t limit, double max_nodes, const char *bytes_where,
+                      const char *nodes_where)
+{
+    if (lattice_bytes_d(res) > (double)limit) {
+        char lim[64];
+        fmt_bytes(buf, len, lattice_bytes_d(res));
+        fmt_limit(lim, sizeof lim, limit);
+        snprintf(buf + strlen(buf), len - strlen(buf), "%s (limit %s)", bytes_where, lim);
+        return 1;
+    }
+    if (!nodes_fit(res, max_nodes)) {
+        fmt_nodes(buf, len, res, nodes_where, max_nodes);
+        return 1;
+    }
+    return 0;
+}
+
 rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
 {
     memset(m, 0, sizeof *m);
@@ -353,7 +373,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
     if (budget > limit)
         budget = limit;
     double maxn = p->max_nodes > 0 ? p->max_nodes : 0;
-    char need[96], lim[64];
+    char need[96];
     int R = p->R, type = p->type, R2 = p->R2;
 
     if (type == MPD_AUTO) {
@@ -368,14 +388,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
         }
     }
     if (type == MPD_TYPE1) {
-        int over_bytes = lattice_bytes_d(R) > (double)limit;
-        if (over_bytes || !nodes_fit(R, maxn)) {
-            if (over_bytes) {
-                fmt_bytes(need, sizeof need, lattice_bytes_d(R));
-                fmt_limit(lim, sizeof lim, limit);
-                snprintf(need + strlen(need), sizeof need - strlen(need), " (limit %s)", lim);
-            } else
-                fmt_nodes(need, sizeof need, R, "", maxn);
+        if (array_over(need, sizeof need, R, limit, maxn, "", "")) {
             int r2 = mpd_largest_r2(R, limit, maxn);
             if (r2 >= 0)
                 return rt_fail(e, RT_EINVAL,
@@ -391,14 +404,7 @@ rt_code mpd_init(mpd *m, const mpd_params *p, const rt_run *run, rt_error *e)
         if (R2 < 0 || R2 > R)
             return rt_fail(e, RT_EINVAL, "R2 = %d is out of range for Type IV (expected 0 .. R = %d)",
                            R2, R);
-        int over_bytes = lattice_bytes_d(R2) > (double)limit;
-        if (over_bytes || !nodes_fit(R2, maxn)) {
-            if (over_bytes) {
-                fmt_bytes(need, sizeof need, lattice_bytes_d(R2));
-                fmt_limit(lim, sizeof lim, limit);
-                snprintf(need + strlen(need), sizeof need - strlen(need), " for its array (limit %s)", lim);
-            } else
-                fmt_nodes(need, sizeof need, R2, " in its array", maxn);
+        if (array_over(need, sizeof need, R2, limit, maxn, " for its array", " in its array")) {
             int r2 = mpd_largest_r2(R, limit, maxn);
             if (r2 >= 0)
                 return rt_fail(e, RT_EINVAL, "Type IV with R2 = %d needs %s; use R2 <= %d", R2, need, r2);

@@ -509,12 +509,12 @@ static void volumes(void)
     bytebuf_init(&b);
     rt_error e;
     test_volume(&v, 3, 2, 4);
-    vio_nrrd_to_mem(&v, VIO_FLOAT, NULL, &b, &e);
-    put_buf("nrrd", "seed_float.nrrd", &b);
-    vio_nrrd_to_mem(&v, VIO_USHORT, NULL, &b, &e);
-    put_buf("nrrd", "seed_ushort.nrrd", &b);
-    vio_nrrd_to_mem(&v, VIO_UCHAR, NULL, &b, &e);
-    put_buf("nrrd", "seed_uchar.nrrd", &b);
+    static const struct { int type; const char *name; } nrrd[] = {
+        {VIO_FLOAT, "seed_float.nrrd"}, {VIO_USHORT, "seed_ushort.nrrd"}, {VIO_UCHAR, "seed_uchar.nrrd"}};
+    for (size_t i = 0; i < sizeof nrrd / sizeof nrrd[0]; i++) {
+        vio_nrrd_to_mem(&v, nrrd[i].type, NULL, &b, &e);
+        put_buf("nrrd", nrrd[i].name, &b);
+    }
     vio_vtk_to_mem(&v, &b, &e);
     put_buf("vtk", "seed.vtk", &b);
     volume_free(&v);
@@ -542,10 +542,10 @@ static void meshes(void)
     bytebuf b;
     bytebuf_init(&b);
     rt_error e;
-    mio_ply_to_mem(&m, 0, &b, &e);
-    put_buf("ply", "seed_bin.ply", &b);
-    mio_ply_to_mem(&m, 1, &b, &e);
-    put_buf("ply", "seed_ascii.ply", &b);
+    for (int ascii = 0; ascii <= 1; ascii++) {
+        mio_ply_to_mem(&m, ascii, &b, &e);
+        put_buf("ply", ascii ? "seed_ascii.ply" : "seed_bin.ply", &b);
+    }
     mio_obj_to_mem(&m, &b, &e);
     put_buf("obj", "seed.obj", &b);
     mio_stl_to_mem(&m, &b, &e);

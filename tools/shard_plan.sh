@@ -35,10 +35,10 @@ sys.dont_write_bytecode = True  # no __pycache__ in the tree
 sys.path.insert(0, here)
 import part
 p = part.read(path)
-calls = p['calls']
+calls = p.calls
 split = {}
-for r in p['records']:
-    split.setdefault(r['call'], (r['kind'], r['chunks']))
+for r in p.records:
+    split.setdefault(r.call, (r.kind, r.chunks))
 # the full calls: grouped by where they were made and why
 full = {}
 for line in open(err):

@@ -2,9 +2,9 @@
 # share.sh SCRIPT [FRAC OPTIONS…] — a shard's part holds only its share.
 #
 # Runs SCRIPT as 1 shard and as 3 shards, reads the parts with an independent
-# program (python3; the format of docs/scale.md) and prints, for every record,
-# its engine call, section, kind, op, chunk count and the payload bytes of
-# the one part of N=1 and of each of the 3 parts. For a rows record it checks
+# program (python3 with part.py; the format of docs/scale.md) and prints, for
+# every record, its engine call, section, kind, op, chunk count and the
+# payload bytes of the one part of N=1 and of each of the 3 parts. For a rows record it checks
 # that each part of N=3 carries exactly the rows of its chunk range and that
 # the three payloads put end to end are the payload of N=1, byte for byte.
 # Prints "skipped (…)" without python3. FRAC (default: frac on PATH).
@@ -23,43 +23,20 @@ trap 'rm -rf "$tmp"' EXIT
 for i in 0 1 2; do
     "$frac" run -q --threads 1 --shard $i/3 "$@" -o "$tmp/p3" "$script" || exit 1
 done
-python3 - "$tmp/p1/$name.shard-0-of-1.part" "$tmp/p3/$name.shard-0-of-3.part" "$tmp/p3/$name.shard-1-of-3.part" \
-    "$tmp/p3/$name.shard-2-of-3.part" <<'END'
-import struct, sys, zlib
+PYTHONPATH=$(dirname "$0") PYTHONDONTWRITEBYTECODE=1 python3 - "$tmp/p1/$name.shard-0-of-1.part" "$tmp/p3/$name.shard-0-of-3.part" \
+    "$tmp/p3/$name.shard-1-of-3.part" "$tmp/p3/$name.shard-2-of-3.part" <<'END'
+import sys
+import part
 
 def records(path):
-    b = open(path, 'rb').read()
-    pos = 0
-    def take(n):
-        nonlocal pos
-        v = b[pos:pos + n]
-        pos += n
-        return v
-    def u32(): return struct.unpack('<I', take(4))[0]
-    def u64(): return struct.unpack('<Q', take(8))[0]
-    def sstr(): return take(u32())
-    assert take(8) == b'FRACPART'
-    assert u32() == 3, 'format'
-    sstr(); sstr(); take(32); u64(); u32(); take(32); sstr()
-    index, count = u32(), u32()
-    assert u32() == zlib.crc32(b[:pos - 4]), 'header CRC'
+    p = part.read(path)  # checks the markers, every CRC and that none is truncated
+    assert p.format == part.FORMAT, 'format'
     out = []
-    while True:
-        start = pos
-        mark = take(4)
-        if mark == b'END ':
-            break
-        assert mark == b'REC ', 'record marker'
-        call, sec, op = u32(), u32(), u32()
-        kind = take(16).rstrip(b'\0').decode()
-        chunks, lo, hi, total, unit, length = u64(), u64(), u64(), u64(), u64(), u64()
-        assert (lo, hi) == (chunks * index // count, chunks * (index + 1) // count), 'chunk range'
-        payload = take(length)
-        assert len(payload) == length, 'truncated'
-        assert u32() == zlib.crc32(b[start:pos - 4]), 'record CRC'
-        if op == 2:  # rows: chunks lo .. hi-1 only
-            assert length == min(hi * unit, total) - min(lo * unit, total), 'rows of the range'
-        out.append((call, sec, op, kind, chunks, unit, total, payload))
+    for r in p.records:
+        assert (r.lo, r.hi) == (r.chunks * p.index // p.count, r.chunks * (p.index + 1) // p.count), 'chunk range'
+        if r.op == 2:  # rows: chunks lo .. hi-1 only
+            assert r.length == min(r.hi * r.unit, r.total) - min(r.lo * r.unit, r.total), 'rows of the range'
+        out.append((r.call, r.section, r.op, r.kind, r.chunks, r.unit, r.total, r.payload))
     return out
 
 one = records(sys.argv[1])

@@ -2,8 +2,9 @@
 # sums.sh — merge checks the LEB128 sums of every record before evaluating
 # (tests/cli/shard_sums.cli). Makes the 3 parts of tests/shard/small.frac
 # with -D n=3e6 (bins of thousands: two-byte values among one-byte ones),
-# then python3 rewrites values of shard 1's first record (the 32×32
-# counts) and re-computes its CRC-32, so only the sums are wrong:
+# then python3 (part.py finds the record) rewrites values of shard 1's
+# first record (the 32×32 counts) and re-computes its CRC-32, so only the
+# sums are wrong:
 #   - a value of ten bytes whose last is 2 (more than 64 bits), placed at
 #     byte 0 and at byte 5 of the payload (eight-byte steps see both);
 #   - two one-byte values made one (a continuation bit set): one value short;
@@ -27,20 +28,14 @@ for i in 0 1 2; do
 done
 p=$tmp/p/small.shard
 patch() { # OUT AT OLD HEX: payload bytes AT .. AT+OLD-1 replaced by HEX
-    python3 - "$p-1-of-3.part" "$@" <<'END'
+    PYTHONPATH=$here PYTHONDONTWRITEBYTECODE=1 python3 - "$p-1-of-3.part" "$@" <<'END'
 import struct, sys, zlib
+import part
 src, out, at, old, new = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), bytes.fromhex(sys.argv[5])
+r = part.read(src).records[0]
 b = bytearray(open(src, 'rb').read())
-pos = 8 + 4
-def skip_str():
-    global pos
-    pos += 4 + struct.unpack_from('<I', b, pos)[0]
-skip_str(); skip_str(); pos += 32 + 8 + 4 + 32; skip_str(); pos += 8 + 4
-start = pos  # the first record
-assert b[start:start + 4] == b'REC '
-lenat = start + 4 + 12 + 16 + 40
-length = struct.unpack_from('<Q', b, lenat)[0]
-payload = lenat + 8
+start, payload, length = r.start, r.at, r.length
+lenat = payload - 8  # the record's length, just before its payload
 assert at + old <= length
 b[payload + at:payload + at + old] = new
 length += len(new) - old
