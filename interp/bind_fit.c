@@ -232,7 +232,7 @@ static int in_list(const char *a, const char *const *list, size_t n)
     return 0;
 }
 
-int fit_command_index(int argc, char **argv)
+int bind_fit_command_index(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -296,7 +296,7 @@ static size_t write_script(char *buf, size_t cap, const char *target, int w, int
     return n;
 }
 
-int fit_command(interp *I, int argc, char **argv, int at, volatile sig_atomic_t *cancel)
+int bind_fit_command(interp *I, int argc, char **argv, int at, volatile sig_atomic_t *cancel)
 {
     const char *target = NULL, *outp = "fit.frac", *maps = NULL, *fgname = "auto";
     fit_opts o = {.iterations = 1000, .seed = I->seed};

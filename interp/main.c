@@ -509,13 +509,13 @@ static int finish_output(int rc)
 
 static int frac_main(int argc, char **argv)
 {
-    int fit_at = fit_command_index(argc, argv);
+    int fit_at = bind_fit_command_index(argc, argv);
     if (fit_at) { /* its own options, before or after the word fit (interp/bind_fit.c) */
         interp st, *I = &st;
         interp_init(I);
         I->threads = par_cores();
         I->progress = 1;
-        int frc = fit_command(I, argc, argv, fit_at, &cli_interrupted);
+        int frc = bind_fit_command(I, argc, argv, fit_at, &cli_interrupted);
         interp_free(I);
         return finish_output(frc);
     }
