@@ -1115,6 +1115,18 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
     }
 }
 
+/* A memory error raised where no node was at hand (an allocation refused
+ * while a value, a list or a scope grew: the hook knows no position) is reported at
+ * the innermost statement that was running, so every error inside a script
+ * has a line and column. */
+static int stmt_failed(interp *I, const node *s)
+{
+    err_state *er = &I->err;
+    if (er->active && er->src < 0 && (er->kind == ERR_MEMORY || er->kind == ERR_LIMIT) && s->line > 0)
+        er->src = s->src, er->line = s->line, er->col = s->col;
+    return -1;
+}
+
 int eval_block(interp *I, env *e, const node *block, value *out)
 {
     if (cstack_exhausted()) /* imports nest blocks without an expression between */
@@ -1128,7 +1140,7 @@ int eval_block(interp *I, env *e, const node *block, value *out)
         }
         if (exec_stmt(I, e, s, out ? &last : NULL)) {
             val_unref(I, last);
-            return -1;
+            return stmt_failed(I, s);
         }
     }
     if (out)

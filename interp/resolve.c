@@ -136,9 +136,15 @@ static int call_check(resolver *r, const node *call)
 
 static int run_pending(resolver *r)
 {
-    for (int i = 0; i < r->npend; i++)
-        if (check_call(r->I, &r->bound, r->mods, r->pend[i].nmods, r->pend[i].call))
+    const node *save = r->I->cur; /* an allocation refused while checking is reported at the call */
+    for (int i = 0; i < r->npend; i++) {
+        r->I->cur = r->pend[i].call;
+        if (check_call(r->I, &r->bound, r->mods, r->pend[i].nmods, r->pend[i].call)) {
+            r->I->cur = save;
             return -1;
+        }
+    }
+    r->I->cur = save;
     r->npend = 0;
     return 0;
 }

@@ -55,8 +55,20 @@ int session_run_lines(interp *I, const char *name, const char *text, size_t len,
     node *prog;
     if (parse_source(I, src, &prog))
         return -1;
-    if ((check_only ? resolve_check : resolve_program)(I, prog, I->globals))
+    if ((check_only ? resolve_check : resolve_program)(I, prog, I->globals)) {
+        err_state *e = &I->err;
+        if (e->active && e->src < 0 && (e->kind == ERR_MEMORY || e->kind == ERR_LIMIT)) {
+            /* the checker's tables or the slot pass were refused memory
+             * where no call was at hand: say so at the script's start */
+            static const char what[] = "checking the script: ";
+            size_t l = strnlen(e->msg, sizeof e->msg - sizeof what);
+            memmove(e->msg + sizeof what - 1, e->msg, l);
+            memcpy(e->msg, what, sizeof what - 1);
+            e->msg[sizeof what - 1 + l] = 0;
+            e->src = src, e->line = first_line, e->col = 1;
+        }
         return -1;
+    }
     {
         /* collect params (for `check --params` and to validate -D names) */
         for (int i = 0; i < prog->nkids; i++) {
@@ -66,8 +78,10 @@ int session_run_lines(interp *I, const char *name, const char *text, size_t len,
             if (I->nparams == I->cap_params) {
                 int nc = I->cap_params ? I->cap_params * 2 : 16;
                 void *np = mem_realloc(I, I->params, (size_t)nc * sizeof *I->params);
-                if (!np)
+                if (!np) { /* refused by the hook, which knows no place: the param's */
+                    I->err.src = s->src, I->err.line = s->line, I->err.col = s->col;
                     return -1;
+                }
                 I->params = np;
                 I->cap_params = nc;
             }

@@ -42,6 +42,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define _XOPEN_SOURCE 700
 #include <dirent.h>
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -952,6 +953,31 @@ static void run_pty_dir(const char *frac, const char *ptyrun)
         rm_tree(home);
 }
 
+/* Does frac's first diagnostic (stderr's first line) carry a position,
+ * "FILE:LINE:COL: error: …"? */
+static int err_has_position(const char *err)
+{
+    if (!err)
+        return 0;
+    const char *p = err, *nl = strchr(p, '\n');
+    size_t len = nl ? (size_t)(nl - p) : strlen(p);
+    for (size_t i = 0; i + 2 < len; i++) {
+        if (p[i] != ':' || !isdigit((unsigned char)p[i + 1]))
+            continue;
+        size_t j = i + 1;
+        while (j < len && isdigit((unsigned char)p[j]))
+            j++;
+        if (j < len && p[j] == ':' && j + 1 < len && isdigit((unsigned char)p[j + 1])) {
+            size_t c = j + 1;
+            while (c < len && isdigit((unsigned char)p[c]))
+                c++;
+            if (len - c >= 8 && memcmp(p + c, ": error:", 8) == 0)
+                return 1;
+        }
+    }
+    return 0;
+}
+
 /* ---- allocation failure ----------------------------------------------------------
  * Run a script failing the N-th allocation, for N = 1, 2, … until the script
  * no longer runs out: each run must end with exit 70 and an "out of memory"
@@ -1042,7 +1068,7 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
         argv[k++] = sargs[i];
     argv[k++] = (char *)script;
     argv[k] = NULL;
-    int ok = 1, n, runs = 0;
+    int ok = 1, n, runs = 0, positioned = 0;
     long made = -1;
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -1082,7 +1108,19 @@ static void run_fail_alloc(const char *frac, const char *script, int stride, con
             if (past || !ok)
                 break; /* past the last allocation (frac says so), or a failure found */
         } else {
+            /* out of memory: once a failure has been reported at a place in
+             * a script (the script has begun), every later one must be too */
+            int pos = err_has_position(err.d);
+            if (pos)
+                positioned = n;
+            else if (positioned) {
+                ok = 0;
+                buf_fmt(&why, "  --fail-alloc %d: out of memory without a position (--fail-alloc %d had one)\n"
+                              "  stderr: %.2000s\n", n, positioned, err.d);
+            }
             free(out.d); free(err.d);
+            if (!ok)
+                break;
         }
         /* the next N: n + 1 in the head, else n + stride or an extra one before it */
         int next = n < head ? n + 1 : n + stride;
