@@ -111,14 +111,16 @@ static token *window_failed(parser *p)
  * on until the k-th token after the next one is in it. */
 static token *fill(parser *p, size_t k)
 {
-    while (k >= (size_t)(p->end - p->cur)) {
+    /* before the first window all three pointers are NULL: no arithmetic on
+     * them (NULL + 0 is undefined, and clang's UBSan says so) */
+    while (k >= (p->buf ? (size_t)(p->end - p->cur) : 0)) {
         if (p->lx.done) {
             if (p->cur == p->end) /* not reached: the parser stops at T_EOF */
                 p->cur--;
             return p->end - 1;
         }
-        if (p->end == p->buf + p->cap) {
-            size_t keep = (size_t)(p->end - p->cur);
+        if (!p->buf || p->end == p->buf + p->cap) {
+            size_t keep = p->buf ? (size_t)(p->end - p->cur) : 0;
             size_t cap = p->cap ? p->cap : PARSE_WINDOW;
             while (keep + k + 1 > cap / 2)
                 cap *= 2;
@@ -127,7 +129,8 @@ static token *fill(parser *p, size_t k)
                 return window_failed(p);
             if (keep)
                 memcpy(nb, p->cur, keep * sizeof *nb);
-            p->base += (size_t)(p->cur - p->buf);
+            if (p->buf)
+                p->base += (size_t)(p->cur - p->buf);
             mem_free(p->I, p->buf);
             p->buf = p->cur = nb;
             p->end = nb + keep;
@@ -488,7 +491,7 @@ static int nv_close(parser *p, nodevec *nv, int lead, node ***kids, const char *
             p->failed = 1;
             return -1;
         }
-        const pending *it = &p->items[nv->base];
+        const pending *it = nv->n ? &p->items[nv->base] : NULL; /* no items yet: NULL, not NULL + 0 */
         if (names) {
             const char **b = (const char **)(a + k);
             for (int i = 0; i < nv->n; i++) {
