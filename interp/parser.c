@@ -14,81 +14,8 @@
 #include <string.h>
 
 #include "lexer.h"
+#include "parse_impl.h"
 
-/* A token kept by value, with its number in the script (tokens are numbered
- * from 0), for what must outlive the window: the construct an error at the
- * end of the input names. */
-typedef struct tokmark {
-    token t;
-    size_t at;
-} tokmark;
-
-#define NO_TOKEN ((size_t)-1)
-
-/* Tokens come from the lexer as the parser reaches them, into a window that
- * holds the next token and those after it the parser has looked at; tokens
- * before the next one are dropped when the window moves on (PARSE_WINDOW
- * tokens at first; it doubles while a lookahead needs more). So a token
- * pointer (peek, ahead) is good only until the parser moves: what a
- * production keeps for later (where it started, its opening bracket) it keeps
- * by value, a token or a tokmark. */
-#ifndef PARSE_WINDOW
-#define PARSE_WINDOW 2048
-#endif
-#define MAX_OPEN 64
-
-typedef struct parser {
-    interp *I;
-    lexer lx;
-    token *buf;     /* the window: token number base is buf[0] */
-    token *cur;     /* the next token, in buf */
-    token *end;     /* past the last token lexed */
-    size_t cap;     /* tokens buf holds */
-    size_t base;
-    token first;    /* the script's first token (the top block's position) */
-    token eof;      /* the rest of the input when the window could not move */
-    int skip_nl;    /* newlines are insignificant here */
-    int table_mode; /* parsing an entry of a table row */
-    int closing;    /* the error being reported is a missing closer */
-    tokmark construct; /* innermost 'if', 'fn' or 'for' being parsed (at NO_TOKEN: none) */
-    int failed;
-    int depth;      /* nesting levels entered (PARSE_MAX_NESTING) */
-    const struct oprow *row[2][T_COUNT]; /* ops[] indexed by fix and token (op_index) */
-    struct pending *items; /* the open lists' items (nodevec), reused for every list */
-    size_t nitems, cap_items;
-} parser;
-
-/* ---- token access ---------------------------------------------------------- */
-
-static token *fill(parser *p, size_t k);
-
-/* The k-th token after the next one (0: the next one), lexing on as needed;
- * k never reaches past T_EOF (the parser stops there). */
-static inline token *ahead(parser *p, size_t k)
-{
-    if (k < (size_t)(p->end - p->cur))
-        return p->cur + k;
-    return fill(p, k);
-}
-
-/* Past the next token (never past T_EOF). */
-static inline void advance(parser *p)
-{
-    if (++p->cur == p->end)
-        fill(p, 0);
-}
-
-/* +1 for the tokens that open a bracket or block, -1 for those that close one */
-static const signed char nesting[T_COUNT] = {
-    [T_LPAREN] = 1, [T_LBRACKET] = 1, [T_LBRACE] = 1, [T_DO] = 1,
-    [T_RPAREN] = -1, [T_RBRACKET] = -1, [T_RBRACE] = -1, [T_END] = -1,
-};
-
-static int is_opener(tok_type k) { return nesting[k] > 0; }
-
-static inline size_t tok_number(const parser *p, const token *t) { return p->base + (size_t)(t - p->buf); }
-
-static tokmark mark(const parser *p, const token *t) { return (tokmark){*t, tok_number(p, t)}; }
 
 /* The window could not grow, or the lexer ran out of memory: the parser
  * sees the end of the input and reports nothing more (failed); parse_source
@@ -109,7 +36,7 @@ static token *window_failed(parser *p)
  * token (a new block, the old one freed, so under ASan a token pointer kept
  * across a move is caught), doubling it while k needs more room, and lexes
  * on until the k-th token after the next one is in it. */
-static token *fill(parser *p, size_t k)
+token *parse_fill(parser *p, size_t k)
 {
     /* before the first window all three pointers are NULL: no arithmetic on
      * them (NULL + 0 is undefined, and clang's UBSan says so) */
@@ -145,27 +72,7 @@ static token *fill(parser *p, size_t k)
     return p->cur + k;
 }
 
-static inline token *peek_raw(parser *p) { return p->cur; }
-
-static inline token *peek(parser *p)
-{
-    if (p->skip_nl)
-        while (p->cur->type == T_NEWLINE)
-            advance(p);
-    return p->cur;
-}
-
-static token *peek2_slow(parser *p);
-
-static inline token *peek2(parser *p) /* the token after peek(), skipping newlines if skip_nl */
-{
-    token *t = p->cur;
-    if (t + 1 < p->end && t->type != T_NEWLINE && t->type != T_EOF && t[1].type != T_NEWLINE)
-        return t + 1;
-    return peek2_slow(p);
-}
-
-static token *peek2_slow(parser *p)
+token *parse_peek2_slow(parser *p)
 {
     size_t k = 0;
     if (p->skip_nl)
@@ -178,207 +85,6 @@ static token *peek2_slow(parser *p)
         while (ahead(p, k)->type == T_NEWLINE)
             k++;
     return ahead(p, k);
-}
-
-/* The next token, by value (the window may move on past it), and past it. */
-static inline token next(parser *p)
-{
-    token t = *peek(p);
-    if (t.type != T_EOF)
-        advance(p);
-    return t;
-}
-
-/* next, with the token's number */
-static tokmark next_mark(parser *p)
-{
-    tokmark m = mark(p, peek(p));
-    next(p);
-    return m;
-}
-
-static int check(parser *p, tok_type t) { return peek(p)->type == t; }
-
-static int match(parser *p, tok_type t)
-{
-    if (check(p, t)) {
-        next(p);
-        return 1;
-    }
-    return 0;
-}
-
-static void skip_newlines(parser *p)
-{
-    while (peek_raw(p)->type == T_NEWLINE || peek_raw(p)->type == T_SEMI)
-        advance(p);
-}
-
-/* The innermost bracket or 'do' still open at the end of the input (closers
- * pop whatever is open, so a mismatch is reported elsewhere): 1 and *out, or
- * 0 if none. Only an error at the end of the input asks, so the text is lexed
- * again from its start rather than the parser tracking every token. */
-static int innermost_open(const parser *p, tokmark *out)
-{
-    lexer L;
-    lex_init(&L, p->lx.text, p->lx.src, p->lx.first_line);
-    tokmark stack[MAX_OPEN];
-    size_t n = 0, deeper = 0, num = 0;
-    token batch[256];
-    int got;
-    while ((got = lex_next(&L, batch, (int)(sizeof batch / sizeof batch[0]))) > 0) {
-        for (int i = 0; i < got; i++, num++) {
-            int d = nesting[batch[i].type];
-            if (d > 0) {
-                if (n < MAX_OPEN)
-                    stack[n++] = (tokmark){batch[i], num};
-                else
-                    deeper++;
-            } else if (d < 0) {
-                if (deeper)
-                    deeper--;
-                else if (n)
-                    n--;
-            }
-        }
-    }
-    if (got < 0 || !n) /* out of memory (a long number literal): no note */
-        return 0;
-    *out = stack[n - 1];
-    return 1;
-}
-
-static void note_opened_here(parser *p, const token *open)
-{
-    err_state *e = &p->I->err;
-    tok_type k = open->type;
-    int bracket = is_opener(k);
-    snprintf(e->note, sizeof e->note, "%s %s here", lex_name(k), bracket ? "opened" : "started");
-    e->note_src = open->src;
-    e->note_line = open->line;
-    e->note_col = open->col;
-}
-
-static int syntax_error(parser *p, const token *t, const char *fmt, const char *a)
-{
-    if (p->failed)
-        return -1;
-    p->failed = 1;
-    if (t->type == T_ERROR) {
-        err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, "%s", t->err);
-        /* a '\' ending the input asks for the line it joins (REPL) */
-        if (t->start[0] == '\\' && t->start[1] == 0)
-            p->I->err.incomplete = 1;
-        return -1;
-    }
-    err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX, fmt, a);
-    if (t->type == T_EOF) {
-        p->I->err.incomplete = 1;
-        /* input that ends inside a construct names where it opened (an
-         * expected closer says so itself, see expect_close) */
-        tokmark opened;
-        const tokmark *open = !p->closing && innermost_open(p, &opened) ? &opened : NULL;
-        const tokmark *c = p->closing || p->construct.at == NO_TOKEN ? NULL : &p->construct;
-        if (c && (!open || c->at > open->at)) {
-            err_state *e = &p->I->err;
-            size_t l = strlen(e->msg);
-            snprintf(e->msg + l, sizeof e->msg - l, " (%s at line %d is not finished)", lex_name(c->t.type),
-                     c->t.line);
-            note_opened_here(p, &c->t);
-        } else if (open) {
-            err_state *e = &p->I->err;
-            size_t l = strlen(e->msg);
-            snprintf(e->msg + l, sizeof e->msg - l, " (%s opened at line %d is not closed)",
-                     lex_name(open->t.type), open->t.line);
-            note_opened_here(p, &open->t);
-        }
-    }
-    return -1;
-}
-
-static const char *tok_desc(const token *t, char *buf, size_t n)
-{
-    if (t->type == T_IDENT || t->type == T_NUMBER || t->type == T_STRING)
-        snprintf(buf, n, "'%.*s'", t->len > 40 ? 40 : t->len, t->start);
-    else
-        snprintf(buf, n, "%s", lex_name(t->type));
-    return buf;
-}
-
-/* Enter one nesting level; past PARSE_MAX_NESTING, fail at the token that
- * went too deep. Every recursive production passes here (parse_subexpr,
- * that is every operand of an operator, and the body of 'for' and of a
- * named 'fn'),
- * so the recursion of every walk over the tree is bounded. At the end of
- * the input the usual "expected …, found end of input" follows instead (the
- * REPL asks for more). Callers that succeed must leave with p->depth--. */
-static int too_deep(parser *p);
-
-static inline int enter_level(parser *p)
-{
-    if (++p->depth <= PARSE_MAX_NESTING)
-        return 0;
-    return too_deep(p);
-}
-
-static int too_deep(parser *p)
-{
-    token *t = peek(p);
-    if (t->type == T_EOF)
-        return 0;
-    p->depth--;
-    if (!p->failed) {
-        p->failed = 1;
-        err_pos(p->I, t->src, t->line, t->col, ERR_SYNTAX,
-                "nested too deeply: more than %d levels of brackets, blocks or operators",
-                PARSE_MAX_NESTING);
-    }
-    return -1;
-}
-
-/* Expect token type t; `what` describes the context for the message. The
- * test is inline, the message out of line. */
-static int expected(parser *p, tok_type t, const char *what);
-
-static inline int expect(parser *p, tok_type t, const char *what)
-{
-    if (peek(p)->type == t) {
-        next(p);
-        return 0;
-    }
-    return expected(p, t, what);
-}
-
-static int expected(parser *p, tok_type t, const char *what)
-{
-    token *k = peek(p);
-    char buf[64], msg[256];
-    snprintf(msg, sizeof msg, "expected %s %s, found %%s", lex_name(t), what);
-    return syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
-}
-
-/* Expect a closing bracket; on failure note where it was opened. */
-static int expected_close(parser *p, tok_type t, const token *open);
-
-static inline int expect_close(parser *p, tok_type t, const token *open)
-{
-    if (peek(p)->type == t) {
-        next(p);
-        return 0;
-    }
-    return expected_close(p, t, open);
-}
-
-static int expected_close(parser *p, tok_type t, const token *open)
-{
-    token *k = peek(p);
-    char buf[64], msg[256];
-    snprintf(msg, sizeof msg, "expected %s to close %s opened at line %d, found %%s", lex_name(t),
-             lex_name(open->type), open->line);
-    p->closing = 1;
-    syntax_error(p, k, msg, tok_desc(k, buf, sizeof buf));
-    note_opened_here(p, open);
-    return -1;
 }
 
 /* ---- node construction --------------------------------------------------- */
@@ -543,7 +249,7 @@ static node *string_node(parser *p, const token *t)
                 token bad = *t;
                 bad.col += i - 1;
                 bad.type = T_STRING;
-                syntax_error(p, &bad, "unknown escape sequence '\\%s' in string",
+                parse_syntax_error(p, &bad, "unknown escape sequence '\\%s' in string",
                              (char[2]){e, 0});
                 return NULL;
             }
@@ -729,7 +435,7 @@ static int parse_arg(parser *p, void *ctx)
         next(p);
         c->named_seen = 1;
     } else if (c->named_seen) {
-        syntax_error(p, peek(p), "%s", "positional argument after a named argument");
+        parse_syntax_error(p, peek(p), "%s", "positional argument after a named argument");
         return -1;
     }
     node *a = parse_expr(p);
@@ -795,8 +501,8 @@ static node *parse_postfix(parser *p, node *e)
             token name = *peek(p);
             if (name.type != T_IDENT) {
                 char buf[64];
-                syntax_error(p, &name, "expected a field name after '.', found %s",
-                             tok_desc(&name, buf, sizeof buf));
+                parse_syntax_error(p, &name, "expected a field name after '.', found %s",
+                             parse_tok_desc(&name, buf, sizeof buf));
                 return NULL;
             }
             next(p);
@@ -828,14 +534,14 @@ static int parse_param(parser *p, void *ctx)
     token t = *peek(p);
     if (t.type != T_IDENT) {
         char buf[64];
-        syntax_error(p, &t, "expected a parameter name, found %s", tok_desc(&t, buf, sizeof buf));
+        parse_syntax_error(p, &t, "expected a parameter name, found %s", parse_tok_desc(&t, buf, sizeof buf));
         return -1;
     }
     next(p);
     const char *name = tok_name(p, &t);
     for (int i = 0; i < params->n; i++)
         if (nv_item(p, params, i)->name == name) {
-            syntax_error(p, &t, "duplicate parameter '%s'", name);
+            parse_syntax_error(p, &t, "duplicate parameter '%s'", name);
             return -1;
         }
     node *def = NULL;
@@ -843,7 +549,7 @@ static int parse_param(parser *p, void *ctx)
         if (!(def = parse_expr(p)))
             return -1;
     } else if (params->n && nv_item(p, params, params->n - 1)->n) {
-        syntax_error(p, &t, "parameter '%s' without a default follows one with a default", name);
+        parse_syntax_error(p, &t, "parameter '%s' without a default follows one with a default", name);
         return -1;
     }
     return nv_push(p, params, def, name) ? -1 : 0;
@@ -893,8 +599,8 @@ static node *parse_lambda_rest(parser *p, const tokmark *at, const char *name)
             return NULL;
     } else {
         char buf[64];
-        syntax_error(p, &t, "expected '=' or 'do' after the parameter list, found %s",
-                     tok_desc(&t, buf, sizeof buf));
+        parse_syntax_error(p, &t, "expected '=' or 'do' after the parameter list, found %s",
+                     parse_tok_desc(&t, buf, sizeof buf));
         return NULL;
     }
     if (!body)
@@ -938,7 +644,7 @@ static int parse_field(parser *p, void *ctx)
         key = s ? interp_intern(p->I, s->str, s->slen) : NULL;
     } else {
         char buf[64];
-        syntax_error(p, &k, "expected a field name in record, found %s", tok_desc(&k, buf, sizeof buf));
+        parse_syntax_error(p, &k, "expected a field name in record, found %s", parse_tok_desc(&k, buf, sizeof buf));
         return -1;
     }
     next(p);
@@ -949,7 +655,7 @@ static int parse_field(parser *p, void *ctx)
         return -1;
     for (int j = 0; j < fields->n; j++)
         if (nv_item(p, fields, j)->name == key) {
-            syntax_error(p, &k, "duplicate field '%s' in record", key);
+            parse_syntax_error(p, &k, "duplicate field '%s' in record", key);
             return -1;
         }
     return nv_push(p, fields, v, key) ? -1 : 0;
@@ -1031,7 +737,7 @@ static int parse_list_item(parser *p, void *ctx)
     token var = *peek(p);
     if (var.type != T_IDENT) {
         char buf[64];
-        syntax_error(p, &var, "expected a variable name after 'for', found %s", tok_desc(&var, buf, sizeof buf));
+        parse_syntax_error(p, &var, "expected a variable name after 'for', found %s", parse_tok_desc(&var, buf, sizeof buf));
         return -1;
     }
     next(p);
@@ -1224,7 +930,7 @@ static node *parse_primary(parser *p)
     case T_FN:
         return parse_fn_expr(p);
     default:
-        syntax_error(p, t, "expected an expression, found %s", tok_desc(t, buf, sizeof buf));
+        parse_syntax_error(p, t, "expected an expression, found %s", parse_tok_desc(t, buf, sizeof buf));
         return NULL;
     }
 }
@@ -1294,7 +1000,7 @@ static node *parse_subexpr(parser *p, int level)
         left->op = r->op;
         const oprow *again = r->assoc == NONE ? infix_at(p) : NULL;
         if (again && again->prec == r->prec) {
-            syntax_error(p, peek(p), "%s", CHAIN_ERROR);
+            parse_syntax_error(p, peek(p), "%s", CHAIN_ERROR);
             left = NULL;
         }
     }
@@ -1321,7 +1027,7 @@ static const char *expect_name(parser *p, const char *what)
     if (t->type != T_IDENT) {
         char buf[64], msg[128];
         snprintf(msg, sizeof msg, "expected %s, found %%s", what);
-        syntax_error(p, t, msg, tok_desc(t, buf, sizeof buf));
+        parse_syntax_error(p, t, msg, parse_tok_desc(t, buf, sizeof buf));
         return NULL;
     }
     const char *name = tok_name(p, t); /* before next: the window may move on */
@@ -1395,8 +1101,8 @@ static node *parse_import(parser *p)
     token s = *peek(p);
     if (s.type != T_STRING) {
         char buf[64];
-        syntax_error(p, &s, "expected a module name in quotes after 'import', found %s",
-                     tok_desc(&s, buf, sizeof buf));
+        parse_syntax_error(p, &s, "expected a module name in quotes after 'import', found %s",
+                     parse_tok_desc(&s, buf, sizeof buf));
         return NULL;
     }
     next(p);
@@ -1497,7 +1203,7 @@ static node *parse_block_until(parser *p, const token *open)
         if (t == T_EOF || (open && t == T_END))
             break;
         if (!open && t == T_END) {
-            syntax_error(p, peek_raw(p), "%s", "'end' without a matching 'do'");
+            parse_syntax_error(p, peek_raw(p), "%s", "'end' without a matching 'do'");
             break;
         }
         node *s = parse_statement(p);
@@ -1507,8 +1213,8 @@ static node *parse_block_until(parser *p, const token *open)
         if (after->type != T_NEWLINE && after->type != T_SEMI && after->type != T_EOF &&
             !(open && after->type == T_END)) {
             char buf[64];
-            syntax_error(p, after, "expected the end of the statement, found %s",
-                         tok_desc(after, buf, sizeof buf));
+            parse_syntax_error(p, after, "expected the end of the statement, found %s",
+                         parse_tok_desc(after, buf, sizeof buf));
             break;
         }
     }
@@ -1529,7 +1235,7 @@ int parse_source(interp *I, int src, node **out)
     p.construct.at = NO_TOKEN;
     lex_init(&p.lx, I->srcs[src].text, src, I->srcs[src].first_line);
     node *b = NULL;
-    if (fill(&p, 0), !p.failed) { /* the first window */
+    if (parse_fill(&p, 0), !p.failed) { /* the first window */
         p.first = *p.cur;
         b = parse_block_until(&p, NULL);
     }
