@@ -18,6 +18,7 @@
 
 #include "check.h"
 #include "fileio.h"
+#include "tempfiles.h"
 
 static char root[256];
 
@@ -41,20 +42,6 @@ static int same_text(const char *path, const char *text)
     int ok = n == strlen(text) && memcmp(d, text, n) == 0;
     rt_free(d);
     return ok;
-}
-
-/* Entries of dir whose names contain ".tmp". */
-static int count_temps(const char *dir)
-{
-    DIR *d = opendir(dir);
-    int k = 0;
-    struct dirent *e;
-    while (d && (e = readdir(d)))
-        if (strstr(e->d_name, ".tmp"))
-            k++;
-    if (d)
-        closedir(d);
-    return k;
 }
 
 static void test_plain(void)

@@ -13,6 +13,7 @@
 
 #include "check.h"
 #include "fileio.h"
+#include "tempfiles.h"
 
 int __real_fsync(int fd);
 int __wrap_fsync(int fd);
@@ -44,19 +45,6 @@ int __wrap_fsync(int fd)
         return -1;
     }
     return __real_fsync(fd);
-}
-
-static int count_temps(const char *dir)
-{
-    DIR *d = opendir(dir);
-    int k = 0;
-    struct dirent *e;
-    while (d && (e = readdir(d)))
-        if (strstr(e->d_name, ".tmp"))
-            k++;
-    if (d)
-        closedir(d);
-    return k;
 }
 
 int main(void)
