@@ -126,6 +126,11 @@ $(BUILD)/tests/test_fuzz_script: tests/unit/test_fuzz_script.c tests/fuzz/fuzz_s
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) \
 	    -Wl,--wrap=fileio_write_atomic,--wrap=fileio_read_all -o $@
+# test_interp_counts runs scripts in the interpreter (linked as the fuzz harness is).
+$(BUILD)/tests/test_interp_counts: tests/unit/test_interp_counts.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a \
+                                   tests/unit/check.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests/unit $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) -o $@
 .PHONY: fuzz fuzz-build fuzz-bins fuzz-seeds fuzz-smoke $(FUZZ_HARNESSES:%=fuzz-%)
 # a changed ignorelist rebuilds the fuzz objects (it decides what is instrumented)
 $(RT_SRC:%.c=$(FUZZ_DIR)/%.o) $(IN_SRC:%.c=$(FUZZ_DIR)/%.o): tests/fuzz/engines.ignorelist

@@ -50,7 +50,7 @@ typedef struct node {
     /* Set by resolve.c (0 = not resolved: look the name up by name). For
      * N_NAME and N_ASSIGN: the name is slot - 1 of the scope `hops` parents
      * up from the one the node is evaluated in; for N_LET, N_PARAM and
-     * N_FNDEF: the slot it defines in its own scope. The evaluator checks
+     * N_FNDEF (and N_IMPORT's alias): the slot it defines in its own scope. The evaluator checks
      * the slot still holds that name before using it (see eval.c). */
     int slot, hops;
     /* The pointers and the kinds' own fields: a node is 80 bytes (one in
@@ -65,6 +65,8 @@ typedef struct node {
     union {
         struct node *body; /* N_LAMBDA */
         const char *doc;   /* N_PARAM: trailing comment text (may be NULL) */
+        const int *slots;  /* N_IMPORT without alias (resolve.c): slots[0] names of the module,
+                            * slots[1 + i] the slot + 1 its name i takes in the importer's scope */
     };
     /* Set by compile.c: the compiled form of a lambda's body or of a block's
      * statements, made the first time it runs (NULL until then). */

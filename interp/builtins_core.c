@@ -362,6 +362,7 @@ static int concat_in_place(interp *I, value *a, int n, value *out)
             return -1;
         l->items = items;
         l->cap = cap;
+        I->count.list_grows++;
     }
     for (int k = 1; k < n; k++) {
         const vlist *m = AS_LIST(a[k]);

@@ -123,7 +123,10 @@ static int set_script_args(interp *I, const opts *o)
         if (val_list_push(I, AS_LIST(l), val_cstr(I, o->args[i])))
             return -1;
     const char *name = interp_intern(I, "args", 4);
-    return name ? val_env_define(I, I->globals, name, l) : -1;
+    if (!name)
+        return -1;
+    /* the first name of the global scope (the script's slots start after it) */
+    return I->globals->n == 0 ? val_env_append(I, I->globals, name, l) : val_env_define(I, I->globals, name, l);
 }
 
 static void print_params(interp *I)

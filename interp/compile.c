@@ -46,7 +46,7 @@ static int c_const(interp *I, env *e, const cnode *c, value *out)
 
 static int c_name(interp *I, env *e, const cnode *c, value *out)
 {
-    value *v = scope_lookup(e, c->n);
+    value *v = scope_lookup(I, e, c->n);
     if (!v)
         return err_at(I, c->n, ERR_NAME, "unknown name '%s'", c->n->str);
     *out = *v;
@@ -76,7 +76,7 @@ static int c_name(interp *I, env *e, const cnode *c, value *out)
     }                                                                          \
     static int NAME##_pp(interp *I, env *e, const cnode *c, value *out)        \
     {                                                                          \
-        const value *pa = cnode_peek(e, c->a), *pb = cnode_peek(e, c->b);      \
+        const value *pa = cnode_peek(I, e, c->a), *pb = cnode_peek(I, e, c->b); \
         if (pa && pb && pa->k == V_NUM && pb->k == V_NUM) {                    \
             double x = pa->u.n, y = pb->u.n;                                   \
             *out = RESULT;                                                     \
@@ -155,7 +155,7 @@ static int c_if(interp *I, env *e, const cnode *c, value *out)
 #define IF_CMP_FN(NAME, CMP)                                                   \
     static int NAME(interp *I, env *e, const cnode *c, value *out)             \
     {                                                                          \
-        const value *pa = cnode_peek(e, c->a->a), *pb = cnode_peek(e, c->a->b); \
+        const value *pa = cnode_peek(I, e, c->a->a), *pb = cnode_peek(I, e, c->a->b); \
         int t;                                                                 \
         if (pa && pb && pa->k == V_NUM && pb->k == V_NUM) {                    \
             t = pa->u.n CMP pb->u.n;                                           \
@@ -248,7 +248,8 @@ static int call_user_exact(interp *I, vfunc *f, const value *args, int nargs, co
             ne->names[j] = l->names[j];
             ne->vals[j] = v;
             ne->n++;
-        } else if (val_env_define(I, ne, l->names[j], v)) {
+        } else if ((size_t)j == ne->n ? val_env_append(I, ne, l->names[j], v)
+                                      : val_env_define(I, ne, l->names[j], v)) {
             goto done;
         }
     }
@@ -368,7 +369,7 @@ static int c_assign(interp *I, env *e, const cnode *c, value *last)
 {
     (void)last;
     const node *n = c->n;
-    value *slot = scope_lookup(e, n);
+    value *slot = scope_lookup(I, e, n);
     if (!slot)
         return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')", n->str,
                       n->str);
@@ -376,7 +377,7 @@ static int c_assign(interp *I, env *e, const cnode *c, value *last)
     if (cnode_eval(I, e, c->a, &v))
         return -1;
     if (!c->a->pure)
-        slot = scope_lookup(e, n); /* a call may have grown the scope */
+        slot = scope_lookup(I, e, n); /* a call may have grown the scope */
     val_unref(I, *slot);
     *slot = v;
     return 0;
@@ -391,7 +392,7 @@ static int c_assign(interp *I, env *e, const cnode *c, value *last)
     {                                                                          \
         (void)last;                                                            \
         const node *n = c->n;                                                  \
-        value *slot = scope_lookup(e, n);                                      \
+        value *slot = scope_lookup(I, e, n);                                      \
         if (!slot)                                                             \
             return err_at(I, n, ERR_NAME,                                      \
                           "cannot assign to '%s': it is not defined (use 'let %s = …')", \

@@ -60,10 +60,15 @@ const cnode *compile_block(interp *I, const node *block);
 
 /* ---- shared with eval.c (the walker) ---- */
 
+/* The search by name behind scope_lookup (eval.c), counted in
+ * I->count.name_searches. */
+value *scope_search(interp *I, env *e, const node *n);
+
 /* A name by its slot (resolve.c), checked: the slot must hold the name
  * (it may not be defined yet, or a REPL input may have stopped half-way),
- * else the search by name decides, as it always did. */
-static inline value *scope_lookup(env *e, const node *n)
+ * else the search by name decides, as it always did. Resolved code that
+ * runs as resolve.c saw it never searches (tests/unit/test_interp_counts.c). */
+static inline value *scope_lookup(interp *I, env *e, const node *n)
 {
     if (n->slot) {
         env *t = e;
@@ -74,19 +79,29 @@ static inline value *scope_lookup(env *e, const node *n)
         if (t && k < t->n && t->names[k] == n->str)
             return &t->vals[k];
     }
-    return val_env_lookup(e, n->str);
+    return scope_search(I, e, n);
 }
 
-/* Define n->str in e (takes v), in place when the slot already holds it. */
-static inline int scope_define(interp *I, env *e, const node *n, value v)
+/* Define n->str in e (takes v): in place when the slot already holds it;
+ * appended when the slot is the next one and every name in e sits at its
+ * own slot (no name was added by name: e->loose), since then n->str, whose
+ * one slot is k, cannot be elsewhere in e; else by name. */
+static inline int scope_define_at(interp *I, env *e, int slot, const char *name, value v)
 {
-    size_t k = (size_t)n->slot - 1;
-    if (n->slot && k < e->n && e->names[k] == n->str) {
+    size_t k = (size_t)slot - 1;
+    if (slot && k < e->n && e->names[k] == name) {
         val_unref(I, e->vals[k]);
         e->vals[k] = v;
         return 0;
     }
-    return val_env_define(I, e, n->str, v);
+    if (slot && k == e->n && !e->loose)
+        return val_env_append(I, e, name, v);
+    return val_env_define(I, e, name, v);
+}
+
+static inline int scope_define(interp *I, env *e, const node *n, value v)
+{
+    return scope_define_at(I, e, n->slot, n->str, v);
 }
 
 /* Evaluate an operand: numbers and names inline (the cnode's function
@@ -106,7 +121,7 @@ __attribute__((always_inline)) static inline int cnode_eval(interp *I, env *e, c
             return 0;
         }
     } else if (c->tag == CT_NAME) {
-        value *v = scope_lookup(e, c->n);
+        value *v = scope_lookup(I, e, c->n);
         if (v) {
             *out = *v;
             val_ref(*out);
@@ -120,7 +135,7 @@ __attribute__((always_inline)) static inline int cnode_eval(interp *I, env *e, c
  * defined names; NULL for anything else. Looking has no effects, so an
  * operator can peek at both operands and evaluate them after all if they
  * are not both numbers. */
-__attribute__((always_inline)) static inline const value *cnode_peek(env *e, const cnode *c)
+__attribute__((always_inline)) static inline const value *cnode_peek(interp *I, env *e, const cnode *c)
 {
     if (c->tag == CT_NUM)
         return &c->k;
@@ -129,7 +144,7 @@ __attribute__((always_inline)) static inline const value *cnode_peek(env *e, con
         return k < e->n && e->names[k] == c->n->str ? &e->vals[k] : NULL;
     }
     if (c->tag == CT_NAME)
-        return scope_lookup(e, c->n);
+        return scope_lookup(I, e, c->n);
     return NULL;
 }
 

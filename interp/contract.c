@@ -353,6 +353,7 @@ static int tp_alt(tparser *t, calt *a)
 
 static const ctype *compile_text(interp *I, const char *text, size_t len, const char **err)
 {
+    I->count.types_compiled++;
     char buf[1024];
     if (len >= sizeof buf) {
         *err = "a shorter type";

@@ -14,13 +14,20 @@
 #include "lang_objects.h"
 #include "lexer.h"
 #include "parser.h"
+#include "resolve.h"
 #include "shard.h"
 #include "stdlib_embed.h"
+
+value *scope_search(interp *I, env *e, const node *n)
+{
+    I->count.name_searches++;
+    return val_env_lookup(e, n->str);
+}
 
 /* A name's value (a new reference), or the error for an unknown one. */
 static inline int eval_name(interp *I, env *e, const node *n, value *out)
 {
-    value *v = scope_lookup(e, n);
+    value *v = scope_lookup(I, e, n);
     if (!v)
         return err_at(I, n, ERR_NAME, "unknown name '%s'", n->str);
     *out = *v;
@@ -270,7 +277,7 @@ static int call_user(interp *I, vfunc *f, const value *pos, int npos, const char
             e->names[j] = l->names[j];
             e->vals[j] = v;
             e->n++;
-        } else if (val_env_define(I, e, l->names[j], v)) {
+        } else if ((size_t)j == e->n ? val_env_append(I, e, l->names[j], v) : val_env_define(I, e, l->names[j], v)) {
             goto done;
         }
     }
@@ -421,7 +428,7 @@ __attribute__((noinline)) static int eval_call_in(interp *I, env *e, const node 
         I->lazy_range = NULL;
     } else if (assign && npos > 0 && pos[0].k == V_LIST && fn.k == V_BUILTIN &&
                strcmp(fn.u.bi->name, "concat") == 0) {
-        value *x = scope_lookup(e, assign); /* the arguments may have reassigned it */
+        value *x = scope_lookup(I, e, assign); /* the arguments may have reassigned it */
         I->append_target = x && x->k == V_LIST && x->u.h == pos[0].u.h ? pos[0].u.h : NULL;
         rc = call_any(I, fn, pos, npos, names, named, nnamed, posn, n, out);
         I->append_target = NULL;
@@ -591,6 +598,7 @@ static env *iter_scope_next(interp *I, env *s)
         for (size_t k = 0; k < s->n; k++)
             val_unref(I, s->vals[k]);
         s->n = 0;
+        s->loose = 0;
         return s;
     }
     val_heap_unref(I, &s->h);
@@ -617,7 +625,8 @@ __attribute__((noinline)) static int eval_comp(interp *I, env *e, const node *n,
         if (!s && !(s = val_env_new(I, e)))
             goto fail;
         value x = iter_item(it, &rs, i);
-        int ok = val_env_define(I, s, n->str, x) == 0;
+        /* the variable is the scope's first name, slot 1 (resolve.c) */
+        int ok = (s->n == 0 ? val_env_append(I, s, n->str, x) : val_env_define(I, s, n->str, x)) == 0;
         int keep = 1;
         if (ok && n->kids[2]) {
             value c;
@@ -812,7 +821,7 @@ static inline int eval_leaf(interp *I, env *e, const node *n, value *out)
         return 0;
     }
     if (n->kind == N_NAME) {
-        value *v = scope_lookup(e, n);
+        value *v = scope_lookup(I, e, n);
         if (v) {
             *out = *v;
             val_ref(*out);
@@ -1009,7 +1018,7 @@ __attribute__((noinline)) static int exec_for(interp *I, env *e, const node *n)
             s->vals[0] = iter_item(it, &rs, i);
             s->n = 1;
         } else {
-            rc = val_env_define(I, s, n->str, iter_item(it, &rs, i));
+            rc = val_env_append(I, s, n->str, iter_item(it, &rs, i)); /* s is empty */
         }
         for (int k = 0; k < body->nkids && rc == 0; k++)
             rc = body->kids[k]->fn(I, s, body->kids[k], NULL);
@@ -1058,11 +1067,13 @@ __attribute__((noinline)) static int exec_import(interp *I, env *e, const node *
                 return -1;
             }
         }
-        return val_env_define(I, e, n->names[0], r);
+        return scope_define_at(I, e, n->slot, n->names[0], r);
     }
+    /* each name at the slot resolve.c gave it (the module is the one it saw: loaded once) */
+    const int *slot = n->slots && (size_t)n->slots[0] == m->n ? n->slots + 1 : NULL;
     for (size_t i = 0; i < m->n; i++) {
         val_ref(m->vals[i]);
-        if (val_env_define(I, e, m->names[i], m->vals[i]))
+        if (scope_define_at(I, e, slot ? slot[i] : 0, m->names[i], m->vals[i]))
             return -1;
     }
     return 0;
@@ -1078,7 +1089,7 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         return scope_define(I, e, n, v);
     }
     case N_ASSIGN: {
-        value *slot = scope_lookup(e, n);
+        value *slot = scope_lookup(I, e, n);
         if (!slot)
             return err_at(I, n, ERR_NAME, "cannot assign to '%s': it is not defined (use 'let %s = …')",
                           n->str, n->str);
@@ -1086,7 +1097,7 @@ static int exec_stmt(interp *I, env *e, const node *n, value *last)
         const node *rhs = n->kids[0];
         if (rhs->kind == N_CALL ? eval_call_in(I, e, rhs, &v, NULL, n) : eval_expr(I, e, rhs, &v))
             return -1;
-        slot = scope_lookup(e, n); /* the evaluation may have grown the scope */
+        slot = scope_lookup(I, e, n); /* the evaluation may have grown the scope */
         val_unref(I, *slot);
         *slot = v;
         return 0;
@@ -1158,35 +1169,61 @@ static int is_file_import(const char *name)
     return name[0] == '.' || name[0] == '/' || (n > 5 && strcmp(name + n - 5, ".frac") == 0);
 }
 
+/* The key a module is loaded under: "std:NAME", or the file's canonical path. */
+static int module_key(interp *I, const node *at, const char *name, char *key, size_t cap)
+{
+    if (is_file_import(name)) {
+        const char *dir = at ? I->srcs[at->src].dir : ".";
+        if (lang_join_path(I, at, dir, name, strlen(name), key, cap, "import"))
+            return -1;
+    } else {
+        snprintf(key, cap, "std:%s", name);
+    }
+    /* canonicalise file paths so a module is loaded once however it is named */
+    if (strncmp(key, "std:", 4) != 0) {
+        char *real = realpath(key, NULL);
+        if (real) {
+            snprintf(key, cap, "%s", real);
+            free(real); /* realpath() allocates with malloc: stays raw */
+        }
+    }
+    return 0;
+}
+
+static module *module_find(interp *I, const char *key)
+{
+    for (int i = 0; i < I->nmods; i++)
+        if (strcmp(I->mods[i].key, key) == 0)
+            return &I->mods[i];
+    return NULL;
+}
+
+env *eval_module_loaded(interp *I, const node *at, const char *name)
+{
+    char key[4096];
+    err_state save = I->err;
+    if (module_key(I, at, name, key, sizeof key)) {
+        I->err = save; /* the import reports it when it runs */
+        return NULL;
+    }
+    const module *m = module_find(I, key);
+    return m && m->state == 2 ? m->exports : NULL;
+}
+
 int eval_import(interp *I, const node *at, const char *name, env **out)
 {
     char key[4096];
     const char *text = NULL;
     unsigned char *filedata = NULL;
     size_t filelen = 0;
-    if (is_file_import(name)) {
-        const char *dir = at ? I->srcs[at->src].dir : ".";
-        if (lang_join_path(I, at, dir, name, strlen(name), key, sizeof key, "import"))
-            return -1;
-    } else {
-        snprintf(key, sizeof key, "std:%s", name);
-    }
-    /* canonicalise file paths so a module is loaded once however it is named */
-    if (strncmp(key, "std:", 4) != 0) {
-        char *real = realpath(key, NULL);
-        if (real) {
-            snprintf(key, sizeof key, "%s", real);
-            free(real); /* realpath() allocates with malloc: stays raw */
-        }
-    }
-    for (int i = 0; i < I->nmods; i++) {
-        if (strcmp(I->mods[i].key, key) == 0) {
-            if (I->mods[i].state == 1) {
-                return err_at(I, at, ERR_VALUE, "import cycle: \"%s\" is already being imported", name);
-            }
-            *out = I->mods[i].exports;
-            return 0;
-        }
+    if (module_key(I, at, name, key, sizeof key))
+        return -1;
+    const module *found = module_find(I, key);
+    if (found) {
+        if (found->state == 1)
+            return err_at(I, at, ERR_VALUE, "import cycle: \"%s\" is already being imported", name);
+        *out = found->exports;
+        return 0;
     }
     char display[4096];
     if (strncmp(key, "std:", 4) == 0) {
@@ -1248,7 +1285,9 @@ int eval_import(interp *I, const node *at, const char *name, env **out)
     }
     int idx = I->nmods++;
     node *prog;
-    if (parse_source(I, src, &prog) || eval_block(I, I->mods[idx].exports, prog, NULL))
+    /* the module's names by slot too (its checks are its run: nothing more is reported here) */
+    if (parse_source(I, src, &prog) || resolve_slots(I, prog, I->mods[idx].exports, 0) ||
+        eval_block(I, I->mods[idx].exports, prog, NULL))
         return -1; /* the module stays marked as loading; the session reports the error */
     I->mods[idx].state = 2;
     *out = I->mods[idx].exports;
@@ -1299,7 +1338,7 @@ int eval_call_positional(interp *I, env *e, value fn, const value *args, int nar
 {
     const node *const *anodes = (const node *const *)call->kids + 1;
     if (assign && nargs > 0 && args[0].k == V_LIST && fn.k == V_BUILTIN && strcmp(fn.u.bi->name, "concat") == 0) {
-        value *x = scope_lookup(e, assign); /* the arguments may have reassigned it */
+        value *x = scope_lookup(I, e, assign); /* the arguments may have reassigned it */
         I->append_target = x && x->k == V_LIST && x->u.h == args[0].u.h ? args[0].u.h : NULL;
         int rc = call_any(I, fn, args, nargs, NULL, NULL, 0, anodes, call, out);
         I->append_target = NULL;

@@ -26,6 +26,8 @@ void eval_keep_last(interp *I, value *last, value v);
 int eval_binary(interp *I, int op, value a, value b, value *out, const node *at);
 /* Load (once) and run a module; returns its scope (borrowed). */
 int eval_import(interp *I, const node *at, const char *name, env **out);
+/* The scope of module `name` if it is loaded already, else NULL (loads nothing, records nothing). */
+env *eval_module_loaded(interp *I, const node *at, const char *name);
 /* Parse a -D override or other value text as an expression and evaluate it. */
 int eval_text(interp *I, const char *srcname, const char *text, value *out);
 

@@ -470,12 +470,11 @@ static int resolve_block(resolver *r, scope *s, const node *b)
     return 0;
 }
 
-static int resolve_slots(interp *I, node *prog, env *globals);
 
 int resolve_program(interp *I, node *prog, env *globals)
 {
     int rc = resolve_check(I, prog, globals);
-    return rc ? rc : resolve_slots(I, prog, globals);
+    return rc ? rc : resolve_slots(I, prog, globals, I->is_repl);
 }
 
 int resolve_check(interp *I, node *prog, env *globals)
@@ -631,14 +630,27 @@ static int slots_defs(interp *I, rscope *s, const node *b)
             if (st->names[0]) {
                 if (rs_define(I, s, st->names[0]))
                     return -1;
+                st->slot = rs_slot(s, st->names[0]) + 1;
             } else {
-                env *m;
-                /* loaded by the checks above: this finds it in the cache */
-                if (eval_import(I, st, st->str, &m))
+                /* a script's modules were loaded by its checks; a module's own
+                 * imports load when they run: until then its names are found
+                 * by name (the slots of the names after them may be off too),
+                 * and no use is bound past this scope (they may hide builtins) */
+                env *m = eval_module_loaded(I, st, st->str);
+                if (!m) {
+                    s->open = 1;
+                    break;
+                }
+                int *slots = mem_arena_alloc(I, (m->n + 1) * sizeof *slots);
+                if (!slots)
                     return -1;
-                for (size_t k = 0; k < m->n; k++)
+                slots[0] = (int)m->n;
+                for (size_t k = 0; k < m->n; k++) {
                     if (rs_define(I, s, m->names[k]))
                         return -1;
+                    slots[k + 1] = rs_slot(s, m->names[k]) + 1;
+                }
+                st->slots = slots;
             }
             break;
         default:
@@ -744,10 +756,10 @@ static int slots_node(interp *I, rscope *s, node *n)
     }
 }
 
-static int resolve_slots(interp *I, node *prog, env *globals)
+int resolve_slots(interp *I, node *prog, env *globals, int open)
 {
     rscope root = {.fixed = globals->parent};
-    rscope top = {.parent = globals->parent ? &root : NULL, .open = I->is_repl};
+    rscope top = {.parent = globals->parent ? &root : NULL, .open = open};
     int rc = 0;
     /* the names the scope already holds keep their slots */
     for (size_t i = 0; i < globals->n && rc == 0; i++)

@@ -15,6 +15,10 @@
 /* Check a parsed program against the names visible in scope `globals`,
  * then give its names their slots (node.slot, node.hops) for the evaluator. */
 int resolve_program(interp *I, node *prog, env *globals);
+/* The slots alone, for a module as it loads (eval.c): scope is its top-level
+ * scope; open: later inputs may add names to it (the REPL's). Reports
+ * only running out of memory or of C stack. */
+int resolve_slots(interp *I, node *prog, env *scope, int open);
 /* The checks alone, without the slots: for `frac check`, which runs nothing. */
 int resolve_check(interp *I, node *prog, env *globals);
 

@@ -96,6 +96,19 @@ typedef struct module {
 
 typedef struct builtin builtin;
 
+/* Counts of the evaluator's slow paths, so tests can see that resolved code
+ * takes the fast ones (no flag shows them; each is one increment where the
+ * slow path already costs far more, except `scopes`, one per scope made). */
+typedef struct interp_counts {
+    long name_searches;  /* a scope searched by name: a use or definition whose slot did not
+                          * hold its name (compile.h scope_lookup / scope_define), or any
+                          * val_env_define into a scope that already holds names */
+    long scopes;         /* scopes made (val_env_new) */
+    long scope_allocs;   /* of those, not taken from the pool (a new heap object) */
+    long list_grows;     /* a list's item array reallocated to a larger capacity */
+    long types_compiled; /* builtin parameter types compiled from their text (contract.c) */
+} interp_counts;
+
 typedef struct interp {
     /* allocation (the hook runs on engine worker threads too: atomics) */
     _Atomic size_t mem_used;
@@ -165,6 +178,7 @@ typedef struct interp {
     const struct bcall *bcall;       /* the builtin call running, for positions */
     struct range_spec *lazy_range;   /* set by `for`: range() describes its items here (eval.c) */
     const heap *append_target;       /* x = concat(x, …): x's list, which concat may extend (eval.c) */
+    interp_counts count;             /* what the evaluator did (tests/unit/test_interp_counts.c) */
 } interp;
 
 /* The items start + step * i, i < count, of a range() that a `for` loop or

@@ -219,6 +219,7 @@ int val_list_push(interp *I, vlist *l, value v)
             val_unref(I, v);
             return -1;
         }
+        I->count.list_grows++;
         l->items = ni;
         l->cap = nc;
     }
@@ -337,11 +338,14 @@ env *val_env_new(interp *I, env *parent)
             I->heap_all->prev = &e->h;
         I->heap_all = &e->h;
         e->n = 0;
+        e->loose = 0;
     } else {
         e = heap_new(I, sizeof(env), H_ENV);
+        I->count.scope_allocs++;
     }
     if (!e)
         return NULL;
+    I->count.scopes++;
     e->parent = parent;
     if (parent)
         parent->h.rc++;
@@ -386,12 +390,20 @@ static int env_reindex(interp *I, env *e)
 
 int val_env_define(interp *I, env *e, const char *name, value v)
 {
+    if (e->n > 0)
+        I->count.name_searches++;
     long at = env_find(e, name);
     if (at >= 0) {
         val_unref(I, e->vals[at]);
         e->vals[at] = v;
         return 0;
     }
+    e->loose = 1; /* its place is not necessarily the slot resolve.c gave it */
+    return val_env_append(I, e, name, v);
+}
+
+int val_env_append(interp *I, env *e, const char *name, value v)
+{
     if (e->n == e->cap) {
         size_t nc = e->cap ? e->cap * 2 : 8;
         const char **nn = mem_realloc(I, e->names, nc * sizeof *nn);

@@ -84,6 +84,8 @@ struct env {
     value *vals;
     uint32_t *index;  /* open addressing: slot + 1, 0 = empty; NULL while small */
     size_t index_cap;
+    int loose;        /* a name was added by name (val_env_define), not at its slot: the
+                       * slots resolve.c gave may not describe this scope (compile.h) */
 };
 
 /* Freed scopes with at most ENV_POOL_CAP slots are kept (up to ENV_POOL_MAX)
@@ -166,6 +168,8 @@ value val_obj(struct interp *I, const obj_class *cls, void *payload); /* destroy
 
 env *val_env_new(struct interp *I, env *parent);
 int val_env_define(struct interp *I, env *e, const char *name, value v); /* takes v; redefines */
+/* Add name (which e does not hold: the caller knows) as e's next slot, without searching; takes v. */
+int val_env_append(struct interp *I, env *e, const char *name, value v);
 value *val_env_lookup(env *e, const char *name);                        /* borrowed, or NULL */
 
 /* The type name used in messages: "number", "string", "list", "image"… */
