@@ -230,12 +230,66 @@ static int c_doblock(interp *I, env *e, const cnode *c, value *out)
     return r;
 }
 
+/* The frame of a call (eval_push_frame's common case inline). */
+static inline int push_frame(interp *I, const vfunc *f, const node *call)
+{
+    if (I->depth < I->lim.max_depth && I->depth < I->stack_cap) {
+        I->stack[I->depth].fname = f->name ? f->name : "<lambda>";
+        I->stack[I->depth].call = call;
+        I->depth++;
+        return 0;
+    }
+    return eval_push_frame(I, f->name ? f->name : "<lambda>", call);
+}
+
+#define LOCAL_NAMES 4 /* names a call's scope on the C stack holds before it grows */
+
+/* call_user_exact for a body that makes no closure (body->local_scope):
+ * its scope is a local here, not a pooled heap object, since no closure
+ * (the only thing that keeps a scope: directly, or through the loop and
+ * block scopes inside it) can be made in it. Scopes made inside it (loops,
+ * blocks) point to it while they run and are released before it is. */
+static int call_local(interp *I, vfunc *f, const value *args, int nargs, const node *call, const cnode *body,
+                      value *out)
+{
+    const node *l = f->lambda;
+    const char *names[LOCAL_NAMES];
+    value vals[LOCAL_NAMES];
+    env s = {.h = {.rc = 1, .kind = H_ENV}, .parent = f->closure, .cap = LOCAL_NAMES, .names = names,
+             .vals = vals, .borrowed = 1};
+    if (s.parent)
+        s.parent->h.rc++;
+    for (int j = 0; j < nargs; j++) {
+        names[j] = l->names[j];
+        vals[j] = args[j];
+        val_ref(vals[j]);
+    }
+    s.n = (size_t)nargs;
+    int rc = -1;
+    if (push_frame(I, f, call) == 0) {
+        rc = body->fn(I, &s, body, out);
+        I->depth--;
+    }
+    for (size_t k = 0; k < s.n; k++)
+        val_unref(I, s.vals[k]);
+    if (!s.borrowed) {
+        mem_free(I, s.names);
+        mem_free(I, s.vals);
+    }
+    mem_free(I, s.index);
+    if (s.parent)
+        val_heap_unref(I, &s.parent->h);
+    return rc;
+}
+
 /* A user function called with exactly its parameters, in order: what
  * call_user does then (no argument matching, no defaults), with the
  * compiled body. */
 static int call_user_exact(interp *I, vfunc *f, const value *args, int nargs, const node *call, value *out)
 {
     const node *l = f->lambda;
+    if (l->code && l->code->local_scope && nargs <= LOCAL_NAMES) /* compiled already (the first call compiles) */
+        return call_local(I, f, args, nargs, call, l->code, out);
     env *ne = val_env_new(I, f->closure);
     if (!ne)
         return -1;
@@ -253,13 +307,8 @@ static int call_user_exact(interp *I, vfunc *f, const value *args, int nargs, co
             goto done;
         }
     }
-    if (I->depth < I->lim.max_depth && I->depth < I->stack_cap) { /* eval_push_frame's common case */
-        I->stack[I->depth].fname = f->name ? f->name : "<lambda>";
-        I->stack[I->depth].call = call;
-        I->depth++;
-    } else if (eval_push_frame(I, f->name ? f->name : "<lambda>", call)) {
+    if (push_frame(I, f, call))
         goto done;
-    }
     const cnode *body = compile_lambda(I, l); /* after the frame, as in call_user */
     rc = body ? body->fn(I, ne, body, out) : -1;
     I->depth--;
@@ -598,11 +647,28 @@ const cnode *compile_block(interp *I, const node *block)
     return comp_block(I, block, 0);
 }
 
+/* Can running n make a closure (a lambda, or a fn definition's)? The only
+ * way a scope outlives its run. Nesting deeper than `depth` allows: 1. */
+static int makes_closure(const node *n, int depth)
+{
+    if (!n)
+        return 0;
+    if (n->kind == N_LAMBDA || depth == 0)
+        return 1;
+    for (int i = 0; i < n->nkids; i++)
+        if (makes_closure(n->kids[i], depth - 1))
+            return 1;
+    return 0;
+}
+
 const cnode *compile_lambda(interp *I, const node *lambda)
 {
     if (lambda->code)
         return lambda->code;
-    const cnode *c = lambda->body->kind == N_BLOCK ? comp_block(I, lambda->body, 0) : comp_expr(I, lambda->body, 0);
+    cnode *c = (cnode *)(lambda->body->kind == N_BLOCK ? comp_block(I, lambda->body, 0)
+                                                        : comp_expr(I, lambda->body, 0));
+    if (c)
+        c->local_scope = !makes_closure(lambda->body, 256);
     ((node *)lambda)->code = c;
     return c;
 }

@@ -49,6 +49,8 @@ struct cnode {
     int nkids;
     int pure;             /* no call or scope below: cannot grow a scope */
     const node *assign;   /* a call that is the value of `x = …` (concat appends) */
+    int local_scope;      /* a lambda's body that makes no closure: nothing in it can keep
+                           * the call's scope, which may then live on the C stack */
 };
 
 /* The compiled body of a lambda (run it in the call's scope, as
@@ -62,7 +64,7 @@ const cnode *compile_block(interp *I, const node *block);
 
 /* The search by name behind scope_lookup (eval.c), counted in
  * I->count.name_searches. */
-value *scope_search(interp *I, env *e, const node *n);
+value *eval_scope_search(interp *I, env *e, const node *n);
 
 /* A name by its slot (resolve.c), checked: the slot must hold the name
  * (it may not be defined yet, or a REPL input may have stopped half-way),
@@ -79,7 +81,7 @@ static inline value *scope_lookup(interp *I, env *e, const node *n)
         if (t && k < t->n && t->names[k] == n->str)
             return &t->vals[k];
     }
-    return scope_search(I, e, n);
+    return eval_scope_search(I, e, n);
 }
 
 /* Define n->str in e (takes v): in place when the slot already holds it;

@@ -18,7 +18,7 @@
 #include "shard.h"
 #include "stdlib_embed.h"
 
-value *scope_search(interp *I, env *e, const node *n)
+value *eval_scope_search(interp *I, env *e, const node *n)
 {
     I->count.name_searches++;
     return val_env_lookup(e, n->str);

@@ -404,6 +404,22 @@ int val_env_define(interp *I, env *e, const char *name, value v)
 
 int val_env_append(interp *I, env *e, const char *name, value v)
 {
+    if (e->n == e->cap && e->borrowed) {
+        size_t nc = e->cap * 2;
+        const char **nn = mem_alloc(I, nc * sizeof *nn);
+        value *nv = nn ? mem_alloc(I, nc * sizeof *nv) : NULL;
+        if (!nv) {
+            mem_free(I, nn);
+            val_unref(I, v);
+            return -1;
+        }
+        memcpy(nn, e->names, e->n * sizeof *nn);
+        memcpy(nv, e->vals, e->n * sizeof *nv);
+        e->names = nn;
+        e->vals = nv;
+        e->cap = nc;
+        e->borrowed = 0;
+    }
     if (e->n == e->cap) {
         size_t nc = e->cap ? e->cap * 2 : 8;
         const char **nn = mem_realloc(I, e->names, nc * sizeof *nn);

@@ -86,6 +86,8 @@ struct env {
     size_t index_cap;
     int loose;        /* a name was added by name (val_env_define), not at its slot: the
                        * slots resolve.c gave may not describe this scope (compile.h) */
+    int borrowed;     /* names and vals are the caller's arrays (a call's scope on the C
+                       * stack, compile.c): growing copies them out, nothing frees them */
 };
 
 /* Freed scopes with at most ENV_POOL_CAP slots are kept (up to ENV_POOL_MAX)

@@ -233,27 +233,50 @@ static void test_types_once(void)
           many.d.types_compiled, one.d.types_compiled);
 }
 
-/* What calls and iterations make: one scope each (a call's parameters, an
- * iteration's variable), taken from the pool, not allocated. */
+/* What calls and iterations make. A call of a function whose body makes
+ * no closure keeps its scope on the C stack (compile.c: no heap scope at
+ * all); one whose body does gets a scope per call, from the pool. A loop
+ * reuses its iteration's scope unless a closure kept it. */
 static void test_scopes(void)
 {
     run small, big;
     run_script(&small, "fn fib(n) = if n < 2 then n else fib(n - 1) + fib(n - 2)\nprint(fib(10))\n");
     run_script(&big, "fn fib(n) = if n < 2 then n else fib(n - 1) + fib(n - 2)\nprint(fib(20))\n");
     CHECK(strcmp(small.out, "55\n") == 0 && strcmp(big.out, "6765\n") == 0, "fib: '%s' '%s'", small.out, big.out);
-    /* fib(20) makes 21891 calls, fib(10) 177: one scope per call */
+    /* fib(20) makes 21891 calls, fib(10) 177: none makes a heap scope (the
+     * first call of each function, which compiles its body, does) */
+    CHECK(big.d.scopes == small.d.scopes, "fib: %ld heap scopes for 177 calls, %ld for 21891", small.d.scopes,
+          big.d.scopes);
+    /* a body with a lambda in it (never called here): one scope per call */
+    run_script(&small, "fn f(n) = if n < 0 then (x => x + n) else if n < 2 then n else f(n - 1) + f(n - 2)\n"
+                       "print(f(10))\n");
+    run_script(&big, "fn f(n) = if n < 0 then (x => x + n) else if n < 2 then n else f(n - 1) + f(n - 2)\n"
+                     "print(f(20))\n");
+    CHECK(strcmp(small.out, "55\n") == 0 && strcmp(big.out, "6765\n") == 0, "f: '%s' '%s'", small.out, big.out);
     CHECK(big.d.scopes - small.d.scopes == 21891 - 177, "scopes per call: %ld more for %d more calls",
           big.d.scopes - small.d.scopes, 21891 - 177);
     /* the pool holds them: allocations bounded by the depth, not the calls */
     CHECK(big.d.scope_allocs - small.d.scope_allocs <= 10, "scopes allocated: %ld then %ld", small.d.scope_allocs,
           big.d.scope_allocs);
-    /* a loop reuses its iteration's scope unless a closure kept it */
+    /* a local scope that outgrows its room (4 names) moves to the heap, and
+     * loops and blocks inside it point to it while they run */
+    resolved("a call's scope grows",
+             "fn g(a, b) do\n  let c = a + b\n  let d = c * 2\n  let e = d + 1\n  let t = 0\n"
+             "  for i in range(3) do\n    t = t + e + i\n  end\n  let u = do\n    let w = t\n    w + a\n  end\n"
+             "  [a, b, c, d, e, t, u]\nend\nprint(g(1, 2), g(2, 3))\n",
+             /* g(1, 2): c 3, d 6, e 7, t = 3 * 7 + 3 = 24, u 25 */
+             "[1, 2, 3, 6, 7, 24, 25] [2, 3, 5, 10, 11, 36, 38]\n");
     run_script(&small, "let s = 0\nfor i in range(10) do\n  s = s + i\nend\nprint(s)\n");
     run_script(&big, "let s = 0\nfor i in range(10000) do\n  s = s + i\nend\nprint(s)\n");
     CHECK(strcmp(small.out, "45\n") == 0 && strcmp(big.out, "49995000\n") == 0, "loops: '%s' '%s'", small.out,
           big.out);
     CHECK(big.d.scopes == small.d.scopes, "a loop's scopes: %ld for 10 iterations, %ld for 10000", small.d.scopes,
           big.d.scopes);
+    /* a closure made in the body keeps its iteration's scope: one each */
+    run_script(&big, "let fs = [i for i in range(0)]\nfor i in range(100) do\n  fs = concat(fs, [() => i])\nend\n"
+                     "print(fs[7](), fs[99](), len(fs))\n");
+    CHECK(strcmp(big.out, "7 99 100\n") == 0, "closures in a loop: '%s' (%s)", big.out, big.err);
+    CHECK(big.d.scopes >= 100, "closures in a loop: %ld scopes", big.d.scopes);
 }
 
 int main(void)
