@@ -219,16 +219,18 @@ static void test_append(void)
           r.d.list_grows);
 }
 
-/* Builtin parameter types are compiled on a builtin's first call only. */
+/* Builtin parameter types are compiled on a builtin's first call only
+ * (norm's v is declared "vec+inf+nan", round's x a union of four types). */
 static void test_types_once(void)
 {
     run one, many;
-    run_script(&one, "let s = 0\nfor i in range(1) do\n  s = s + clamp(i, 0, 5)\nend\nprint(s)\n");
-    run_script(&many, "let s = 0\nfor i in range(1000) do\n  s = s + clamp(i, 0, 5)\nend\nprint(s)\n");
-    CHECK(one.rc == 0 && strcmp(one.out, "0\n") == 0, "clamp once: '%s' (%s)", one.out, one.err);
-    /* 0 + 1 + 2 + 3 + 4 + 5 * 995 */
-    CHECK(many.rc == 0 && strcmp(many.out, "4985\n") == 0, "clamp 1000: '%s' (%s)", many.out, many.err);
-    CHECK(one.d.types_compiled > 0, "the first call compiles clamp's types: %ld", one.d.types_compiled);
+    run_script(&one, "let s = 0\nfor i in range(1) do\n  s = s + round(norm([i, 2 * i]) / 2)\nend\nprint(s)\n");
+    run_script(&many, "let s = 0\nfor i in range(1000) do\n  s = s + round(norm([i, 2 * i]) / 2)\nend\nprint(s)\n");
+    CHECK(one.rc == 0 && strcmp(one.out, "0\n") == 0, "once: '%s' (%s)", one.out, one.err);
+    /* round(i * sqrt(5) / 2) summed over i < 1000 (Python: sum(floor(i * sqrt(5) / 2 + 0.5))) */
+    CHECK(many.rc == 0 && strcmp(many.out, "558456\n") == 0, "1000 times: '%s' (%s)", many.out, many.err);
+    CHECK(one.d.types_compiled >= 2, "the first calls compile norm's and round's types: %ld",
+          one.d.types_compiled);
     CHECK(many.d.types_compiled == one.d.types_compiled, "1000 calls compiled %ld types, one call %ld",
           many.d.types_compiled, one.d.types_compiled);
 }
