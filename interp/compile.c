@@ -441,7 +441,7 @@ static int c_assign(interp *I, env *e, const cnode *c, value *last)
     {                                                                          \
         (void)last;                                                            \
         const node *n = c->n;                                                  \
-        value *slot = scope_lookup(I, e, n);                                      \
+        value *slot = scope_lookup(I, e, n);                                   \
         if (!slot)                                                             \
             return err_at(I, n, ERR_NAME,                                      \
                           "cannot assign to '%s': it is not defined (use 'let %s = …')", \
