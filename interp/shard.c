@@ -352,30 +352,39 @@ typedef struct sum_dec {
 } sum_dec;
 
 /* acc: add each value into acc[n] (NULL: only check the structure); a run
- * of zeros adds nothing. Eight bytes without a high bit and without a zero
- * are eight one-byte values, added after one test. */
+ * of zeros adds nothing. Numbers of one or two bytes (nearly all: values
+ * below 2^14, runs shorter than 129) are taken whole by the first loop;
+ * the second reads any number byte by byte, across blocks too. */
 static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t *acc)
 {
-    const uint64_t high = 0x8080808080808080u, ones = 0x0101010101010101u;
     /* locals: the stores into acc could alias d's fields */
     uint64_t v = d->v, n = d->n, want = d->want;
     unsigned shift = d->shift;
     int run = d->run, bad = d->bad;
     size_t i = 0;
     while (i < len && !bad) {
-        if (shift == 0 && !run && len - i >= 8 && want - n >= 8) {
-            uint64_t w;
-            memcpy(&w, p + i, 8); /* byte order does not matter: only tested */
-            /* every byte below 0x80: w - ones borrows (sets a high bit) exactly where a byte is 0 */
-            if (!(w & high) && !((w - ones) & high)) {
+        while (shift == 0 && !run && len - i >= 2 && n < want) {
+            unsigned c = p[i], c1 = p[i + 1];
+            if (c - 1 < 0x7f) { /* 1 … 127 */
                 if (acc)
-                    for (int q = 0; q < 8; q++)
-                        acc[n + q] += p[i + q];
-                n += 8;
-                i += 8;
-                continue;
+                    acc[n] += c;
+                n++, i++;
+            } else if (c == 0 && c1 < 0x80) { /* 0 and a one-byte count: c1 + 1 zeros */
+                if (c1 >= want - n) {
+                    bad = 1;
+                    break;
+                }
+                n += c1 + 1u, i += 2;
+            } else if (c >= 0x80 && c1 - 1 < 0x7f) { /* 128 … 16383 */
+                if (acc)
+                    acc[n] += (c & 0x7fu) | (uint64_t)c1 << 7;
+                n++, i += 2;
+            } else {
+                break;
             }
         }
+        if (bad || i >= len)
+            break;
         unsigned c = p[i++];
         if (shift > 63 || (shift == 63 && (c & 0x7e))) {
             bad = 1;
