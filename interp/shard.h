@@ -45,7 +45,7 @@
 #include "par.h"
 #include "state.h"
 
-#define SHARD_FORMAT 3
+#define SHARD_FORMAT 4
 #define SHARD_OP_WINDOW 4 /* a record's op: the window fitted for its call (after the par_part_op ones) */
 #define SHARD_MAX_FULL 4096
 #define SHARD_MAX_PARTS 65536

@@ -72,7 +72,9 @@ static void fixed_point(const affine *a, double out[3])
     }
 }
 
-static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, rt_error *e)
+/* palette: 0 when no loop reads pal/palf (the window pre-pass, counts
+ * without colour), which spares 1024 ramp evaluations. */
+static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, int palette, rt_error *e)
 {
     const affine *maps;
     int n, dim, rows;
@@ -151,6 +153,8 @@ static sysdata *sys_make(const chaos_sys *s, const chaos_opts *o, int want_dim, 
         d->start_map = (uint32_t)(s->rifs->start % n);
     }
     fixed_point(&maps[d->start_map], d->x0);
+    if (!palette)
+        return d;
     ramp grey = ramp_grey();
     const ramp *rp = o->ramp ? o->ramp : &grey;
     for (int i = 0; i < CHAOS_PALETTE; i++) {
@@ -726,40 +730,108 @@ static void heap_offer(double *h, size_t n, size_t k, double v)
 
 enum { FIT_TAIL = CHAOS_FIT_POINTS / 1000 + 1 };
 
+/* The tails of one run of the pre-pass, per axis: hl keeps the cut+1
+ * smallest coordinates (a max-heap), hh the cut+1 largest, negated. */
+typedef struct tails {
+    double hl[3][FIT_TAIL], hh[3][FIT_TAIL];
+} tails;
+
+/* One orbit step of the pre-pass on locals (dimension and kind constant). */
+INLINE void fit_step(rng *r, const sysdata *d, uint32_t *st, uint32_t *cur, double *x, double *y,
+                     double *z, const int dim, const int kind)
+{
+    uint32_t m = step_choose(r, (uint32_t)d->n, d->thr, d->sel, st, cur, kind);
+    if (dim == 2)
+        step_map2(d->m + 6 * (size_t)m, x, y);
+    else
+        step_map3(d->m + 12 * (size_t)m, x, y, z);
+}
+
+/* Offer v to axis a's tails once both heaps are full; *lo and *hi hold the
+ * heaps' tops (hl[a][0] and -hh[a][0]) in registers. The tests are
+ * heap_offer's own (v < hl[a][0], and -v < hh[a][0]), made before the call. */
+INLINE void tail_offer(tails *t, int a, size_t k, double v, double *lo, double *hi)
+{
+    if (v < *lo) {
+        heap_offer(t->hl[a], k, k, v);
+        *lo = t->hl[a][0];
+    }
+    if (v > *hi) {
+        heap_offer(t->hh[a], k, k, -v);
+        *hi = -t->hh[a][0];
+    }
+}
+
 /* The pre-pass without storing its points: per axis the (cut+1)-th smallest
  * and largest coordinate (as floats, what a stored point cloud holds) in
  * two heaps of cut+1 values — the same order statistics a selection over
- * all the points gives (chaos.h). 0 if a coordinate is not finite (the
- * caller then sorts the stored points). */
-static int fit_tails(const job *j, size_t cut, double *lo, double *hi)
+ * all the points gives (chaos.h). Specialised like the hot loops (the
+ * dimension and system kind are constants, the orbit in locals). Once the
+ * heaps are full a value is compared with the heap's top first: after the
+ * first few thousand points almost none enters a 0.1 % tail, so a point
+ * costs its orbit step and two comparisons an axis; what enters does so
+ * exactly as heap_offer would have it, so the heaps hold the same values.
+ * Non-finite values are not tested point by point: sum adds every value,
+ * and a sum of at most 3·2^16 floats cannot overflow a double, so it is
+ * finite exactly when every value is (an infinity or NaN makes it infinite
+ * or NaN for good). 0 if a coordinate was not finite (the caller then sorts
+ * the stored points). */
+INLINE int fit_tails_run(const job *j, size_t cut, tails *t, const int dim, const int kind)
 {
     const sysdata *d = j->d;
-    double hl[3][FIT_TAIL], hh[3][FIT_TAIL]; /* hh holds the negated values */
-    size_t k = cut + 1;
+    size_t k = cut + 1, np = (size_t)j->points;
     orbit ob;
     orbit_start(&ob, d, j->o->seed, 0);
+    rng r = ob.r;
+    uint32_t st = ob.s, cur = ob.cur;
+    double x = ob.x, y = ob.y, z = ob.z, sum = 0;
     for (uint64_t i = 0; i < j->burn; i++)
-        orbit_step_any(&ob, d);
-    for (size_t i = 0; i < j->points; i++) {
-        orbit_step_any(&ob, d);
-        float v[3] = {(float)ob.x, (float)ob.y, (float)ob.z};
-        for (int a = 0; a < d->dim; a++) {
-            double va = v[a];
-            if (!isfinite(va))
-                return 0;
-            heap_offer(hl[a], i, k, va);
-            heap_offer(hh[a], i, k, -va);
+        fit_step(&r, d, &st, &cur, &x, &y, &z, dim, kind);
+    for (size_t i = 0; i < k; i++) { /* filling the heaps (k <= np) */
+        fit_step(&r, d, &st, &cur, &x, &y, &z, dim, kind);
+        double v[3] = {(float)x, (float)y, (float)z};
+        for (int a = 0; a < dim; a++) {
+            sum += v[a];
+            heap_offer(t->hl[a], i, k, v[a]);
+            heap_offer(t->hh[a], i, k, -v[a]);
         }
     }
-    for (int a = 0; a < d->dim; a++)
-        lo[a] = hl[a][0], hi[a] = -hh[a][0];
-    return 1;
+    double lx = t->hl[0][0], hx = -t->hh[0][0], ly = t->hl[1][0], hy = -t->hh[1][0];
+    double lz = dim == 3 ? t->hl[2][0] : 0, hz = dim == 3 ? -t->hh[2][0] : 0;
+    for (size_t i = k; i < np; i++) {
+        fit_step(&r, d, &st, &cur, &x, &y, &z, dim, kind);
+        double vx = (float)x, vy = (float)y;
+        sum += vx + vy;
+        tail_offer(t, 0, k, vx, &lx, &hx);
+        tail_offer(t, 1, k, vy, &ly, &hy);
+        if (dim == 3) {
+            double vz = (float)z;
+            sum += vz;
+            tail_offer(t, 2, k, vz, &lz, &hz);
+        }
+    }
+    return isfinite(sum);
+}
+
+static int fit_tails(const job *j, size_t cut, double *lo, double *hi)
+{
+    tails t;
+    int dim = j->d->dim, kind = j->d->kind, ok;
+    if (dim == 2)
+        ok = kind == KIND_IFS ? fit_tails_run(j, cut, &t, 2, KIND_IFS)
+           : kind == KIND_R1 ? fit_tails_run(j, cut, &t, 2, KIND_R1) : fit_tails_run(j, cut, &t, 2, KIND_R2);
+    else
+        ok = kind == KIND_IFS ? fit_tails_run(j, cut, &t, 3, KIND_IFS)
+           : kind == KIND_R1 ? fit_tails_run(j, cut, &t, 3, KIND_R1) : fit_tails_run(j, cut, &t, 3, KIND_R2);
+    for (int a = 0; a < dim; a++)
+        lo[a] = t.hl[a][0], hi[a] = -t.hh[a][0];
+    return ok;
 }
 
 rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
                   rt_error *e)
 {
-    sysdata *d = sys_make(s, o, 0, e);
+    sysdata *d = sys_make(s, o, 0, 0, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
     size_t np = o->fit_points && o->fit_points < CHAOS_FIT_POINTS ? (size_t)o->fit_points : CHAOS_FIT_POINTS;
@@ -931,7 +1003,7 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
         return rt_fail(e, RT_EINVAL, "histogram window [%g, %g] x [%g, %g] is empty", hs->lo[0],
                        hs->hi[0], hs->lo[1], hs->hi[1]);
-    sysdata *d = sys_make(s, o, 2, e);
+    sysdata *d = sys_make(s, o, 2, o->colour != CHAOS_COLOUR_NONE, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
     job j;
@@ -1031,7 +1103,7 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
     for (int a = 0; a < 3; a++)
         if (!(vol->hi[a] > vol->lo[a]))
             return rt_fail(e, RT_EINVAL, "volume box is empty on axis %c", "xyz"[a]);
-    sysdata *d = sys_make(s, o, 3, e);
+    sysdata *d = sys_make(s, o, 3, 0, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
     job j;
@@ -1111,7 +1183,7 @@ rt_code chaos_volume(const chaos_sys *s, const chaos_opts *o, chaos_norm norm, v
 rt_code chaos_points(const chaos_sys *s, const chaos_opts *o, mesh *m, const rt_run *run,
                      rt_error *e)
 {
-    sysdata *d = sys_make(s, o, 0, e);
+    sysdata *d = sys_make(s, o, 0, 1, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
     job j;
@@ -1191,7 +1263,7 @@ rt_code chaos_project(const chaos_sys *s, const chaos_opts *o, const camera *cam
 {
     if (st)
         st->plotted = st->inside = 0;
-    sysdata *d = sys_make(s, o, 3, e);
+    sysdata *d = sys_make(s, o, 3, 1, e);
     if (!d)
         return e ? e->code : RT_EINVAL;
     job j;

@@ -69,7 +69,7 @@ static int skip_str(const unsigned char *d, size_t n, size_t *pos)
     return 0;
 }
 
-/* The layout of interp/shard.c, part format 3 (docs/scale.md): header
+/* The layout of interp/shard.c, part format 4 (docs/scale.md): header
  * fields, then its CRC; records "REC " + 76 bytes of head + payload, then a
  * CRC of head and payload; the end ("END ", counts, the files read), then
  * its CRC. Repairs in place; hash gets the header's script hash. */

@@ -1,8 +1,8 @@
 #!/bin/sh
 # format.sh — the part file as docs/scale.md describes it, read by an
 # independent program (python3 with part.py: hashlib's SHA-256, zlib's
-# CRC-32, LEB128 decoded by hand) for the 3 parts of tests/shard/small.frac
-# (tests/cli/shard_format.cli). Prints what it found, or "skipped (…)".
+# CRC-32, LEB128 and the runs of zeros decoded by hand) for the 3 parts of
+# tests/shard/small.frac (tests/cli/shard_format.cli). Prints what it found, or "skipped (…)".
 set -u
 frac=${FRAC:-frac}
 here=$(dirname "$0")
@@ -36,7 +36,7 @@ for path in sys.argv[2:]:
         assert (r.lo, r.hi) == (r.chunks * p.index // p.count, r.chunks * (p.index + 1) // p.count), 'chunk range'
         if r.op != 1:
             continue
-        vals = part.leb128(r.payload)
+        vals = part.sums(r.payload)
         assert len(vals) == r.total // 8, 'LEB128 sums'
         acc = sums.setdefault((r.call, r.section), [0] * len(vals))
         for k, x in enumerate(vals):

@@ -1,7 +1,8 @@
 """part.py — a reader of frac's part files that shares no code with frac:
 the format of docs/scale.md "The part file" read with struct and zlib's
 CRC-32, for the python3 parts of tests/shard/format.sh, share.sh,
-records.sh and sums.sh, and of tools/shard_plan.sh.
+records.sh and sums.sh, and of tools/shard_plan.sh; sums() and
+sums_bytes() decode and encode a sums payload.
 
     PYTHONPATH=tests/shard python3 -c 'import part; p = part.read(PATH)'
 
@@ -16,7 +17,7 @@ import struct
 import zlib
 from types import SimpleNamespace
 
-FORMAT = 3  # the format number docs/scale.md gives; the scripts check parts carry it
+FORMAT = 4  # the format number docs/scale.md gives; the scripts check parts carry it
 
 
 class Bytes:
@@ -93,8 +94,8 @@ def read(path):
 
 
 def leb128(payload):
-    """The unsigned LEB128 numbers of a sums payload (7 bits a byte, low
-    group first, the top bit set on every byte of a number but its last)."""
+    """The unsigned LEB128 numbers of a payload (7 bits a byte, low group
+    first, the top bit set on every byte of a number but its last)."""
     vals, v, shift = [], 0, 0
     for byte in payload:
         v |= (byte & 0x7f) << shift
@@ -104,3 +105,45 @@ def leb128(payload):
             v, shift = 0, 0
     assert shift == 0, 'a number runs past the payload'
     return vals
+
+
+def sums(payload):
+    """The values of a sums payload: LEB128 numbers, where a 0 is followed
+    by the count of the further zeros of its run (format 4)."""
+    nums, vals, k = leb128(payload), [], 0
+    while k < len(nums):
+        if nums[k]:
+            vals.append(nums[k])
+            k += 1
+        else:
+            assert k + 1 < len(nums), 'a zero without its run count'
+            vals.extend([0] * (1 + nums[k + 1]))
+            k += 2
+    return vals
+
+
+def leb128_bytes(v):
+    """One number as unsigned LEB128."""
+    out = bytearray()
+    while v >= 0x80:
+        out.append(v & 0x7f | 0x80)
+        v >>= 7
+    out.append(v)
+    return bytes(out)
+
+
+def sums_bytes(vals, longest=None):
+    """vals as a sums payload: each run of zeros as 0 and the count of the
+    zeros after the first, runs of at most longest zeros (None: whole runs)."""
+    out, k = bytearray(), 0
+    while k < len(vals):
+        if vals[k]:
+            out += leb128_bytes(vals[k])
+            k += 1
+            continue
+        j = k
+        while j < len(vals) and not vals[j] and (longest is None or j - k < longest):
+            j += 1
+        out += b'\0' + leb128_bytes(j - k - 1)
+        k = j
+    return bytes(out)

@@ -34,18 +34,21 @@ echo "# changed" >>"$tmp/small.frac"
 case_ "other script" "$tmp/small.frac" "$p-0-of-3.part" "$p-1-of-3.part" "$p-2-of-3.part"
 "$frac" run -q --shard 1/2 -o "$tmp/q" "$s" || exit 1
 case_ "other N" "$s" "$p-0-of-3.part" "$tmp/q/small.shard-1-of-2.part" "$p-2-of-3.part"
-# cut inside the payload of the first record (the 32x32 counts, > 1 KiB)
-head -c 600 "$p-1-of-3.part" >"$tmp/trunc.part"
+# cut inside the payload of the first record (the 32x32 counts of a call
+# of one chunk, which shard 1 does not compute: one run of 1024 zeros, the
+# 3 bytes from byte 203 on: after the 123 bytes of the header and the 80 of
+# the record's head)
+head -c 204 "$p-1-of-3.part" >"$tmp/trunc.part"
 case_ "truncated" "$s" "$p-0-of-3.part" "$tmp/trunc.part" "$p-2-of-3.part"
-# flip one byte in the middle of shard 1's first record
+# flip one byte of shard 1's first record (its payload's second)
 cp "$p-1-of-3.part" "$tmp/bad.part"
-printf 'Z' | dd of="$tmp/bad.part" bs=1 seek=400 conv=notrunc 2>/dev/null
+printf 'Z' | dd of="$tmp/bad.part" bs=1 seek=204 conv=notrunc 2>/dev/null
 case_ "corrupt" "$s" "$p-0-of-3.part" "$tmp/bad.part" "$p-2-of-3.part"
-# a part of format 2 (the format field, after the magic, set to 2): made
-# by a frac before the window record
-cp "$p-1-of-3.part" "$tmp/v2.part"
-printf '\002' | dd of="$tmp/v2.part" bs=1 seek=8 conv=notrunc 2>/dev/null
-case_ "format 2" "$s" "$p-0-of-3.part" "$tmp/v2.part" "$p-2-of-3.part"
+# a part of format 3 (the format field, after the magic, set to 3): made
+# by a frac before the runs of zeros in sums
+cp "$p-1-of-3.part" "$tmp/v3.part"
+printf '\003' | dd of="$tmp/v3.part" bs=1 seek=8 conv=notrunc 2>/dev/null
+case_ "format 3" "$s" "$p-0-of-3.part" "$tmp/v3.part" "$p-2-of-3.part"
 case_ "not a part" "$s" "$p-0-of-3.part" "$s" "$p-2-of-3.part"
 case_ "unreadable" "$s" "$p-0-of-3.part" "$tmp/none.part" "$p-2-of-3.part"
 # --shard auto: each launcher's variables (the others unset)

@@ -1,5 +1,5 @@
 #!/bin/sh
-# window.sh — the window record of part format 3 (docs/scale.md;
+# window.sh — the window record of part format 4 (docs/scale.md;
 # tests/cli/shard_window.cli). Makes the 3 parts of tests/shard/small.frac,
 # whose chaos call fits its window; python3 reads each part's records: the
 # window record (op 4: lo then hi as little-endian doubles) follows the
@@ -33,7 +33,7 @@ out, mode = sys.argv[1], sys.argv[2]
 seen = []
 for path in sys.argv[3:]:
     b = bytes(open(path, 'rb').read())
-    assert b[:8] == b'FRACPART' and struct.unpack_from('<I', b, 8)[0] == 3, 'format'
+    assert b[:8] == b'FRACPART' and struct.unpack_from('<I', b, 8)[0] == 4, 'format'
     pos = 12
     def skip_str():
         global pos

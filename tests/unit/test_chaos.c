@@ -690,6 +690,172 @@ static void test_fit_quantiles(void)
     ifs_free(&f);
 }
 
+/* The window chaos.h defines, computed the straightforward way: the
+ * pre-pass points stored (chaos_points with the pre-pass seed, one chunk of
+ * np points, the same burn), each axis sorted (as floats, what the points
+ * hold), the (cut+1)-th smallest and largest taken, then the rules for a
+ * non-finite or degenerate extent, the 5 % margins and the aspect. */
+static void fit_by_sorting(const chaos_sys *s, const chaos_opts *o, int dim, int w, int h, double *lo, double *hi)
+{
+    rt_error e;
+    size_t np = o->fit_points && o->fit_points < CHAOS_FIT_POINTS ? (size_t)o->fit_points : CHAOS_FIT_POINTS;
+    size_t cut = np / 1000;
+    chaos_opts po = *o;
+    po.points = np;
+    po.chunk = (uint32_t)np;
+    po.colour = CHAOS_COLOUR_NONE;
+    po.seed = rng_hash3(o->seed, 1ull << 63, 0, 0);
+    mesh m;
+    mesh_init(&m, 0, 0);
+    CHECK(chaos_points(s, &po, &m, NULL, &e) == RT_OK, "points: %s", e.msg);
+    float *ax = malloc(np * sizeof *ax);
+    double ext[3], big = 0;
+    for (int a = 0; a < dim; a++) {
+        for (size_t i = 0; i < np; i++)
+            ax[i] = m.pos[3 * i + a];
+        qsort(ax, np, sizeof *ax, cmp_float);
+        lo[a] = ax[cut], hi[a] = ax[np - 1 - cut];
+        if (!isfinite(lo[a]) || !isfinite(hi[a]))
+            lo[a] = -1, hi[a] = 1;
+        ext[a] = hi[a] - lo[a];
+        big = ext[a] > big ? ext[a] : big;
+    }
+    for (int a = 0; a < dim; a++) {
+        double c = 0.5 * (lo[a] + hi[a]), x = ext[a];
+        if (!(x > 1e-12 * (fabs(c) + 1)))
+            x = big > 0 ? 0.1 * big : 1;
+        x *= 1.1;
+        lo[a] = c - 0.5 * x, hi[a] = c + 0.5 * x;
+    }
+    if (dim == 2 && w > 0 && h > 0) {
+        double ex = hi[0] - lo[0], ey = hi[1] - lo[1], want = (double)w / h;
+        int ax0 = ex / ey < want ? 0 : 1;
+        double c = 0.5 * (lo[ax0] + hi[ax0]), half = ax0 == 0 ? 0.5 * ey * want : 0.5 * ex / want;
+        lo[ax0] = c - half, hi[ax0] = c + half;
+    }
+    free(ax);
+    mesh_free(&m);
+}
+
+/* chaos_fit keeps only the tails of the pre-pass (two heaps an axis, a value
+ * tested against the heap's top first, non-finite values detected once at
+ * the end): it must give the sorted window bit for bit, on a 2-D IFS, both
+ * RIFS orders, a 3-D IFS, rare far excursions (dozens of points enter the
+ * tails late), degenerate attractors (a point; a line), float overflow that
+ * the double orbit recovers from (the stored points are sorted instead),
+ * and fewer pre-pass points (cut 0 and 5). */
+static void check_fit(const char *what, const chaos_sys *s, uint64_t fit_points, int dim, int w, int h,
+                      double *lo_out, double *hi_out)
+{
+    rt_error e;
+    chaos_opts o = {0};
+    o.seed = 77;
+    o.fit_points = fit_points;
+    double lo[3], hi[3], rlo[3], rhi[3];
+    CHECK(chaos_fit(s, &o, w, h, lo, hi, &e) == RT_OK, "%s: fit: %s", what, e.msg);
+    fit_by_sorting(s, &o, dim, w, h, rlo, rhi);
+    for (int a = 0; a < dim; a++) {
+        CHECK(memcmp(&lo[a], &rlo[a], sizeof lo[a]) == 0 && memcmp(&hi[a], &rhi[a], sizeof hi[a]) == 0,
+              "%s: axis %d: [%.17g, %.17g], by sorting [%.17g, %.17g]", what, a, lo[a], hi[a], rlo[a], rhi[a]);
+        if (lo_out)
+            lo_out[a] = lo[a], hi_out[a] = hi[a];
+    }
+}
+
+static void test_fit_tails(void)
+{
+    rt_error e;
+    ifs f;
+    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
+                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
+                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
+    double pf[4] = {0.01, 0.85, 0.07, 0.07};
+    CHECK(ifs_build(&f, fern, 4, pf, 0, &e) == RT_OK, "fern");
+    chaos_sys s = {&f, NULL};
+    check_fit("fern", &s, 0, 2, 300, 200, NULL, NULL);
+    check_fit("fern, 2 points", &s, 2, 2, 64, 64, NULL, NULL); /* the tails: 1 point each */
+    check_fit("fern, 3 points", &s, 3, 2, 64, 64, NULL, NULL);
+    check_fit("fern, 500 points", &s, 500, 2, 64, 64, NULL, NULL);
+    check_fit("fern, 1000 points", &s, 1000, 2, 64, 64, NULL, NULL); /* cut 1 */
+    check_fit("fern, 5000 points", &s, 5000, 2, 100, 300, NULL, NULL);
+    ifs_free(&f);
+
+    /* far excursions: one step in ~5000 jumps by (400, -300), and halving
+     * brings it back over ~10 steps: ~130 far points, the tails' 66 among them */
+    affine far[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0.5),
+                     affine_from_2d(0.5, 0, 0, 0.5, 400, -300)};
+    double pfar[3] = {0.4999, 0.4999, 0.0002};
+    CHECK(ifs_build(&f, far, 3, pfar, 0, &e) == RT_OK, "far: %s", e.msg);
+    s.ifs = &f;
+    double lo[3], hi[3];
+    check_fit("far excursions", &s, 0, 2, 100, 100, lo, hi);
+    CHECK(hi[0] > 5 && lo[1] < -5, "the excursions are in the tails: x up to %g, y down to %g", hi[0], lo[1]);
+    ifs_free(&f);
+
+    /* a point: every coordinate 2 exactly, so the extent is 0 -> 1 unit */
+    affine pt[1] = {affine_from_2d(0.5, 0, 0, 0.5, 1, 1)};
+    CHECK(ifs_build(&f, pt, 1, NULL, 0, &e) == RT_OK, "point: %s", e.msg);
+    s.ifs = &f;
+    check_fit("a point", &s, 0, 2, 0, 0, lo, hi);
+    CHECK(lo[0] == 2 - 0.55 && hi[0] == 2 + 0.55 && lo[1] == 2 - 0.55, "point window [%g, %g]", lo[0], hi[0]);
+    ifs_free(&f);
+
+    /* a line: y = 0.25 always, so y gets 10 % of x's extent */
+    affine line[2] = {affine_from_2d(0.5, 0, 0, 0, 0, 0.25), affine_from_2d(0.5, 0, 0, 0, 0.5, 0.25)};
+    CHECK(ifs_build(&f, line, 2, NULL, 0, &e) == RT_OK, "line: %s", e.msg);
+    s.ifs = &f;
+    check_fit("a line", &s, 0, 2, 0, 0, lo, hi);
+    CHECK(fabs((hi[1] - lo[1]) - 0.1 * (hi[0] - lo[0])) < 1e-12, "line: y extent %g, x extent %g",
+          hi[1] - lo[1], hi[0] - lo[0]);
+    ifs_free(&f);
+
+    /* float overflow: one step in 10^4 puts x at 10^39 (a float infinity,
+     * a finite double), and halving brings it back below FLT_MAX */
+    affine big[2] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5), affine_from_2d(0, 0, 0, 0.5, 1e39, 0)};
+    double pbig[2] = {0.9999, 0.0001};
+    CHECK(ifs_build(&f, big, 2, pbig, 0, &e) == RT_OK, "overflow: %s", e.msg);
+    s.ifs = &f;
+    check_fit("float overflow", &s, 0, 2, 0, 0, NULL, NULL);
+    ifs_free(&f);
+
+    /* NaN: x = 10^308, then ×10 overflows the double, and the next 0·x
+     * (map 1) makes x NaN for good: the heaps cannot order NaN, so the
+     * stored points are sorted instead (and the x window is the default) */
+    affine nan[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0.5), affine_from_2d(0, 0, 0, 0.5, 1e308, 0),
+                     affine_from_2d(10, 0, 0, 0.5, 0, 0)};
+    double pnan[3] = {0.98, 0.01, 0.01};
+    CHECK(ifs_build(&f, nan, 3, pnan, IFS_ALLOW_EXPANDING, &e) == RT_OK, "NaN: %s", e.msg);
+    s.ifs = &f;
+    check_fit("NaN", &s, 0, 2, 0, 0, lo, hi);
+    CHECK(lo[0] == -1.1 && hi[0] == 1.1, "NaN: x window [%g, %g]", lo[0], hi[0]);
+    ifs_free(&f);
+
+    /* RIFS of order 1 and 2 (the chain of test_order2) */
+    rifs r;
+    affine bin[2] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.6, 0.5, 0.4)};
+    double P1[4] = {0.3, 0.7, 0.6, 0.4};
+    CHECK(rifs_build(&r, bin, 2, 1, P1, 0, &e) == RT_OK, "order 1: %s", e.msg);
+    chaos_sys sr = {NULL, &r};
+    check_fit("RIFS order 1", &sr, 0, 2, 120, 80, NULL, NULL);
+    rifs_free(&r);
+    double P2[8] = {0, 1, 0.5, 0.5, 0.5, 0.5, 1, 0};
+    CHECK(rifs_build(&r, bin, 2, 2, P2, 0, &e) == RT_OK, "order 2: %s", e.msg);
+    check_fit("RIFS order 2", &sr, 0, 2, 80, 120, NULL, NULL);
+    rifs_free(&r);
+
+    /* 3-D: three rotating maps (the box is returned without an aspect) */
+    double M[3][9] = {{0.5, -0.2, 0, 0.2, 0.5, 0, 0, 0, 0.5},
+                      {0.5, 0, 0.1, 0, 0.5, 0, -0.1, 0, 0.5},
+                      {0.4, 0, 0, 0, 0.4, 0.2, 0, -0.2, 0.4}};
+    double T[3][3] = {{0, 0, 0}, {1, 0, 0.5}, {0, 1, 1}};
+    affine m3[3] = {affine_from_3d(M[0], T[0]), affine_from_3d(M[1], T[1]), affine_from_3d(M[2], T[2])};
+    CHECK(ifs_build(&f, m3, 3, NULL, 0, &e) == RT_OK, "3-D: %s", e.msg);
+    s.ifs = &f;
+    check_fit("3-D", &s, 0, 3, 0, 0, NULL, NULL);
+    check_fit("3-D, 900 points", &s, 900, 3, 0, 0, NULL, NULL);
+    ifs_free(&f);
+}
+
 /* The stage chain holds no copies (the allocation hook sees every block):
  * counts without colour on one thread go straight into the histogram and a
  * 3-D measure into the volume's own memory; tone mapping allocates nothing.
@@ -936,6 +1102,7 @@ int main(void)
     test_tonemap();
     test_hist_adds();
     test_fit_quantiles();
+    test_fit_tails();
     test_no_copies();
     test_volume_inside();
     test_colour_inside();
