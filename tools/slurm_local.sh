@@ -98,7 +98,7 @@ fi
 host=$(hostname -s)
 cat >"$SLURM_CONF" <<EOF
 # written by tools/slurm_local.sh: a one-node cluster on $host
-ClusterName=frac
+ClusterName=frac-local
 SlurmctldHost=$host(127.0.0.1)
 SlurmUser=root
 AuthType=auth/munge
@@ -122,6 +122,8 @@ PartitionName=local Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
 stop_pid "$dir/slurmd.pid"
 stop_pid "$dir/slurmctld.pid"
+# a fresh cluster: no jobs or cluster name of an earlier one
+rm -rf "$dir/state" "$dir/spool" && mkdir "$dir/state" "$dir/spool" || exit 1
 slurmctld -c -f "$SLURM_CONF" || die "slurmctld did not start (see $dir/slurmctld.log)"
 wait_for 15 ping_ok || die "slurmctld does not answer after 15 s (see $dir/slurmctld.log)"
 slurmd -f "$SLURM_CONF" || die "slurmd did not start (see $dir/slurmd.log)"

@@ -50,8 +50,11 @@ unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROC
 unset SLURM_CPUS_PER_TASK OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
 # the jobs of this test: those whose working folder is this one
 jobs_here() { timeout 10 scontrol -o show job 2>/dev/null | grep " WorkDir=$wd " ; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+field() { sed -n "s/^\(.* \)\{0,1\}$1=\([^ ]*\).*/\2/p"; } # NAME=VALUE of each line
+own=0 # 1: the cluster is tools/slurm_local.sh's (below)
+part_up() { [ "$own" = 0 ] || timeout 10 scontrol update PartitionName=local State=UP; }
 cleanup() {
+    part_up 2>/dev/null
     ids=$(jobs_here | field JobId | tr '\n' ' ')
     [ -z "$ids" ] || timeout 10 scancel $ids 2>/dev/null
     rm -rf "$tmp"
@@ -67,7 +70,27 @@ grep -q '^sbatch ' submit.sh || fail "no sbatch lines in docs/scale.md"
 range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\)$/\1/p' render.sbatch)
 [ -n "$range" ] || fail "the array is not A-B"
 n=$((${range#*-} - ${range%-*} + 1))
-timeout 60 sh -e submit.sh </dev/null >submit.out 2>&1 || fail "the submission: $(tail -n 3 submit.out)"
+# On a cluster of tools/slurm_local.sh (ClusterName frac-local, nobody
+# else's) the test makes the merge job free to start before the array, as
+# the emulation does: the partition is DOWN during the submission, then the
+# array is held, the partition UP, and the merge must stay pending for 5 s
+# (without its afterok it would run, and fail for want of parts); then the
+# array is released. On another cluster the jobs run in the order it picks.
+timeout 10 scontrol show config 2>/dev/null | grep -q '^ClusterName *= frac-local$' && own=1
+[ "$own" = 0 ] || timeout 10 scontrol update PartitionName=local State=DOWN || fail "cannot set the partition DOWN"
+timeout 60 sh -e submit.sh </dev/null >submit.out 2>&1 || { part_up; fail "the submission: $(tail -n 3 submit.out)"; }
+if [ "$own" = 1 ]; then
+    arr=$(jobs_here | field ArrayJobId | sort -u)
+    [ -n "$arr" ] && timeout 10 scontrol hold "$arr" || { part_up; fail "cannot hold the array"; }
+    part_up || fail "cannot set the partition UP"
+    sleep 5
+    merge=$(jobs_here | grep -v " ArrayJobId=")
+    case $merge in
+    *" JobState=PENDING "*) ;;
+    *) fail "the merge job did not wait for the array: $(echo "$merge" | field JobState) $(echo "$merge" | field ExitCode); $(cat slurm-*.out 2>/dev/null | tail -n 2)" ;;
+    esac
+    timeout 10 scontrol release "$arr" || fail "cannot release the array"
+fi
 # until every job of this folder has ended (a job pending on a dependency
 # that can never be satisfied has ended too)
 limit=${FRAC_SLURM_WAIT:-90}
@@ -100,4 +123,4 @@ start=$(field StartTime <merge.txt)
 [ "$(ls slurm-"$arrays"_*.out | wc -l)" -eq "$n" ] || fail "$(ls slurm-"$arrays"_*.out | wc -l) task outputs, not $n"
 why=$(recipe_parts "$n") || fail "$why"
 why=$(recipe_same single out) || fail "$why"
-say "ok N=$n, the recipe of docs/scale.md, $(ls out | wc -l) files as the single run"
+say "ok N=$n, the recipe of docs/scale.md, $(ls out | wc -l) files as the single run$([ "$own" = 1 ] && echo ", the merge held back by its dependency")"
