@@ -49,7 +49,7 @@ wd=$(pwd -P)
 unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
 unset SLURM_CPUS_PER_TASK OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
 # the jobs of this test: those whose working folder is this one
-jobs_here() { timeout 10 scontrol -o show job 2>/dev/null | grep " WorkDir=$wd " ; }
+jobs_here() { timeout 10 scontrol -o show job 2>/dev/null | grep -e " WorkDir=$wd " -e " WorkDir=$wd/mpi " ; }
 field() { sed -n "s/^\(.* \)\{0,1\}$1=\([^ ]*\).*/\2/p"; } # NAME=VALUE of each line
 own=0 # 1: the cluster is tools/slurm_local.sh's (below)
 part_up() { [ "$own" = 0 ] || timeout 10 scontrol update PartitionName=local State=UP; }
@@ -94,16 +94,19 @@ fi
 # until every job of this folder has ended (a job pending on a dependency
 # that can never be satisfied has ended too)
 limit=${FRAC_SLURM_WAIT:-90}
-t=0
-while :; do
-    open=$(jobs_here | grep -v -e ' JobState=COMPLETED ' -e ' JobState=FAILED ' -e ' JobState=CANCELLED ' \
-        -e ' JobState=TIMEOUT ' -e ' JobState=OUT_OF_MEMORY ' -e ' JobState=NODE_FAIL ' -e ' Reason=DependencyNeverSatisfied ')
-    [ -n "$open" ] || break
-    [ "$t" -lt "$limit" ] || fail "jobs not done after $limit s: $(echo "$open" | field JobState | sort | uniq -c | tr '\n' ' ')"
-    sleep 1
-    t=$((t + 1))
-done
-jobs_here >jobs.txt
+wait_jobs() {
+    t=0
+    while :; do
+        open=$(jobs_here | grep -v -e ' JobState=COMPLETED ' -e ' JobState=FAILED ' -e ' JobState=CANCELLED ' \
+            -e ' JobState=TIMEOUT ' -e ' JobState=OUT_OF_MEMORY ' -e ' JobState=NODE_FAIL ' -e ' Reason=DependencyNeverSatisfied ')
+        [ -n "$open" ] || break
+        [ "$t" -lt "$limit" ] || fail "jobs not done after $limit s: $(echo "$open" | field JobState | sort | uniq -c | tr '\n' ' ')"
+        sleep 1
+        t=$((t + 1))
+    done
+}
+wait_jobs
+jobs_here | grep " WorkDir=$wd " >jobs.txt
 arrays=$(field ArrayJobId <jobs.txt | sort -u)
 [ "$(echo "$arrays" | grep -c .)" -eq 1 ] || fail "$(echo "$arrays" | grep -c .) job arrays, not 1"
 grep -v " ArrayJobId=" jobs.txt >merge.txt
@@ -124,3 +127,27 @@ start=$(field StartTime <merge.txt)
 why=$(recipe_parts "$n") || fail "$why"
 why=$(recipe_same single out) || fail "$why"
 say "ok N=$n, the recipe of docs/scale.md, $(ls out | wc -l) files as the single run$([ "$own" = 1 ] && echo ", the merge held back by its dependency")"
+
+# mpirun in a batch job (docs/scale.md's mpi.sbatch): every rank inherits the
+# job's SLURM_PROCID=0; --shard auto must take mpirun's rank instead
+if ! command -v mpirun >/dev/null 2>&1; then
+    say "mpirun in a batch job: skipped (mpirun is not installed; Debian: apt-get install openmpi-bin)"
+    exit 0
+fi
+if [ "$(id -u)" = 0 ]; then
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+    export OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
+fi
+mkdir mpi && cp scene.frac mpi/ && cd mpi || exit 1
+recipe_block "tests/shard/slurm_real.sh runs this block as mpi.sbatch" >mpi.sbatch
+grep -q '^mpirun ' mpi.sbatch || fail "no mpirun batch script in docs/scale.md"
+m=$(sed -n 's/^mpirun .*-np \([0-9][0-9]*\) .*/\1/p' mpi.sbatch)
+[ -n "$m" ] || fail "mpi.sbatch: no -np N"
+timeout 60 sbatch --parsable mpi.sbatch </dev/null >submit.out 2>&1 || fail "the submission of mpi.sbatch: $(tail -n 3 submit.out)"
+wait_jobs
+j=$(jobs_here | grep " WorkDir=$wd/mpi ")
+st="$(echo "$j" | field JobState) $(echo "$j" | field ExitCode)"
+[ "$st" = "COMPLETED 0:0" ] || fail "mpi.sbatch: $st; $(tail -n 3 slurm-*.out)"
+why=$(recipe_parts "$m") || fail "mpi.sbatch: $why"
+why=$(recipe_same ../single out) || fail "mpi.sbatch: $why"
+say "mpirun in a batch job: ok N=$m, mpi.sbatch of docs/scale.md, $(ls out | wc -l) files as the single run"
