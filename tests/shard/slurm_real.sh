@@ -100,7 +100,7 @@ wait_jobs() {
         open=$(jobs_here | grep -v -e ' JobState=COMPLETED ' -e ' JobState=FAILED ' -e ' JobState=CANCELLED ' \
             -e ' JobState=TIMEOUT ' -e ' JobState=OUT_OF_MEMORY ' -e ' JobState=NODE_FAIL ' -e ' Reason=DependencyNeverSatisfied ')
         [ -n "$open" ] || break
-        [ "$t" -lt "$limit" ] || fail "jobs not done after $limit s: $(echo "$open" | field JobState | sort | uniq -c | tr '\n' ' ')"
+        [ "$t" -lt "$limit" ] || fail "jobs not done after $limit s: $(echo "$open" | sed -n 's/.* JobState=\([^ ]*\) Reason=\([^ ]*\).*/\1 (\2)/p' | sort | uniq -c | sed 's/^ *//' | paste -sd, -)"
         sleep 1
         t=$((t + 1))
     done
