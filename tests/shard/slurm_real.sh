@@ -7,12 +7,15 @@
 # COMPLETED with exit code 0, the merge must have started no earlier than the
 # last task ended, there must be one slurm-ARRAY_TASK.out a task, parts/ must
 # hold one part a task, and out/ must equal the single run's files, byte for
-# byte (tests/cli/shard_slurm_real.cli).
+# byte (tests/cli/shard_slurm_real.cli). On tools/slurm_local.sh's cluster the
+# merge job is first made free to start before the array (below). Then, when
+# mpirun is installed, the doc's mpi.sbatch (mpirun in a batch job) runs the
+# same way: one job, COMPLETED 0:0, its merged files equal to the single run.
 #
 # The cluster: the one of $SLURM_CONF, else /tmp/frac-slurm/slurm.conf when it
 # exists (what `tools/slurm_local.sh start` writes), else Slurm's default
-# configuration. Prints "slurm (real Slurm): ok N=…", or "slurm (real Slurm):
-# skipped (…)" when Slurm is not installed or no controller answers; exits
+# configuration. Prints "slurm (real Slurm): ok N=…" (and a line for
+# mpi.sbatch), or "slurm (real Slurm): skipped (…)" when Slurm is not installed or no controller answers; exits
 # non-zero on a failure. The test folder is made in $TMPDIR (default /tmp):
 # on a cluster of several machines set TMPDIR to a folder every node sees,
 # with the frac under test in one too. Every wait has a time limit
@@ -48,7 +51,7 @@ wd=$(pwd -P)
 # a task sees Slurm's variables only, as in a job (none of another launcher's)
 unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
 unset SLURM_CPUS_PER_TASK OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
-# the jobs of this test: those whose working folder is this one
+# the jobs of this test: those whose working folder is this one or its mpi/
 jobs_here() { timeout 10 scontrol -o show job 2>/dev/null | grep -e " WorkDir=$wd " -e " WorkDir=$wd/mpi " ; }
 field() { sed -n "s/^\(.* \)\{0,1\}$1=\([^ ]*\).*/\2/p"; } # NAME=VALUE of each line
 own=0 # 1: the cluster is tools/slurm_local.sh's (below)
