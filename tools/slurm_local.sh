@@ -37,7 +37,7 @@ wait_for() {
     done
     return 1
 }
-munge_ok() { munge -n </dev/null | timeout 5 unmunge; }
+munge_ok() { timeout 5 munge -n </dev/null | timeout 5 unmunge; }
 ping_ok() { timeout 5 scontrol -o ping | grep -q 'is UP'; }
 node_idle() { timeout 5 sinfo -h -N -o %t | grep -qx 'idle'; }
 stop_pid() { # the daemon whose pid file is $1, if it runs; up to 10 s
@@ -87,9 +87,9 @@ if ! munge_ok >/dev/null 2>&1; then
     mkdir -p /run/munge /var/log/munge /var/lib/munge || exit 1
     if id munge >/dev/null 2>&1; then
         chown munge:munge /run/munge /var/log/munge /var/lib/munge
-        runuser -u munge -- munged || die "munged did not start"
+        timeout 15 runuser -u munge -- munged || die "munged did not start"
     else
-        munged --force || die "munged did not start"
+        timeout 15 munged --force || die "munged did not start"
     fi
     wait_for 10 munge_ok || die "munged does not answer after 10 s"
     cp /run/munge/munged.pid "$dir/munged.pid" 2>/dev/null
@@ -124,8 +124,8 @@ stop_pid "$dir/slurmd.pid"
 stop_pid "$dir/slurmctld.pid"
 # a fresh cluster: no jobs or cluster name of an earlier one
 rm -rf "$dir/state" "$dir/spool" && mkdir "$dir/state" "$dir/spool" || exit 1
-slurmctld -c -f "$SLURM_CONF" || die "slurmctld did not start (see $dir/slurmctld.log)"
+timeout 15 slurmctld -c -f "$SLURM_CONF" || die "slurmctld did not start (see $dir/slurmctld.log)"
 wait_for 15 ping_ok || die "slurmctld does not answer after 15 s (see $dir/slurmctld.log)"
-slurmd -f "$SLURM_CONF" || die "slurmd did not start (see $dir/slurmd.log)"
+timeout 15 slurmd -f "$SLURM_CONF" || die "slurmd did not start (see $dir/slurmd.log)"
 wait_for 15 node_idle || die "node $host not idle after 15 s: $(sinfo -h -N -o '%t %E' 2>&1) (see $dir/slurmd.log)"
 echo "export SLURM_CONF=$SLURM_CONF"
