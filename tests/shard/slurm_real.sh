@@ -43,7 +43,7 @@ fi
 ping=$(timeout 10 scontrol -o ping 2>&1)
 case $ping in
 *"is UP"*) ;;
-*) say "skipped (no Slurm controller answers${SLURM_CONF:+ for $SLURM_CONF}: $(echo "$ping" | tail -n 1 | cut -c 1-120); tools/slurm_local.sh start brings one up)"
+*) say "skipped (no Slurm controller answers${SLURM_CONF:+ for $SLURM_CONF}: $( (echo "$ping" | grep -e 'is DOWN' -e 'fatal:'; echo "$ping") | head -n 1 | cut -c 1-120); tools/slurm_local.sh start brings one up)"
    exit 0 ;;
 esac
 recipe_setup slurm-real
