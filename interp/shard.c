@@ -133,7 +133,7 @@ int shard_init_run(shard *s, const char *spec)
             }
             /* a list (--array=1,4,7) has no step: Slurm sets 1, and its gaps give
                a number out of range here */
-            if (m && ((i - mn) % st != 0 || i < mn || (i - mn) / st >= n)) {
+            if (launchers[k].min && ((i - mn) % st != 0 || i < mn || (i - mn) / st >= n)) {
                 fprintf(stderr,
                         "frac: --shard auto: %s=%s with %s=%ld, %s=%ld and %s=%ld is not a shard: "
                         "(ID - MIN) / STEP must be a whole number in 0..%ld (an --array range A-B or A-B:S "
@@ -142,7 +142,7 @@ int shard_init_run(shard *s, const char *spec)
                         n - 1);
                 return -1;
             }
-            if (!m && (i < 0 || i >= n)) {
+            if (!launchers[k].min && (i < 0 || i >= n)) {
                 fprintf(stderr, "frac: --shard auto: %s=%s gives shard %ld, not in 0..%ld\n(run `frac --help` for usage)\n",
                         launchers[k].rank, r, i, n - 1);
                 return -1;
