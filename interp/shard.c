@@ -88,13 +88,18 @@ static void chunk_range(size_t nchunks, int i, int n, size_t *lo, size_t *hi)
 
 /* ---- the command line ------------------------------------------------------------ */
 
+/* In this order. An MPI launcher's rank comes before SLURM_PROCID: a batch
+ * job's script is task 0 of its job, so every rank that `mpirun` starts in
+ * it inherits SLURM_PROCID=0 (seen on Slurm 22.05, tests/shard/slurm_real.sh);
+ * only srun sets SLURM_PROCID a task. An array task's number (min and step
+ * taken off: --array=A-B:S) comes first, as the one a user asked for. */
 static const struct {
-    const char *rank, *size, *min;
+    const char *rank, *size, *min, *step;
 } launchers[] = {
-    {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN"},
-    {"SLURM_PROCID", "SLURM_NTASKS", NULL},
-    {"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE", NULL},
-    {"PMI_RANK", "PMI_SIZE", NULL},
+    {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_STEP"},
+    {"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE", NULL, NULL},
+    {"PMI_RANK", "PMI_SIZE", NULL, NULL},
+    {"SLURM_PROCID", "SLURM_NTASKS", NULL, NULL},
 };
 
 static void shard_zero(shard *s)
@@ -116,25 +121,38 @@ int shard_init_run(shard *s, const char *spec)
             const char *r = getenv(launchers[k].rank), *z = getenv(launchers[k].size);
             if (!r)
                 continue;
-            long mn = 0;
-            if (parse_count(r, 0, &i) || parse_count(z, 1, &n) ||
-                (launchers[k].min && getenv(launchers[k].min) && parse_count(getenv(launchers[k].min), 0, &mn))) {
+            long mn = 0, st = 1;
+            const char *m = launchers[k].min ? getenv(launchers[k].min) : NULL;
+            const char *t = launchers[k].step ? getenv(launchers[k].step) : NULL;
+            if (parse_count(r, 0, &i) || parse_count(z, 1, &n) || (m && parse_count(m, 0, &mn)) ||
+                (t && parse_count(t, 1, &st))) {
                 fprintf(stderr, "frac: --shard auto: %s=%s with %s=%s is not a shard number and count\n"
                                 "(run `frac --help` for usage)\n",
                         launchers[k].rank, r, launchers[k].size, z ? z : "(unset)");
                 return -1;
             }
-            i -= mn;
-            if (i < 0 || i >= n) {
+            /* a list (--array=1,4,7) has no step: Slurm sets 1, and its gaps give
+               a number out of range here */
+            if (launchers[k].min && ((i - mn) % st != 0 || i < mn || (i - mn) / st >= n)) {
+                fprintf(stderr,
+                        "frac: --shard auto: %s=%s with %s=%ld, %s=%ld and %s=%ld is not a shard: "
+                        "(ID - MIN) / STEP must be a whole number in 0..%ld (an --array range A-B or A-B:S "
+                        "numbers the shards, a list does not)\n(run `frac --help` for usage)\n",
+                        launchers[k].rank, r, launchers[k].min, mn, launchers[k].step, st, launchers[k].size, n,
+                        n - 1);
+                return -1;
+            }
+            if (!launchers[k].min && (i < 0 || i >= n)) {
                 fprintf(stderr, "frac: --shard auto: %s=%s gives shard %ld, not in 0..%ld\n(run `frac --help` for usage)\n",
                         launchers[k].rank, r, i, n - 1);
                 return -1;
             }
+            i = (i - mn) / st;
             break;
         }
         if (k == sizeof launchers / sizeof launchers[0]) {
-            fprintf(stderr, "frac: --shard auto: no launcher environment found (SLURM_ARRAY_TASK_ID, SLURM_PROCID, "
-                            "OMPI_COMM_WORLD_RANK or PMI_RANK); give --shard I/N\n(run `frac --help` for usage)\n");
+            fprintf(stderr, "frac: --shard auto: no launcher environment found (SLURM_ARRAY_TASK_ID, "
+                            "OMPI_COMM_WORLD_RANK, PMI_RANK or SLURM_PROCID); give --shard I/N\n(run `frac --help` for usage)\n");
             return -1;
         }
     } else {

@@ -16,8 +16,12 @@
 #   default --chdir). --wrap=CMD submits the script "#!/bin/sh", CMD.
 # - Each job gets the next job ID (FAKE_SLURM_STATE/next, from 1000). An
 #   array of K tasks takes K IDs: task k runs with SLURM_JOB_ID = the first
-#   + k and SLURM_ARRAY_JOB_ID = the first, which is the array's ID.
-# - A task sees SLURM_JOB_ID, SLURM_JOBID, SLURM_SUBMIT_DIR, and for an array
+#   + k and SLURM_ARRAY_JOB_ID = the first, which is the array's ID. (Slurm
+#   22.05 gives the array's ID to its last task and later IDs to the others:
+#   frac reads neither.)
+# - A task sees SLURM_JOB_ID, SLURM_JOBID, SLURM_SUBMIT_DIR, SLURM_PROCID=0
+#   (a batch script is task 0 of its job; no SLURM_NTASKS without --ntasks,
+#   as on Slurm 22.05, tests/shard/slurm_real.sh), and for an array
 #   SLURM_ARRAY_JOB_ID, SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT,
 #   SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_MAX, SLURM_ARRAY_TASK_STEP;
 #   SLURM_CPUS_PER_TASK only when --cpus-per-task was given (as Slurm).
@@ -51,8 +55,8 @@ task() { # TASK_JOB_ID OUTPUT [ARRAY_TASK_ID], then the script's arguments
     shift 3
     (
         cd "$submit_dir" || exit 1
-        SLURM_JOB_ID=$tj SLURM_JOBID=$tj SLURM_SUBMIT_DIR=$submit_dir
-        export SLURM_JOB_ID SLURM_JOBID SLURM_SUBMIT_DIR
+        SLURM_JOB_ID=$tj SLURM_JOBID=$tj SLURM_SUBMIT_DIR=$submit_dir SLURM_PROCID=0
+        export SLURM_JOB_ID SLURM_JOBID SLURM_SUBMIT_DIR SLURM_PROCID
         if [ -n "$cpus" ]; then SLURM_CPUS_PER_TASK=$cpus && export SLURM_CPUS_PER_TASK; fi
         if [ -n "$ti" ]; then
             SLURM_ARRAY_JOB_ID=$jid SLURM_ARRAY_TASK_ID=$ti SLURM_ARRAY_TASK_COUNT=$count

@@ -52,7 +52,7 @@ case_ "format 3" "$s" "$p-0-of-3.part" "$tmp/v3.part" "$p-2-of-3.part"
 case_ "not a part" "$s" "$p-0-of-3.part" "$s" "$p-2-of-3.part"
 case_ "unreadable" "$s" "$p-0-of-3.part" "$tmp/none.part" "$p-2-of-3.part"
 # --shard auto: each launcher's variables (the others unset)
-unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
+unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_ARRAY_TASK_STEP SLURM_PROCID SLURM_NTASKS
 unset OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
 auto() { # NAME, then VAR=VALUE words
     name=$1
@@ -66,4 +66,11 @@ auto "slurm tasks" SLURM_PROCID=2 SLURM_NTASKS=5
 auto "open mpi" OMPI_COMM_WORLD_RANK=0 OMPI_COMM_WORLD_SIZE=2
 auto "pmi" PMI_RANK=1 PMI_SIZE=3
 auto "bad" PMI_RANK=3 PMI_SIZE=3
+# --array=0-6:2 (Slurm sets the step); --array=1,4,7 (a list: Slurm sets step 1)
+auto "slurm array step" SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_COUNT=4 SLURM_ARRAY_TASK_MIN=0 SLURM_ARRAY_TASK_STEP=2
+auto "slurm array list" SLURM_ARRAY_TASK_ID=4 SLURM_ARRAY_TASK_COUNT=3 SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_STEP=1
+# mpirun in a Slurm batch job: every rank has the job's SLURM_PROCID=0;
+# srun in an array task: SLURM_PROCID=0 of 1 beside the task's number
+auto "mpirun in sbatch" OMPI_COMM_WORLD_RANK=1 OMPI_COMM_WORLD_SIZE=3 SLURM_PROCID=0 SLURM_NTASKS=3
+auto "srun in an array" SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=4 SLURM_ARRAY_TASK_MIN=0 SLURM_PROCID=0 SLURM_NTASKS=1
 auto "none" X=1
