@@ -357,8 +357,26 @@ rt_code png_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
         return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", im->w, im->h);
     unsigned maxval = bits == 16 ? 65535 : 255;
     unsigned char *o = s;
+    /* pending pixels (image.h) are made band by band into a small buffer,
+     * so the float image is never written whole */
+    size_t band = 1, bw = (size_t)im->w * 4;
+    float *buf = NULL;
+    if (im->src) {
+        band = bw >= 65536 ? 1 : 65536 / bw;
+        buf = rt_mallocn(band, bw * sizeof(float));
+        if (!buf) {
+            rt_free(s);
+            return rt_fail(e, RT_ENOMEM, "out of memory encoding a %d×%d PNG", im->w, im->h);
+        }
+    }
+    size_t i0 = 0; /* the first pixel in buf */
     for (size_t i = 0; i < np; i++) {
-        const float *p = im->px + 4 * i;
+        if (buf && i % (band * (size_t)im->w) == 0) {
+            int y0 = (int)(i / (size_t)im->w), y1 = y0 + (int)band < im->h ? y0 + (int)band : im->h;
+            image_rows(im, y0, y1, buf);
+            i0 = i;
+        }
+        const float *p = buf ? buf + 4 * (i - i0) : im->px + 4 * i;
         float v[4];
         int k = 0;
         if (channels <= 2)
@@ -374,6 +392,7 @@ rt_code png_encode(const image *im, int bits, int channels, bytebuf *out, rt_err
             *o++ = (unsigned char)q;
         }
     }
+    rt_free(buf);
     c = png_encode_samples(s, im->w, im->h, channels, bits, PNG_DEFAULT_LEVEL, out, NULL, e);
     rt_free(s);
     return c;
@@ -712,6 +731,7 @@ rt_code png_decode(const unsigned char *data, size_t n, image *im, png_info *inf
 {
     im->w = im->h = 0;
     im->px = NULL;
+    im->src = NULL;
     rt_code c = check_sig(data, n, e);
     if (c)
         return c;
