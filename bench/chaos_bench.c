@@ -331,8 +331,8 @@ static void fresh_report(void)
         {"  ... pixels made ready (float image written)", job_render2_ready, 24},
         {"  the window pre-pass alone (chaos_fit)", job_fit, 0},
         {"plain 2-D loop + PNG of its counts", job_plain2_png, 8},
-        {"chaos render 1024^2 + PNG encode (RGBA 8-bit)", job_render2_png, 12},
-        {"chaos render 1024^2, colour blend", job_render2_colour, 20},
+        {"chaos render 1024^2 + PNG encode (RGBA 8-bit)", job_render2_png, 16},
+        {"chaos render 1024^2, colour blend", job_render2_colour, 36},
         {"plain 3-D loop (256^3 uint32, prefetch ring)", job_plain3, 64},
         {"chaos measure 256^3 (counts, float volume)", job_measure3, 64},
     };
@@ -353,10 +353,11 @@ static void fresh_report(void)
             printf("  %-46s %8.4f %8.4f %8.1f %8s %8s %7ld\n", jobs[i].what, cpu[i], med - base_med, rss, "-", "-",
                    f.faults - base.faults);
     }
-    printf("  (data: what the job must hold at once; 2-D render: 8 B/px counts (the pixels pending; the\n"
-           "   image's 16 B/px are allocated, not touched), made ready + 16 B/px float RGBA image, with\n"
-           "   PNG + 4 B/px samples, with colour 20 B/px histogram; plain + PNG: 4 B/px counts + 4 B/px\n"
-           "   samples; 3-D: the 4 B/voxel float volume)\n");
+    printf("  (data: what the job must hold at once. 2-D render: 8 B/px counts (the pixels pending: the\n"
+           "   image's 16 B/px are allocated, not touched); made ready: + the 16 B/px float RGBA image;\n"
+           "   + PNG: the counts, 4 B/px samples and 4 B/px filtered rows; plain + PNG: samples and filtered\n"
+           "   rows (its counts are freed first); colour: 20 B/px histogram + the worker's 16 B/px cells;\n"
+           "   3-D: the 4 B/voxel float volume)\n");
     printf("  fixed cost of a 1024^2 chaos render (fit, counts, tone map) vs the plain loop: %.2fx CPU,"
            " best of %d each (goal <= 2x); without the pre-pass %.2fx\n", cpu[1] / cpu[0], FRESH_REPS,
            (cpu[1] - cpu[3]) / cpu[0]);
