@@ -42,6 +42,50 @@ static double density(tonemap_curve curve, uint64_t c, uint64_t mx, double lmx, 
     return v > 1 ? 1 : v;
 }
 
+/* The largest of n counts. The OR of a block of counts is at least their
+ * maximum, so a block whose OR is not above the maximum so far holds
+ * nothing new: most blocks of a render (empty or sparse bins) cost only
+ * the ORs, 2 counts per instruction with vector extensions (SSE2 on
+ * x86-64, as png.c), instead of a compare and select per bin. */
+#if defined(__GNUC__) || defined(__clang__)
+typedef uint64_t tm_v2u64 __attribute__((vector_size(16)));
+static uint64_t block_or(const uint64_t *c) /* 64 counts */
+{
+    tm_v2u64 o0, o1, o2, o3, v;
+    memcpy(&o0, c, sizeof v), memcpy(&o1, c + 2, sizeof v);
+    memcpy(&o2, c + 4, sizeof v), memcpy(&o3, c + 6, sizeof v);
+    for (int i = 8; i < 64; i += 8) {
+        memcpy(&v, c + i, sizeof v), o0 |= v;
+        memcpy(&v, c + i + 2, sizeof v), o1 |= v;
+        memcpy(&v, c + i + 4, sizeof v), o2 |= v;
+        memcpy(&v, c + i + 6, sizeof v), o3 |= v;
+    }
+    v = (o0 | o1) | (o2 | o3);
+    return v[0] | v[1];
+}
+#else
+static uint64_t block_or(const uint64_t *c)
+{
+    uint64_t o = 0;
+    for (int i = 0; i < 64; i++)
+        o |= c[i];
+    return o;
+}
+#endif
+
+static uint64_t max_count(const uint64_t *c, size_t n)
+{
+    uint64_t mx = 0;
+    size_t b = 0;
+    for (; b + 64 <= n; b += 64)
+        if (block_or(c + b) > mx)
+            for (int i = 0; i < 64; i++)
+                mx = c[b + i] > mx ? c[b + i] : mx;
+    for (; b < n; b++)
+        mx = c[b] > mx ? c[b] : mx;
+    return mx;
+}
+
 /* Everything the pixels depend on besides the bins, found once: the
  * checked options, k, M and the tables of small counts. tonemap_apply fills
  * every row from it at once; tonemap_defer keeps it (and the histogram) as
@@ -83,9 +127,7 @@ static rt_code plan_init(tm_plan *p, const hist2 *hs, const tonemap_opts *o, con
     size_t npx = (size_t)im->w * (size_t)im->h;
     uint64_t mx = 0;
     if (k == 1) {
-        const uint64_t *cnt = hs->count;
-        for (size_t b = 0; b < npx; b++)
-            mx = cnt[b] > mx ? cnt[b] : mx;
+        mx = max_count(hs->count, npx);
     } else {
         for (int y = 0; y < im->h; y++)
             for (int x = 0; x < im->w; x++) {

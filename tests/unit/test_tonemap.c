@@ -85,8 +85,41 @@ static void both_ways(int k, const tonemap_opts *o, int with_colour, const char 
     hist2_free(&ha);
 }
 
+/* M, the largest count, wherever it lies: first bin, the end of a 64-bin
+ * block, the start of the next, the short tail (the maximum pass skips
+ * blocks by their OR); every other bin holds an OR-rich pattern below M.
+ * Linear grey: a bin of count c is c / M, so a wrong M shows everywhere. */
+static void test_max_anywhere(void)
+{
+    rt_error e;
+    double lo[2] = {0, 0}, hi[2] = {1, 1};
+    const int w = 64 * 3 + 5; /* 197 bins: three blocks and a tail of 5 */
+    int where[] = {0, 63, 64, 130, 191, 192, 196};
+    for (size_t t = 0; t < sizeof where / sizeof where[0]; t++) {
+        hist2 hs;
+        image im;
+        CHECK(hist2_init(&hs, w, 1, lo, hi, 0, &e) == RT_OK && image_init(&im, w, 1, &e) == RT_OK, "hist");
+        const uint64_t M = 1000;
+        for (int b = 0; b < w; b++)
+            hs.count[b] = (uint64_t)(b * 37 % 999); /* below M; ORs of blocks reach 1023 > M */
+        hs.count[where[t]] = M;
+        tonemap_opts o = {0};
+        o.curve = TONEMAP_LINEAR;
+        CHECK(tonemap_apply(&hs, &o, &im, &e) == RT_OK, "apply");
+        int bad = 0;
+        for (int b = 0; b < w; b++) {
+            double want = hs.count[b] ? (double)hs.count[b] / (double)M : 0;
+            bad += fabs(im.px[4 * b] - want) > 1e-6;
+        }
+        CHECK(bad == 0, "maximum at bin %d: %d pixels off", where[t], bad);
+        image_free(&im);
+        hist2_free(&hs);
+    }
+}
+
 int main(void)
 {
+    test_max_anywhere();
     ramp rp = ramp_grey();
     rp.n = 3; /* red, green at 0.3, blue: channels that differ */
     double pos[3] = {0, 0.3, 1};
