@@ -565,7 +565,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
         if (!c)
             report_work(I, "chaos game", "points", (double)co.points, t0);
         if (!c && !lang_image_new(I, w, h, &im))
-            c = tonemap_apply(&hs, &t, im, &e);
+            c = tonemap_defer(&hs, &t, im, &e); /* pixels pending until read (tonemap.h) */
         hist2_free(&hs);
     }
     if (c || !im) {

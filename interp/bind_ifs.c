@@ -670,9 +670,9 @@ static int b_chaos(interp *I, value *a, int n, value *out)
         *out = val_nil();
         return 0;
     }
-    image *im = NULL;
+    image *im = NULL; /* pixels pending until read: a PNG save tone-maps band by band */
     if (!c && !lang_image_new(I, w, h, &im))
-        c = tonemap_apply(&hs, &t, im, &e);
+        c = tonemap_defer(&hs, &t, im, &e);
     hist2_free(&hs);
     if (c || !im) {
         lang_image_discard(im);

@@ -100,7 +100,14 @@ int lang_image_finish(interp *I, image *im, rt_code c, const rt_error *e, const 
 
 image *lang_as_image(value v)
 {
-    return v.k == V_OBJ && AS_OBJ(v)->cls == &lang_image_class ? AS_OBJ(v)->payload : NULL;
+    if (v.k != V_OBJ || AS_OBJ(v)->cls != &lang_image_class)
+        return NULL;
+    /* every reader of an image's pixels comes here: pending pixels (a chaos
+     * render's tone map, tonemap.h) are made now; save reaches the codecs
+     * through the class's hook without this, so a PNG is encoded band by band */
+    image *im = AS_OBJ(v)->payload;
+    image_ready(im);
+    return im;
 }
 
 int lang_get_colour(interp *I, value v, float rgba[4], const char *what)

@@ -13,17 +13,41 @@
 
 #include "rt.h"
 
+typedef struct image_src image_src;
+
 typedef struct image {
     int w, h;
     float *px; /* w * h * 4 floats; NULL: no pixels (mem is then ignored) */
     void *mem; /* the block px lies in: big images start on a 2 MiB boundary
                 * (rt_calloc_huge), so filling one faults in huge pages only */
+    image_src *src; /* NULL, or the pixels are pending (see below) */
 } image;
+
+/* Pending pixels. A renderer whose last stage is a pure function of data it
+ * holds (tonemap.h: a histogram) may leave the pixels to be computed when
+ * they are needed: px is allocated but not written (fresh zero pages, not
+ * yet faulted in) and src computes any band of rows. image_rows reads a band
+ * either way, so an encoder can run band by band without the full float
+ * image ever being written (png_encode does); image_ready fills px from src
+ * and drops src, after which the image is an ordinary one. Both give the
+ * same floats. rows cannot fail: all checks and allocations happen when
+ * the source is made. */
+struct image_src {
+    /* rows [y0, y1) into out (w * 4 floats per row) */
+    void (*rows)(const image_src *s, int y0, int y1, float *out);
+    void (*destroy)(image_src *s); /* frees s and what it holds */
+};
 
 /* Allocate a w×h image filled with transparent black. w, h >= 1. */
 rt_code image_init(image *im, int w, int h, rt_error *e);
 void image_free(image *im);
-/* Deep copy. */
+/* Fill the pixels of an image whose pixels are pending (nothing otherwise).
+ * The pixel values do not change, so it takes a const image: every reader of
+ * px calls it first (codecs, the interpreter's image values). */
+void image_ready(const image *im);
+/* Rows [y0, y1) into out (w * 4 floats per row), pending or not. */
+void image_rows(const image *im, int y0, int y1, float *out);
+/* Deep copy (the copy is ready). */
 rt_code image_copy(image *dst, const image *src, rt_error *e);
 
 static inline float *image_at(const image *im, int x, int y)

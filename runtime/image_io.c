@@ -56,6 +56,7 @@ rt_code image_read_file(const char *path, size_t max, image *im, unsigned char *
 {
     im->w = im->h = 0;
     im->px = NULL;
+    im->src = NULL;
     return fileio_read_all(path, max, d, n, e);
 }
 

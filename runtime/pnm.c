@@ -85,6 +85,7 @@ static rt_code read_head(image *im, const unsigned char *d, size_t n, const char
 {
     im->w = im->h = 0;
     im->px = NULL;
+    im->src = NULL;
     if (n < 2 || d[0] != 'P' || (d[1] != kinds[0] && d[1] != kinds[1]))
         return rt_fail(e, RT_EFORMAT, "%s", not_msg);
     int ch = d[1] == kinds[0] ? 1 : 3;
@@ -116,6 +117,7 @@ static rt_code start_data(hdr *h, size_t bps, image *im, rt_error *e)
 
 rt_code pnm_encode(const image *im, int bits, int channels, bytebuf *out, rt_error *e)
 {
+    image_ready(im);
     if (bits != 8 && bits != 16)
         return rt_fail(e, RT_EINVAL, "PGM/PPM bit depth %d is invalid (expected 8 or 16)", bits);
     if (channels != 1 && channels != 3)
@@ -195,6 +197,7 @@ rt_code pnm_decode(const unsigned char *d, size_t n, image *im, pnm_info *info, 
 
 rt_code pfm_encode(const image *im, int channels, bytebuf *out, rt_error *e)
 {
+    image_ready(im);
     if (channels != 1 && channels != 3)
         return rt_fail(e, RT_EINVAL, "PFM channels %d is invalid (expected 1 or 3)", channels);
     bytebuf_printf(out, "P%c\n%d %d\n-1.0\n", channels == 1 ? 'f' : 'F', im->w, im->h);

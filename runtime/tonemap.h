@@ -42,5 +42,14 @@ typedef struct tonemap_opts {
  * Reads hs in place (two passes: the maximum, then the pixels); allocates
  * nothing. */
 rt_code tonemap_apply(const hist2 *hs, const tonemap_opts *o, image *im, rt_error *e);
+/* The same map with im's pixels left pending (image.h): the maximum pass
+ * and the checks run now, the pixels when they are read (image_rows, e.g.
+ * png_encode band by band) or made ready (image_ready), with the same
+ * floats as tonemap_apply. On success im owns hs's arrays (hs is left
+ * empty; hist2_free on it is harmless) and frees them when the pixels are
+ * made or the image is freed; on failure hs and im are unchanged. The cost
+ * of a render saved as PNG without ever being inspected: no 16 B/pixel
+ * float image is written, the bins (8 B/pixel) are held instead. */
+rt_code tonemap_defer(hist2 *hs, const tonemap_opts *o, image *im, rt_error *e);
 
 #endif

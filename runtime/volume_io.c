@@ -612,6 +612,7 @@ rt_code volume_slice_axis(const volume *v, int axis, int index, const ramp *r, d
     static const char *axn = "xyz";
     int n[3] = {v->nx, v->ny, v->nz};
     out->px = NULL;
+    out->src = NULL;
     if (axis < 0 || axis > 2)
         return rt_fail(e, RT_EINVAL, "slice axis %d is not 0 (x), 1 (y) or 2 (z)", axis);
     if (index < 0 || index >= n[axis])

@@ -225,7 +225,7 @@ static void test_size_and_errors(void)
     t.cols = 3;
     t.max_rows = -1;
     CHECK(termview_render(&im, &t, &b, &e) == RT_EINVAL && strstr(e.msg, "got -1"), "max_rows -1: %s", e.msg);
-    image empty = {0, 0, NULL, NULL};
+    image empty = {0, 0, NULL, NULL, NULL};
     t.max_rows = 0;
     CHECK(termview_render(&empty, &t, &b, &e) == RT_EINVAL && strstr(e.msg, "empty"), "empty image: %s", e.msg);
     CHECK(b.len == 0, "nothing written on error");
