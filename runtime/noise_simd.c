@@ -77,14 +77,39 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
 /* Eight points at a time: the hash chain runs in 32-bit lanes, one gather
  * per level and corner pair (seven per eight points, instead of 56 scalar
  * loads with their index arithmetic), while the floors, fades, gradients
- * and lerps run on two 4-double vectors per quantity. The gradient coefficients come from the hash bytes
- * by a 16-entry byte table lookup (pshufb) and exact int8 -> int32 -> double
- * conversions: the values ±1 and 0 of noise_gpairs, no memory gather. */
-ALWAYS_INLINE v4d cvt4(const int8_t *c)
+ * and lerps run on two 4-double vectors per quantity.
+ *
+ * The gradient coefficients are doubles made by byte shuffles alone, no
+ * int -> double conversion: the top byte of 2.0, -2.0 and +0.0 (0x40,
+ * 0xC0, 0x00; their other seven bytes are zero) comes from the hash by a
+ * 16-entry table lookup (pshufb, coef8_avx2), and one pshufb per
+ * coefficient vector puts four points' bytes into the top bytes of four
+ * zeroed lanes (coef4). So the kernel computes with 2g for every gradient
+ * coefficient g, and every value it forms is exactly twice perlin()'s,
+ * rounded the same, as long as no product rounds to a subnormal:
+ *   - 2c * d = 2 (c * d) exactly for c in {-1, 0, 1} (zeros keep their
+ *     sign: (2 * 0) * -0 = -0 = 2 * (0 * -0)); |d| <= 1, no overflow;
+ *   - sums and differences of doubles scale exactly by 2 (when the result
+ *     is subnormal the operation is exact, in either computation);
+ *   - a product t * 2e rounds like 2 (t * e) when t * e is normal: rounding
+ *     commutes with a power of two in the normal range;
+ *   - 0.5 * 2r = r exactly.
+ * Products round to subnormals only if a fraction (x - floor x etc.) is
+ * tiny, so a group goes the fast way only if all 24 of its fractions are
+ * >= 2^-30 (which also excludes ±0): then every gradient is a multiple of
+ * 2^-82 (the fractions are, to within their ulp), the fades are >= 2^-90
+ * (fade(t) >= t^3 on [0, 1]), the first products |u (b - a)| >= 2^-172 and
+ * the values after them multiples of 2^-224, the second products
+ * >= 2^-314, multiples of 2^-366 after, the last >= 2^-456: all normal.
+ * Other groups (lattice points, -0, tiny coordinates; rare on scattered
+ * points) multiply the shuffled coefficients by 0.5 first — exactly ±1, +0,
+ * the scalar's own coefficients — and compute perlin()'s operations as they
+ * are (half4 with exact = 1). */
+ALWAYS_INLINE v4d coef4(const int8_t *c8, __m256i place)
 {
-    int32_t w;
-    memcpy(&w, c, 4);
-    return (v4d)_mm256_cvtepi32_pd(_mm_cvtepi8_epi32(_mm_cvtsi32_si128(w)));
+    int64_t w;
+    memcpy(&w, c8, 8);
+    return (v4d)_mm256_shuffle_epi8(_mm256_set1_epi64x(w), place);
 }
 
 /* floor of each lane (|v| < 2^30) as perlin() computes it: +0 for -0 */
@@ -96,38 +121,50 @@ ALWAYS_INLINE v4d floor4(v4d v)
 
 ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
-/* the lerps of four points (lanes 4k..4k+3 of the eight) */
-ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0)
+/* the lerps of four points (lanes 4k..4k+3 of the eight); exact: see above */
+ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0, int exact)
 {
-    const v4d one = {1, 1, 1, 1};
+    const v4d one = {1, 1, 1, 1}, half = {0.5, 0.5, 0.5, 0.5};
     v4d u = fade4(x0), v = fade4(y0), w = fade4(z0);
     v4d x1 = x0 - one, y1 = y0 - one, z1 = z0 - one;
-#define G(c, xc, yc, zc, o) (cvt4(&cf[c][0][o]) * (xc) + cvt4(&cf[c][1][o]) * (yc) + cvt4(&cf[c][2][o]) * (zc))
-    int o0 = 4 * k, o1 = 4 * k + 8;
-    v4d g00 = G(0, x0, y0, z0, o0), g10 = G(1, x1, y0, z0, o0);
-    v4d g01 = G(2, x0, y1, z0, o0), g11 = G(3, x1, y1, z0, o0);
+    /* byte 7 of lane j <- byte j (at z) or 4 + j (at z + 1) of the four
+     * points' eight coefficient bytes, every other byte zero */
+#define PL(b) _mm256_setr_epi8(-1, -1, -1, -1, -1, -1, -1, (char)(b), -1, -1, -1, -1, -1, -1, -1, (char)((b) + 1), \
+                               -1, -1, -1, -1, -1, -1, -1, (char)((b) + 2), -1, -1, -1, -1, -1, -1, -1, (char)((b) + 3))
+    const __m256i pl0 = PL(0), pl1 = PL(4);
+#undef PL
+#define C(c, ax, pl) (exact ? coef4(cf[c][ax] + 8 * k, pl) * half : coef4(cf[c][ax] + 8 * k, pl))
+#define G(c, xc, yc, zc, pl) (C(c, 0, pl) * (xc) + C(c, 1, pl) * (yc) + C(c, 2, pl) * (zc))
+    v4d g00 = G(0, x0, y0, z0, pl0), g10 = G(1, x1, y0, z0, pl0);
+    v4d g01 = G(2, x0, y1, z0, pl0), g11 = G(3, x1, y1, z0, pl0);
     v4d a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
     v4d c0 = a + v * (b - a);
-    g00 = G(0, x0, y0, z1, o1), g10 = G(1, x1, y0, z1, o1);
-    g01 = G(2, x0, y1, z1, o1), g11 = G(3, x1, y1, z1, o1);
+    g00 = G(0, x0, y0, z1, pl1), g10 = G(1, x1, y0, z1, pl1);
+    g01 = G(2, x0, y1, z1, pl1), g11 = G(3, x1, y1, z1, pl1);
     a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
     v4d c1 = a + v * (b - a);
 #undef G
-    return c0 + w * (c1 - c0);
+#undef C
+    v4d r = c0 + w * (c1 - c0);
+    return exact ? r : r * half;
 }
 
 /* The gradient coefficients of the 64 corners of eight points from their
  * pairs' gradient numbers: byte 3 of lane j of hq[c] = p[512 + the pair
  * index] (noise.h) of corner pair c (AA, BA, AB, BB) of point j (as
- * hash8_avx2 gathers them); cf[c][axis][l]: lanes l = 0..7 at z, 8..15 at
- * z + 1. */
+ * stage3_avx2 gathers them); cf[c][axis][l]: the top byte of twice the
+ * coefficient (above), points 0..3 at z, then at z + 1, then points 4..7
+ * the same way (so that half4 reads the eight bytes of its four points). */
 ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
 {
     const __m128i low4 = _mm_set1_epi8(15);
-#define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
-                             G(11), G(12), G(13), G(14), G(15))
+#define TOP(g) (char)((g) > 0 ? 0x40 : (g) < 0 ? 0xC0 : 0) /* 2.0, -2.0, +0.0 */
+#define T16(G) _mm_setr_epi8(TOP(G(0)), TOP(G(1)), TOP(G(2)), TOP(G(3)), TOP(G(4)), TOP(G(5)), \
+                             TOP(G(6)), TOP(G(7)), TOP(G(8)), TOP(G(9)), TOP(G(10)), TOP(G(11)), \
+                             TOP(G(12)), TOP(G(13)), TOP(G(14)), TOP(G(15)))
     const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
 #undef T16
+#undef TOP
     /* byte 3 of each lane to bytes 0..3 of its 128-bit half, the halves' low
      * words side by side: the eight points' bytes in order */
     const __m256i top = _mm256_setr_epi8(3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
@@ -135,7 +172,7 @@ ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
     const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
     for (int c = 0; c < 4; c++) {
         __m128i b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hq[c], top), join));
-        __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
+        __m128i h = _mm_and_si128(_mm_unpacklo_epi32(b, _mm_srli_epi16(b, 4)), low4);
         _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
         _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
@@ -152,96 +189,149 @@ ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
     return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
 }
 
-/* Chunks of up to CHUNK groups of eight points: stage one finds the cells,
- * hashes and coefficients of every group, stage two does the arithmetic, so
- * the second never waits on the first's stores. */
-enum { CHUNK = 8 };
-
-/* perlin()'s hash chain for the groups of eight points whose bit is set in
- * okm, in 32-bit lanes, each level one gather per corner pair (4-byte
- * loads; only the low bytes count): [P[X], P[X+1]], then [P[A], P[A+1]] and
- * [P[B], P[B+1]], then the four pair bytes p[512 + AA] ... in byte 3 (that
- * load starts 3 bytes early, so it never reads past p[1023]; every index
- * is <= 510). Level by level over all groups: a gather's latency is long,
- * and the groups' chains are independent. */
-ALWAYS_INLINE void hash_avx2(const uint8_t *p, size_t ng, unsigned okm, const __m256i *X,
-                             const __m256i *Y, const __m256i *Z, __m256i (*hq)[4])
-{
-    const __m256i ff = _mm256_set1_epi32(255);
-    const int *pp = (const int *)(const void *)p, *pg = (const int *)(const void *)(p + 512 - 3);
-    __m256i hA[CHUNK], hB[CHUNK];
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            __m256i hx = _mm256_i32gather_epi32(pp, X[g], 1);
-            hA[g] = _mm256_add_epi32(_mm256_and_si256(hx, ff), Y[g]);
-            hB[g] = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y[g]);
-        }
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            hA[g] = _mm256_i32gather_epi32(pp, hA[g], 1);
-            hB[g] = _mm256_i32gather_epi32(pp, hB[g], 1);
-        }
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            hq[g][0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA[g], ff), Z[g]), 1);
-            hq[g][1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB[g], ff), Z[g]), 1);
-            hq[g][2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA[g], 8), ff), Z[g]), 1);
-            hq[g][3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB[g], 8), ff), Z[g]), 1);
-        }
-}
-
 ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
 ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
+
+/* the groups with a tiny fraction (rare; a call of its own, so that the
+ * compiler does not share the coefficient shuffles of the two ways) */
+static __attribute__((noinline)) void exact8_avx2(const int8_t cf[4][3][16], const v4d fr[3][2], v4d *ra,
+                                                  v4d *rb)
+{
+    *ra = half4(cf, 0, fr[0][0], fr[1][0], fr[2][0], 1);
+    *rb = half4(cf, 1, fr[0][1], fr[1][1], fr[2][1], 1);
+}
+
+/* A group of eight points between the stages of kernel8_avx2: the fractions
+ * of x, y, z (points 0..3 and 4..7), the way it goes, the hash chain's
+ * last gather results and lattice indices, the coefficient bytes. */
+enum { WAY_FAST, WAY_EXACT, WAY_SCALAR };
+typedef struct group8 {
+    v4d fr[3][2];
+    __m256i h0, h1, Y, Z;
+    int8_t cf[4][3][16];
+    int way;
+} group8;
+
+/* stage one: cells, fractions, the way, and the first gather of the hash
+ * chain, [P[X], P[X+1]], of points xs[0..7] ... (scaled by s unless mode is
+ * NOISE_SET). The chain (4-byte gathers; only the low bytes count):
+ * [P[X], P[X+1]], then [P[A], P[A+1]] and [P[B], P[B+1]], then the four pair
+ * bytes p[512 + AA] ... in byte 3 (that load starts 3 bytes early, so it
+ * never reads past p[1023]; every index is <= 510). */
+ALWAYS_INLINE void stage1_avx2(const uint8_t *p, const double *xs, const double *ys, const double *zs,
+                               double s, int mode, group8 *q)
+{
+    const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
+    const v4d lim = {0x1p-30, 0x1p-30, 0x1p-30, 0x1p-30}; /* half4's fast-way bound */
+    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+    v4d xa = ld4(xs), xb = ld4(xs + 4), ya = ld4(ys), yb = ld4(ys + 4), za = ld4(zs), zb = ld4(zs + 4);
+    if (mode != NOISE_SET) {
+        xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+    }
+#define IN(v) ((v4d)((v4l)(v) & ~sign) < big) /* |v| < 2^30, false for NaN */
+    v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
+#undef IN
+    if (_mm256_movemask_pd((__m256d)ok) != 15) {
+        q->way = WAY_SCALAR;
+        return;
+    }
+    __m256i X = cell8_avx2(xa, xb, q->fr[0]);
+    q->Y = cell8_avx2(ya, yb, q->fr[1]), q->Z = cell8_avx2(za, zb, q->fr[2]);
+#define LOW(v) ((v4l)((v) < lim))
+    v4l low = LOW(q->fr[0][0]) | LOW(q->fr[0][1]) | LOW(q->fr[1][0]) | LOW(q->fr[1][1]) |
+              LOW(q->fr[2][0]) | LOW(q->fr[2][1]);
+#undef LOW
+    q->way = _mm256_movemask_pd((__m256d)low) ? WAY_EXACT : WAY_FAST;
+    q->h0 = _mm256_i32gather_epi32((const int *)(const void *)p, X, 1);
+}
+
+/* stage two: [P[A], P[A+1]] and [P[B], P[B+1]] */
+ALWAYS_INLINE void stage2_avx2(const uint8_t *p, group8 *q)
+{
+    if (q->way == WAY_SCALAR)
+        return;
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pp = (const int *)(const void *)p;
+    __m256i hA = _mm256_add_epi32(_mm256_and_si256(q->h0, ff), q->Y);
+    __m256i hB = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(q->h0, 8), ff), q->Y);
+    q->h0 = _mm256_i32gather_epi32(pp, hA, 1);
+    q->h1 = _mm256_i32gather_epi32(pp, hB, 1);
+}
+
+/* stage three: the corner pairs' gradient numbers and the coefficients */
+ALWAYS_INLINE void stage3_avx2(const uint8_t *p, group8 *q)
+{
+    if (q->way == WAY_SCALAR)
+        return;
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pg = (const int *)(const void *)(p + 512 - 3);
+    __m256i hA = q->h0, hB = q->h1, Z = q->Z, hq[4];
+    hq[0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA, ff), Z), 1);
+    hq[1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB, ff), Z), 1);
+    hq[2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA, 8), ff), Z), 1);
+    hq[3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB, 8), ff), Z), 1);
+    coef8_avx2(hq, q->cf);
+}
+
+/* stage four: the arithmetic of a group, into out[0..7] */
+ALWAYS_INLINE void stage4_avx2(const uint8_t *p, const group8 *q, const double *xs, const double *ys,
+                               const double *zs, double s, double a, int mode, double *out)
+{
+    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+    if (q->way == WAY_SCALAR) {
+        kernel_scalar(p, 8, xs, ys, zs, s, a, mode, out);
+        return;
+    }
+    v4d ra, rb;
+    if (q->way == WAY_EXACT) {
+        exact8_avx2(q->cf, q->fr, &ra, &rb);
+    } else {
+        ra = half4(q->cf, 0, q->fr[0][0], q->fr[1][0], q->fr[2][0], 0);
+        rb = half4(q->cf, 1, q->fr[0][1], q->fr[1][1], q->fr[2][1], 0);
+    }
+    if (mode == NOISE_SET) {
+        st4(out, ra), st4(out + 4, rb);
+        return;
+    }
+    if (mode == NOISE_ADD_ABS) {
+        ra = (v4d)((v4l)ra & ~sign), rb = (v4d)((v4l)rb & ~sign); /* fabs */
+    }
+    st4(out, ld4(out) + a * ra);
+    st4(out + 4, ld4(out + 4) + a * rb);
+}
+
+/* Software-pipelined over the groups: iteration j runs stage one of group
+ * j, two of j - D, three of j - 2D and four of j - 3D (R slots hold the
+ * groups in flight). Each stage starts from gathers issued D iterations
+ * (several hundred instructions) earlier, so their long latency overlaps
+ * the other groups' arithmetic instead of stalling it; D = 2 measured
+ * better than 1 and 3 (bench/README_field.md). Stage one also prefetches
+ * the inputs (and out) PF doubles ahead: on arrays larger than the caches
+ * the hardware prefetcher alone left the kernel waiting for memory. */
+enum { D = 2, R = 8, PF = 64 };
 
 ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                                 const double *zs, double s, double a, int mode, double *out)
 {
-    const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
-    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
-    int8_t cf[CHUNK][4][3][16];
-    __m256i X[CHUNK], Y[CHUNK], Z[CHUNK], hq[CHUNK][4];
-    v4d fr[CHUNK][3][2]; /* the fractions of x, y, z, points 0..3 and 4..7 */
-    size_t i = 0;
-    while (i + 8 <= n) {
-        size_t ng = (n - i) / 8;
-        ng = ng < CHUNK ? ng : CHUNK;
-        unsigned okm = 0;
-        for (size_t g = 0; g < ng; g++) {
-            size_t j = i + 8 * g;
-            v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
-            v4d za = ld4(zs + j), zb = ld4(zs + j + 4);
-            if (mode != NOISE_SET) {
-                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+    group8 q[R];
+    size_t ng = n / 8;
+    for (size_t j = 0; j < ng + 3 * D; j++) {
+        if (j < ng) {
+            if (8 * j + PF < n) {
+                _mm_prefetch((const char *)(xs + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(ys + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(zs + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(out + 8 * j + PF), _MM_HINT_T0);
             }
-#define IN(v) ((v4d)((v4l)(v) & ~sign) < big) /* |v| < 2^30, false for NaN */
-            v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
-#undef IN
-            if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                X[g] = cell8_avx2(xa, xb, fr[g][0]), Y[g] = cell8_avx2(ya, yb, fr[g][1]);
-                Z[g] = cell8_avx2(za, zb, fr[g][2]);
-                okm |= 1u << g;
-            }
+            stage1_avx2(p, xs + 8 * j, ys + 8 * j, zs + 8 * j, s, mode, &q[j % R]);
         }
-        hash_avx2(p, ng, okm, X, Y, Z, hq);
-        for (size_t g = 0; g < ng; g++)
-            if (okm >> g & 1)
-                coef8_avx2(hq[g], cf[g]);
-        for (size_t g = 0; g < ng; g++, i += 8) {
-            if (!(okm >> g & 1)) {
-                kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
-                continue;
-            }
-            v4d ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
-            v4d rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
-            if (mode == NOISE_SET) {
-                st4(out + i, ra), st4(out + i + 4, rb);
-                continue;
-            }
-            if (mode == NOISE_ADD_ABS) {
-                ra = (v4d)((v4l)ra & ~sign), rb = (v4d)((v4l)rb & ~sign); /* fabs */
-            }
-            st4(out + i, ld4(out + i) + a * ra);
-            st4(out + i + 4, ld4(out + i + 4) + a * rb);
+        if (j >= D && j - D < ng)
+            stage2_avx2(p, &q[(j - D) % R]);
+        if (j >= 2 * D && j - 2 * D < ng)
+            stage3_avx2(p, &q[(j - 2 * D) % R]);
+        if (j >= 3 * D && j - 3 * D < ng) {
+            size_t k = j - 3 * D;
+            stage4_avx2(p, &q[k % R], xs + 8 * k, ys + 8 * k, zs + 8 * k, s, a, mode, out + 8 * k);
         }
     }
 }
