@@ -126,7 +126,7 @@ ALWAYS_INLINE v4d floor4(v4d v)
 ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
 /* the lerps of four points (lanes 4k..4k+3 of the eight); exact: see above */
-ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0, int exact)
+ALWAYS_INLINE v4d half4(const int8_t cf[3][2][32], int k, v4d x0, v4d y0, v4d z0, int exact)
 {
     const v4d one = {1, 1, 1, 1}, half = {0.5, 0.5, 0.5, 0.5};
     v4d u = fade4(x0), v = fade4(y0), w = fade4(z0);
@@ -137,7 +137,8 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
                                -1, -1, -1, -1, -1, -1, -1, (char)((b) + 2), -1, -1, -1, -1, -1, -1, -1, (char)((b) + 3))
     const __m256i pl0 = PL(0), pl1 = PL(4);
 #undef PL
-#define C(c, ax, pl) (exact ? coef4(cf[c][ax] + 8 * k, pl) * half : coef4(cf[c][ax] + 8 * k, pl))
+#define CF(c, ax) &cf[ax][(c) >> 1][16 * k + 8 * ((c) & 1)]
+#define C(c, ax, pl) (exact ? coef4(CF(c, ax), pl) * half : coef4(CF(c, ax), pl))
 #define G(c, xc, yc, zc, pl) (C(c, 0, pl) * (xc) + C(c, 1, pl) * (yc) + C(c, 2, pl) * (zc))
     v4d g00 = G(0, x0, y0, z0, pl0), g10 = G(1, x1, y0, z0, pl0);
     v4d g01 = G(2, x0, y1, z0, pl0), g11 = G(3, x1, y1, z0, pl0);
@@ -149,6 +150,7 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
     v4d c1 = a + v * (b - a);
 #undef G
 #undef C
+#undef CF
     v4d r = c0 + w * (c1 - c0);
     return exact ? r : r * half;
 }
@@ -156,31 +158,35 @@ ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0
 /* The gradient coefficients of the 64 corners of eight points from their
  * pairs' gradient numbers: byte 3 of lane j of hq[c] = p[512 + the pair
  * index] (noise.h) of corner pair c (AA, BA, AB, BB) of point j (as
- * stage3_avx2 gathers them); cf[c][axis][l]: the top byte of twice the
- * coefficient (above), points 0..3 at z, then at z + 1, then points 4..7
- * the same way (so that half4 reads the eight bytes of its four points). */
-ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
+ * stage3_avx2 gathers them). cf[axis][c / 2] holds the top bytes of twice
+ * the coefficients (above) of pairs c = 0, 1 or 2, 3: 128-bit half k for
+ * points 4k..4k+3, in it eight bytes per pair, the four points at z, then
+ * at z + 1 (so that half4 reads the eight bytes of its four points). Two
+ * pairs per 256-bit operation: the packs gather the pair bytes of all four
+ * pairs in one register, points 0..3 in the low half, 4..7 in the high. */
+ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[3][2][32])
 {
-    const __m128i low4 = _mm_set1_epi8(15);
 #define TOP(g) (char)((g) > 0 ? 0x40 : (g) < 0 ? 0xC0 : 0) /* 2.0, -2.0, +0.0 */
-#define T16(G) _mm_setr_epi8(TOP(G(0)), TOP(G(1)), TOP(G(2)), TOP(G(3)), TOP(G(4)), TOP(G(5)), \
-                             TOP(G(6)), TOP(G(7)), TOP(G(8)), TOP(G(9)), TOP(G(10)), TOP(G(11)), \
-                             TOP(G(12)), TOP(G(13)), TOP(G(14)), TOP(G(15)))
-    const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
+#define T16(G) TOP(G(0)), TOP(G(1)), TOP(G(2)), TOP(G(3)), TOP(G(4)), TOP(G(5)), TOP(G(6)), TOP(G(7)), \
+               TOP(G(8)), TOP(G(9)), TOP(G(10)), TOP(G(11)), TOP(G(12)), TOP(G(13)), TOP(G(14)), TOP(G(15))
+    const __m256i tgx = _mm256_setr_epi8(T16(NOISE_GX), T16(NOISE_GX));
+    const __m256i tgy = _mm256_setr_epi8(T16(NOISE_GY), T16(NOISE_GY));
+    const __m256i tgz = _mm256_setr_epi8(T16(NOISE_GZ), T16(NOISE_GZ));
 #undef T16
 #undef TOP
-    /* byte 3 of each lane to bytes 0..3 of its 128-bit half, the halves' low
-     * words side by side: the eight points' bytes in order */
-    const __m256i top = _mm256_setr_epi8(3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                         3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
-    for (int c = 0; c < 4; c++) {
-        __m128i b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hq[c], top), join));
-        __m128i h = _mm_and_si128(_mm_unpacklo_epi32(b, _mm_srli_epi16(b, 4)), low4);
-        _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
-        _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
-        _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
-    }
+    const __m256i low4 = _mm256_set1_epi8(15);
+    /* per half: words [pair 0 points, pair 1 points], then bytes [0, 1, 2, 3] */
+    __m256i w01 = _mm256_packus_epi32(_mm256_srli_epi32(hq[0], 24), _mm256_srli_epi32(hq[1], 24));
+    __m256i w23 = _mm256_packus_epi32(_mm256_srli_epi32(hq[2], 24), _mm256_srli_epi32(hq[3], 24));
+    __m256i b = _mm256_packus_epi16(w01, w23);
+    __m256i lo = _mm256_and_si256(b, low4), hi = _mm256_and_si256(_mm256_srli_epi16(b, 4), low4);
+    __m256i h01 = _mm256_unpacklo_epi32(lo, hi), h23 = _mm256_unpackhi_epi32(lo, hi);
+    _mm256_storeu_si256((__m256i *)(void *)cf[0][0], _mm256_shuffle_epi8(tgx, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[0][1], _mm256_shuffle_epi8(tgx, h23));
+    _mm256_storeu_si256((__m256i *)(void *)cf[1][0], _mm256_shuffle_epi8(tgy, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[1][1], _mm256_shuffle_epi8(tgy, h23));
+    _mm256_storeu_si256((__m256i *)(void *)cf[2][0], _mm256_shuffle_epi8(tgz, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[2][1], _mm256_shuffle_epi8(tgz, h23));
 }
 
 /* (int)floor & 255 of eight lanes given as two 4-double halves, and in
@@ -198,7 +204,7 @@ ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
 
 /* the groups with a tiny fraction (rare; a call of its own, so that the
  * compiler does not share the coefficient shuffles of the two ways) */
-static __attribute__((noinline)) void exact8_avx2(const int8_t cf[4][3][16], const v4d fr[3][2], v4d *ra,
+static __attribute__((noinline)) void exact8_avx2(const int8_t cf[3][2][32], const v4d fr[3][2], v4d *ra,
                                                   v4d *rb)
 {
     *ra = half4(cf, 0, fr[0][0], fr[1][0], fr[2][0], 1);
@@ -212,7 +218,7 @@ enum { WAY_FAST, WAY_EXACT, WAY_SCALAR };
 typedef struct group8 {
     v4d fr[3][2];
     __m256i h0, h1, Y, Z;
-    int8_t cf[4][3][16];
+    int8_t cf[3][2][32];
     int way;
 } group8;
 
