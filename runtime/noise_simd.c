@@ -12,9 +12,10 @@
  * -ffp-contract=off so nothing fuses into an FMA (FMA is available inside
  * the AVX2 and AVX-512 regions), the floors are exact, and the gradient
  * coefficients are the same exact values ±1, 0 — so the result is
- * bit-identical to the scalar path on every level. A group with a point the
- * fast lattice path cannot take (|coordinate| >= 2^30, NaN, infinity) goes
- * through the scalar perlin() point by point. */
+ * bit-identical to the scalar path on every level (AVX2 computes with
+ * twice the coefficients where that is exact; see there). A group with a
+ * point the vector lattice cannot take (|coordinate| >= 2^30, or 2^31 on
+ * AVX2; NaN, infinity) goes through the scalar perlin() point by point. */
 #include "noise.h"
 #include "noise_impl.h"
 
@@ -116,7 +117,7 @@ ALWAYS_INLINE v4d coef4(const int8_t *c8, __m256i place)
     return (v4d)_mm256_shuffle_epi8(b, place);
 }
 
-/* floor of each lane (|v| < 2^30) as perlin() computes it: +0 for -0 */
+/* floor of each lane as perlin() computes it: +0 for -0 */
 ALWAYS_INLINE v4d floor4(v4d v)
 {
     const v4d zero = {0, 0, 0, 0};
@@ -189,18 +190,19 @@ ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[3][2][32])
     _mm256_storeu_si256((__m256i *)(void *)cf[2][1], _mm256_shuffle_epi8(tgz, h23));
 }
 
-/* (int)floor & 255 of eight lanes given as two 4-double halves, and in
- * fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
+ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
+ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
+
+/* (int)floor of eight lanes given as two 4-double halves (INT32_MIN where
+ * floor is out of the int range, infinite or NaN: cvttpd2dq's "integer
+ * indefinite"), and in fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
 ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
 {
     v4d fa = floor4(a), fb = floor4(b);
     fr[0] = a - fa, fr[1] = b - fb;
     __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
-    return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
+    return _mm256_set_m128i(hi, lo);
 }
-
-ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
-ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
 
 /* the groups with a tiny fraction (rare; a call of its own, so that the
  * compiler does not share the coefficient shuffles of the two ways) */
@@ -231,22 +233,25 @@ typedef struct group8 {
 ALWAYS_INLINE void stage1_avx2(const uint8_t *p, const double *xs, const double *ys, const double *zs,
                                double s, int mode, group8 *q)
 {
-    const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     const v4d lim = {0x1p-30, 0x1p-30, 0x1p-30, 0x1p-30}; /* half4's fast-way bound */
-    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
     v4d xa = ld4(xs), xb = ld4(xs + 4), ya = ld4(ys), yb = ld4(ys + 4), za = ld4(zs), zb = ld4(zs + 4);
     if (mode != NOISE_SET) {
         xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
     }
-#define IN(v) ((v4d)((v4l)(v) & ~sign) < big) /* |v| < 2^30, false for NaN */
-    v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
-#undef IN
-    if (_mm256_movemask_pd((__m256d)ok) != 15) {
+    /* Any lane whose floor is not an int (|coordinate| >= 2^31, infinite,
+     * NaN) sends the group through perlin() point by point. The others need
+     * not be below perlin()'s 2^30: from 2^30 to 2^31 its far path takes the
+     * same floor, the same index mod 256 and the same operations. */
+    const __m256i ff = _mm256_set1_epi32(255), indef = _mm256_set1_epi32(INT32_MIN);
+    __m256i X = cell8_avx2(xa, xb, q->fr[0]), Y = cell8_avx2(ya, yb, q->fr[1]);
+    __m256i Z = cell8_avx2(za, zb, q->fr[2]);
+    __m256i bad = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(X, indef), _mm256_cmpeq_epi32(Y, indef)),
+                                  _mm256_cmpeq_epi32(Z, indef));
+    if (!_mm256_testz_si256(bad, bad)) {
         q->way = WAY_SCALAR;
         return;
     }
-    __m256i X = cell8_avx2(xa, xb, q->fr[0]);
-    q->Y = cell8_avx2(ya, yb, q->fr[1]), q->Z = cell8_avx2(za, zb, q->fr[2]);
+    X = _mm256_and_si256(X, ff), q->Y = _mm256_and_si256(Y, ff), q->Z = _mm256_and_si256(Z, ff);
 #define LOW(v) ((v4l)((v) < lim))
     v4l low = LOW(q->fr[0][0]) | LOW(q->fr[0][1]) | LOW(q->fr[1][0]) | LOW(q->fr[1][1]) |
               LOW(q->fr[2][0]) | LOW(q->fr[2][1]);
