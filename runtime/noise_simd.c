@@ -198,7 +198,10 @@ ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
  * indefinite"), and in fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
 ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
 {
-    v4d fa = floor4(a), fb = floor4(b);
+    /* without floor4's +0: the fraction of -0 comes out +0 here, not
+     * perlin()'s -0, but that sends the group the exact way (stage1_avx2),
+     * which computes its fractions again */
+    v4d fa = (v4d)_mm256_floor_pd((__m256d)a), fb = (v4d)_mm256_floor_pd((__m256d)b);
     fr[0] = a - fa, fr[1] = b - fb;
     __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
     return _mm256_set_m128i(hi, lo);
@@ -252,11 +255,17 @@ ALWAYS_INLINE void stage1_avx2(const uint8_t *p, const double *xs, const double 
         return;
     }
     X = _mm256_and_si256(X, ff), q->Y = _mm256_and_si256(Y, ff), q->Z = _mm256_and_si256(Z, ff);
-#define LOW(v) ((v4l)((v) < lim))
-    v4l low = LOW(q->fr[0][0]) | LOW(q->fr[0][1]) | LOW(q->fr[1][0]) | LOW(q->fr[1][1]) |
-              LOW(q->fr[2][0]) | LOW(q->fr[2][1]);
-#undef LOW
-    q->way = _mm256_movemask_pd((__m256d)low) ? WAY_EXACT : WAY_FAST;
+    /* the least fraction of each lane (no NaN here; ±0 compare equal) */
+#define MIN(a, b) ((v4d)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
+    v4d least = MIN(MIN(MIN(q->fr[0][0], q->fr[0][1]), MIN(q->fr[1][0], q->fr[1][1])),
+                    MIN(q->fr[2][0], q->fr[2][1]));
+#undef MIN
+    q->way = _mm256_movemask_pd((__m256d)(least < lim)) ? WAY_EXACT : WAY_FAST;
+    if (q->way == WAY_EXACT) { /* perlin()'s fractions: -0 for -0 */
+        q->fr[0][0] = xa - floor4(xa), q->fr[0][1] = xb - floor4(xb);
+        q->fr[1][0] = ya - floor4(ya), q->fr[1][1] = yb - floor4(yb);
+        q->fr[2][0] = za - floor4(za), q->fr[2][1] = zb - floor4(zb);
+    }
     q->h0 = _mm256_i32gather_epi32((const int *)(const void *)p, X, 1);
 }
 
