@@ -478,6 +478,12 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
                      1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
+        if (i + PF < n) { /* as kernel8_avx2 */
+            _mm_prefetch((const char *)(xs + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(ys + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(zs + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(out + i + PF), _MM_HINT_T0);
+        }
         v8d x = (v8d)_mm512_loadu_pd(xs + i), y = (v8d)_mm512_loadu_pd(ys + i);
         v8d z = (v8d)_mm512_loadu_pd(zs + i);
         if (mode != NOISE_SET)
