@@ -99,8 +99,8 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
  * tiny, so a group goes the fast way only if all 24 of its fractions are
  * >= 2^-30 (which also excludes ±0): then every gradient is a multiple of
  * 2^-82 (as doubles >= 2^-30 and their differences with 1 are), the fades
- * are >= 2^-90
- * (fade(t) >= t^3 on [0, 1]), the first products |u (b - a)| >= 2^-172 and
+ * are >= 2^-90 (fade(t) >= t^3 on [0, 1]), the first products
+ * |u (b - a)| >= 2^-172 and
  * the values after them multiples of 2^-224, the second products
  * >= 2^-314, multiples of 2^-366 after, the last >= 2^-456: all normal.
  * Other groups (lattice points, -0, tiny coordinates; rare on scattered
@@ -111,7 +111,7 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
  * coef4: the eight bytes are loaded by an asm statement that GCC can neither
  * merge with the same load for the other layer nor hoist: with a plain load
  * it broadcast once per half, kept the 24 broadcasts live across the half
- * and spilled them (47 more stack accesses per group, 3% slower). */
+ * and spilled them (47 more stack accesses in the kernel, 3% slower). */
 ALWAYS_INLINE v4d coef4(const int8_t *c8, __m256i place)
 {
     __m256i b;
