@@ -55,12 +55,15 @@
  * SIMD (noise_simd.c). Several points at a time on three levels found at
  * run time (noise_simd_best: the highest level __builtin_cpu_supports
  * allows): SSE2 (the x86-64 baseline, four points), AVX2 (eight points; the
- * hash chains as 32-bit gathers from the permutation, the arithmetic on
- * 4-double vectors) and AVX-512 (eight points in 8-double vectors, the
- * permutation lookups as byte-lane table permutes, vpermi2b). The gradient
- * coefficients come from the hash by register table lookups. Every
- * level gives bit for bit the scalar values (same operations in the same
- * order, no FMA), so a result never depends on the machine. The blocks use
+ * hash chains as 32-bit gathers from the permutation, software-pipelined
+ * with the arithmetic of earlier groups, which runs on 4-double vectors)
+ * and AVX-512 (eight points in 8-double vectors, the permutation lookups as
+ * byte-lane table permutes, vpermi2b). The gradient coefficients come from
+ * the hash by register table lookups (AVX2: byte shuffles that build ±2.0
+ * and +0.0, where computing with twice the coefficients is provably exact,
+ * noise_simd.c). Every level gives bit for bit the scalar values (same
+ * operations in the same order, no FMA), so a result never depends on the
+ * machine. The blocks use
  * the best level except SSE2, which measured slower than the per-point loop
  * (bench/noise_bench.c). The *_block_at variants take the level
  * (NOISE_LEVEL_SCALAR runs the per-point loop), for tests and benchmarks.

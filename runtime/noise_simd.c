@@ -12,9 +12,10 @@
  * -ffp-contract=off so nothing fuses into an FMA (FMA is available inside
  * the AVX2 and AVX-512 regions), the floors are exact, and the gradient
  * coefficients are the same exact values ±1, 0 — so the result is
- * bit-identical to the scalar path on every level. A group with a point the
- * fast lattice path cannot take (|coordinate| >= 2^30, NaN, infinity) goes
- * through the scalar perlin() point by point. */
+ * bit-identical to the scalar path on every level (AVX2 computes with
+ * twice the coefficients where that is exact; see there). A group with a
+ * point the vector lattice cannot take (|coordinate| >= 2^30, or 2^31 on
+ * AVX2; NaN, infinity) goes through the scalar perlin() point by point. */
 #include "noise.h"
 #include "noise_impl.h"
 
@@ -77,17 +78,48 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
 /* Eight points at a time: the hash chain runs in 32-bit lanes, one gather
  * per level and corner pair (seven per eight points, instead of 56 scalar
  * loads with their index arithmetic), while the floors, fades, gradients
- * and lerps run on two 4-double vectors per quantity. The gradient coefficients come from the hash bytes
- * by a 16-entry byte table lookup (pshufb) and exact int8 -> int32 -> double
- * conversions: the values ±1 and 0 of noise_gpairs, no memory gather. */
-ALWAYS_INLINE v4d cvt4(const int8_t *c)
+ * and lerps run on two 4-double vectors per quantity.
+ *
+ * The gradient coefficients are doubles made by byte shuffles alone, no
+ * int -> double conversion: the top byte of 2.0, -2.0 and +0.0 (0x40,
+ * 0xC0, 0x00; their other seven bytes are zero) comes from the hash by a
+ * 16-entry table lookup (pshufb, coef8_avx2), and one pshufb per
+ * coefficient vector puts four points' bytes into the top bytes of four
+ * zeroed lanes (coef4). So the kernel computes with 2g for every gradient
+ * coefficient g, and every value it forms is exactly twice perlin()'s,
+ * rounded the same, as long as no product rounds to a subnormal:
+ *   - 2c * d = 2 (c * d) exactly for c in {-1, 0, 1} (zeros keep their
+ *     sign: (2 * 0) * -0 = -0 = 2 * (0 * -0)); |d| <= 1, no overflow;
+ *   - sums and differences of doubles scale exactly by 2 (when the result
+ *     is subnormal the operation is exact, in either computation);
+ *   - a product t * 2e rounds like 2 (t * e) when t * e is normal: rounding
+ *     commutes with a power of two in the normal range;
+ *   - 0.5 * 2r = r exactly.
+ * Products round to subnormals only if a fraction (x - floor x etc.) is
+ * tiny, so a group goes the fast way only if all 24 of its fractions are
+ * >= 2^-30 (which also excludes ±0): then every gradient is a multiple of
+ * 2^-82 (as doubles >= 2^-30 and their differences with 1 are), the fades
+ * are >= 2^-90 (fade(t) >= t^3 on [0, 1]), the first products
+ * |u (b - a)| >= 2^-172 and
+ * the values after them multiples of 2^-224, the second products
+ * >= 2^-314, multiples of 2^-366 after, the last >= 2^-456: all normal.
+ * Other groups (lattice points, -0, tiny coordinates; rare on scattered
+ * points) multiply the shuffled coefficients by 0.5 first — exactly ±1, +0,
+ * the scalar's own coefficients — and compute perlin()'s operations as they
+ * are (half4 with exact = 1).
+ *
+ * coef4: the eight bytes are loaded by an asm statement that GCC can neither
+ * merge with the same load for the other layer nor hoist: with a plain load
+ * it broadcast once per half, kept the 24 broadcasts live across the half
+ * and spilled them (47 more stack accesses in the kernel, 3% slower). */
+ALWAYS_INLINE v4d coef4(const int8_t *c8, __m256i place)
 {
-    int32_t w;
-    memcpy(&w, c, 4);
-    return (v4d)_mm256_cvtepi32_pd(_mm_cvtepi8_epi32(_mm_cvtsi32_si128(w)));
+    __m256i b;
+    __asm__ volatile("vpbroadcastq %1, %0" : "=x"(b) : "m"(*(const int64_t *)(const void *)c8));
+    return (v4d)_mm256_shuffle_epi8(b, place);
 }
 
-/* floor of each lane (|v| < 2^30) as perlin() computes it: +0 for -0 */
+/* floor of each lane as perlin() computes it: +0 for -0 */
 ALWAYS_INLINE v4d floor4(v4d v)
 {
     const v4d zero = {0, 0, 0, 0};
@@ -96,152 +128,236 @@ ALWAYS_INLINE v4d floor4(v4d v)
 
 ALWAYS_INLINE v4d fade4(v4d t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
-/* the lerps of four points (lanes 4k..4k+3 of the eight) */
-ALWAYS_INLINE v4d half4(const int8_t cf[4][3][16], int k, v4d x0, v4d y0, v4d z0)
+/* the lerps of four points (lanes 4k..4k+3 of the eight); exact: see above */
+ALWAYS_INLINE v4d half4(const int8_t cf[3][2][32], int k, v4d x0, v4d y0, v4d z0, int exact)
 {
-    const v4d one = {1, 1, 1, 1};
+    const v4d one = {1, 1, 1, 1}, half = {0.5, 0.5, 0.5, 0.5};
     v4d u = fade4(x0), v = fade4(y0), w = fade4(z0);
     v4d x1 = x0 - one, y1 = y0 - one, z1 = z0 - one;
-#define G(c, xc, yc, zc, o) (cvt4(&cf[c][0][o]) * (xc) + cvt4(&cf[c][1][o]) * (yc) + cvt4(&cf[c][2][o]) * (zc))
-    int o0 = 4 * k, o1 = 4 * k + 8;
-    v4d g00 = G(0, x0, y0, z0, o0), g10 = G(1, x1, y0, z0, o0);
-    v4d g01 = G(2, x0, y1, z0, o0), g11 = G(3, x1, y1, z0, o0);
+    /* byte 7 of lane j <- byte j (at z) or 4 + j (at z + 1) of the four
+     * points' eight coefficient bytes, every other byte zero */
+#define PL(b) _mm256_setr_epi8(-1, -1, -1, -1, -1, -1, -1, (char)(b), -1, -1, -1, -1, -1, -1, -1, (char)((b) + 1), \
+                               -1, -1, -1, -1, -1, -1, -1, (char)((b) + 2), -1, -1, -1, -1, -1, -1, -1, (char)((b) + 3))
+    const __m256i pl0 = PL(0), pl1 = PL(4);
+#undef PL
+#define CF(c, ax) &cf[ax][(c) >> 1][16 * k + 8 * ((c) & 1)]
+#define C(c, ax, pl) (exact ? coef4(CF(c, ax), pl) * half : coef4(CF(c, ax), pl))
+#define G(c, xc, yc, zc, pl) (C(c, 0, pl) * (xc) + C(c, 1, pl) * (yc) + C(c, 2, pl) * (zc))
+    v4d g00 = G(0, x0, y0, z0, pl0), g10 = G(1, x1, y0, z0, pl0);
+    v4d g01 = G(2, x0, y1, z0, pl0), g11 = G(3, x1, y1, z0, pl0);
     v4d a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
     v4d c0 = a + v * (b - a);
-    g00 = G(0, x0, y0, z1, o1), g10 = G(1, x1, y0, z1, o1);
-    g01 = G(2, x0, y1, z1, o1), g11 = G(3, x1, y1, z1, o1);
+    g00 = G(0, x0, y0, z1, pl1), g10 = G(1, x1, y0, z1, pl1);
+    g01 = G(2, x0, y1, z1, pl1), g11 = G(3, x1, y1, z1, pl1);
     a = g00 + u * (g10 - g00), b = g01 + u * (g11 - g01);
     v4d c1 = a + v * (b - a);
 #undef G
-    return c0 + w * (c1 - c0);
+#undef C
+#undef CF
+    v4d r = c0 + w * (c1 - c0);
+    return exact ? r : r * half;
 }
 
 /* The gradient coefficients of the 64 corners of eight points from their
  * pairs' gradient numbers: byte 3 of lane j of hq[c] = p[512 + the pair
  * index] (noise.h) of corner pair c (AA, BA, AB, BB) of point j (as
- * hash8_avx2 gathers them); cf[c][axis][l]: lanes l = 0..7 at z, 8..15 at
- * z + 1. */
-ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[4][3][16])
+ * stage3_avx2 gathers them). cf[axis][c / 2] holds the top bytes of twice
+ * the coefficients (above) of pairs c = 0, 1 or 2, 3: 128-bit half k for
+ * points 4k..4k+3, in it eight bytes per pair, the four points at z, then
+ * at z + 1 (so that half4 reads the eight bytes of its four points). Two
+ * pairs per 256-bit operation: the packs gather the pair bytes of all four
+ * pairs in one register, points 0..3 in the low half, 4..7 in the high. */
+ALWAYS_INLINE void coef8_avx2(const __m256i hq[4], int8_t cf[3][2][32])
 {
-    const __m128i low4 = _mm_set1_epi8(15);
-#define T16(G) _mm_setr_epi8(G(0), G(1), G(2), G(3), G(4), G(5), G(6), G(7), G(8), G(9), G(10), \
-                             G(11), G(12), G(13), G(14), G(15))
-    const __m128i tgx = T16(NOISE_GX), tgy = T16(NOISE_GY), tgz = T16(NOISE_GZ);
+#define TOP(g) (char)((g) > 0 ? 0x40 : (g) < 0 ? 0xC0 : 0) /* 2.0, -2.0, +0.0 */
+#define T16(G) TOP(G(0)), TOP(G(1)), TOP(G(2)), TOP(G(3)), TOP(G(4)), TOP(G(5)), TOP(G(6)), TOP(G(7)), \
+               TOP(G(8)), TOP(G(9)), TOP(G(10)), TOP(G(11)), TOP(G(12)), TOP(G(13)), TOP(G(14)), TOP(G(15))
+    const __m256i tgx = _mm256_setr_epi8(T16(NOISE_GX), T16(NOISE_GX));
+    const __m256i tgy = _mm256_setr_epi8(T16(NOISE_GY), T16(NOISE_GY));
+    const __m256i tgz = _mm256_setr_epi8(T16(NOISE_GZ), T16(NOISE_GZ));
 #undef T16
-    /* byte 3 of each lane to bytes 0..3 of its 128-bit half, the halves' low
-     * words side by side: the eight points' bytes in order */
-    const __m256i top = _mm256_setr_epi8(3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                         3, 7, 11, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
-    for (int c = 0; c < 4; c++) {
-        __m128i b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hq[c], top), join));
-        __m128i h = _mm_and_si128(_mm_unpacklo_epi64(b, _mm_srli_epi16(b, 4)), low4);
-        _mm_storeu_si128((__m128i *)(void *)cf[c][0], _mm_shuffle_epi8(tgx, h));
-        _mm_storeu_si128((__m128i *)(void *)cf[c][1], _mm_shuffle_epi8(tgy, h));
-        _mm_storeu_si128((__m128i *)(void *)cf[c][2], _mm_shuffle_epi8(tgz, h));
-    }
-}
-
-/* (int)floor & 255 of eight lanes given as two 4-double halves, and in
- * fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
-ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
-{
-    v4d fa = floor4(a), fb = floor4(b);
-    fr[0] = a - fa, fr[1] = b - fb;
-    __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
-    return _mm256_and_si256(_mm256_set_m128i(hi, lo), _mm256_set1_epi32(255));
-}
-
-/* Chunks of up to CHUNK groups of eight points: stage one finds the cells,
- * hashes and coefficients of every group, stage two does the arithmetic, so
- * the second never waits on the first's stores. */
-enum { CHUNK = 8 };
-
-/* perlin()'s hash chain for the groups of eight points whose bit is set in
- * okm, in 32-bit lanes, each level one gather per corner pair (4-byte
- * loads; only the low bytes count): [P[X], P[X+1]], then [P[A], P[A+1]] and
- * [P[B], P[B+1]], then the four pair bytes p[512 + AA] ... in byte 3 (that
- * load starts 3 bytes early, so it never reads past p[1023]; every index
- * is <= 510). Level by level over all groups: a gather's latency is long,
- * and the groups' chains are independent. */
-ALWAYS_INLINE void hash_avx2(const uint8_t *p, size_t ng, unsigned okm, const __m256i *X,
-                             const __m256i *Y, const __m256i *Z, __m256i (*hq)[4])
-{
-    const __m256i ff = _mm256_set1_epi32(255);
-    const int *pp = (const int *)(const void *)p, *pg = (const int *)(const void *)(p + 512 - 3);
-    __m256i hA[CHUNK], hB[CHUNK];
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            __m256i hx = _mm256_i32gather_epi32(pp, X[g], 1);
-            hA[g] = _mm256_add_epi32(_mm256_and_si256(hx, ff), Y[g]);
-            hB[g] = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hx, 8), ff), Y[g]);
-        }
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            hA[g] = _mm256_i32gather_epi32(pp, hA[g], 1);
-            hB[g] = _mm256_i32gather_epi32(pp, hB[g], 1);
-        }
-    for (size_t g = 0; g < ng; g++)
-        if (okm >> g & 1) {
-            hq[g][0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA[g], ff), Z[g]), 1);
-            hq[g][1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB[g], ff), Z[g]), 1);
-            hq[g][2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA[g], 8), ff), Z[g]), 1);
-            hq[g][3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB[g], 8), ff), Z[g]), 1);
-        }
+#undef TOP
+    const __m256i low4 = _mm256_set1_epi8(15);
+    /* per half: words [pair 0 points, pair 1 points], then bytes [0, 1, 2, 3] */
+    __m256i w01 = _mm256_packus_epi32(_mm256_srli_epi32(hq[0], 24), _mm256_srli_epi32(hq[1], 24));
+    __m256i w23 = _mm256_packus_epi32(_mm256_srli_epi32(hq[2], 24), _mm256_srli_epi32(hq[3], 24));
+    __m256i b = _mm256_packus_epi16(w01, w23);
+    __m256i lo = _mm256_and_si256(b, low4), hi = _mm256_and_si256(_mm256_srli_epi16(b, 4), low4);
+    __m256i h01 = _mm256_unpacklo_epi32(lo, hi), h23 = _mm256_unpackhi_epi32(lo, hi);
+    _mm256_storeu_si256((__m256i *)(void *)cf[0][0], _mm256_shuffle_epi8(tgx, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[0][1], _mm256_shuffle_epi8(tgx, h23));
+    _mm256_storeu_si256((__m256i *)(void *)cf[1][0], _mm256_shuffle_epi8(tgy, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[1][1], _mm256_shuffle_epi8(tgy, h23));
+    _mm256_storeu_si256((__m256i *)(void *)cf[2][0], _mm256_shuffle_epi8(tgz, h01));
+    _mm256_storeu_si256((__m256i *)(void *)cf[2][1], _mm256_shuffle_epi8(tgz, h23));
 }
 
 ALWAYS_INLINE v4d ld4(const double *p) { return (v4d)_mm256_loadu_pd(p); }
 ALWAYS_INLINE void st4(double *p, v4d v) { _mm256_storeu_pd(p, (__m256d)v); }
 
+/* (int)floor of eight lanes given as two 4-double halves (INT32_MIN where
+ * floor is out of the int range, infinite or NaN: cvttpd2dq's "integer
+ * indefinite"), and in fr[0], fr[1] the fractions a - floor(a), b - floor(b) */
+ALWAYS_INLINE __m256i cell8_avx2(v4d a, v4d b, v4d fr[2])
+{
+    /* without floor4's +0: the fraction of -0 comes out +0 here, not
+     * perlin()'s -0, but that sends the group the exact way (stage1_avx2),
+     * which computes its fractions again */
+    v4d fa = (v4d)_mm256_floor_pd((__m256d)a), fb = (v4d)_mm256_floor_pd((__m256d)b);
+    fr[0] = a - fa, fr[1] = b - fb;
+    __m128i lo = _mm256_cvttpd_epi32((__m256d)fa), hi = _mm256_cvttpd_epi32((__m256d)fb);
+    return _mm256_set_m128i(hi, lo);
+}
+
+/* the groups with a tiny fraction (rare; a call of its own, so that the
+ * compiler does not share the coefficient shuffles of the two ways) */
+static __attribute__((noinline)) void exact8_avx2(const int8_t cf[3][2][32], const v4d fr[3][2], v4d *ra,
+                                                  v4d *rb)
+{
+    *ra = half4(cf, 0, fr[0][0], fr[1][0], fr[2][0], 1);
+    *rb = half4(cf, 1, fr[0][1], fr[1][1], fr[2][1], 1);
+}
+
+/* A group of eight points between the stages of kernel8_avx2: the fractions
+ * of x, y, z (points 0..3 and 4..7), the way it goes, the hash chain's
+ * last gather results and lattice indices, the coefficient bytes. */
+enum { WAY_FAST, WAY_EXACT, WAY_SCALAR };
+typedef struct group8 {
+    v4d fr[3][2];
+    __m256i h0, h1, Y, Z;
+    int8_t cf[3][2][32];
+    int way;
+} group8;
+
+/* stage one: cells, fractions, the way, and the first gather of the hash
+ * chain, [P[X], P[X+1]], of points xs[0..7] ... (scaled by s unless mode is
+ * NOISE_SET). The chain (4-byte gathers; only the low bytes count):
+ * [P[X], P[X+1]], then [P[A], P[A+1]] and [P[B], P[B+1]], then the four pair
+ * bytes p[512 + AA] ... in byte 3 (that load starts 3 bytes early, so it
+ * never reads past p[1023]; every index is <= 510). */
+ALWAYS_INLINE void stage1_avx2(const uint8_t *p, const double *xs, const double *ys, const double *zs,
+                               double s, int mode, group8 *q)
+{
+    const v4d lim = {0x1p-30, 0x1p-30, 0x1p-30, 0x1p-30}; /* half4's fast-way bound */
+    v4d xa = ld4(xs), xb = ld4(xs + 4), ya = ld4(ys), yb = ld4(ys + 4), za = ld4(zs), zb = ld4(zs + 4);
+    if (mode != NOISE_SET) {
+        xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+    }
+    /* Any lane whose floor is not an int (|coordinate| >= 2^31, infinite,
+     * NaN) sends the group through perlin() point by point. The others need
+     * not be below perlin()'s 2^30: from 2^30 to 2^31 its far path takes the
+     * same floor, the same index mod 256 and the same operations. */
+    const __m256i ff = _mm256_set1_epi32(255), indef = _mm256_set1_epi32(INT32_MIN);
+    __m256i X = cell8_avx2(xa, xb, q->fr[0]), Y = cell8_avx2(ya, yb, q->fr[1]);
+    __m256i Z = cell8_avx2(za, zb, q->fr[2]);
+    __m256i bad = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(X, indef), _mm256_cmpeq_epi32(Y, indef)),
+                                  _mm256_cmpeq_epi32(Z, indef));
+    if (!_mm256_testz_si256(bad, bad)) {
+        q->way = WAY_SCALAR;
+        return;
+    }
+    X = _mm256_and_si256(X, ff), q->Y = _mm256_and_si256(Y, ff), q->Z = _mm256_and_si256(Z, ff);
+    /* the least fraction of each lane (no NaN here; ±0 compare equal) */
+#define MIN(a, b) ((v4d)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
+    v4d least = MIN(MIN(MIN(q->fr[0][0], q->fr[0][1]), MIN(q->fr[1][0], q->fr[1][1])),
+                    MIN(q->fr[2][0], q->fr[2][1]));
+#undef MIN
+    q->way = _mm256_movemask_pd((__m256d)(least < lim)) ? WAY_EXACT : WAY_FAST;
+    if (q->way == WAY_EXACT) { /* perlin()'s fractions: -0 for -0 */
+        q->fr[0][0] = xa - floor4(xa), q->fr[0][1] = xb - floor4(xb);
+        q->fr[1][0] = ya - floor4(ya), q->fr[1][1] = yb - floor4(yb);
+        q->fr[2][0] = za - floor4(za), q->fr[2][1] = zb - floor4(zb);
+    }
+    q->h0 = _mm256_i32gather_epi32((const int *)(const void *)p, X, 1);
+}
+
+/* stage two: [P[A], P[A+1]] and [P[B], P[B+1]] */
+ALWAYS_INLINE void stage2_avx2(const uint8_t *p, group8 *q)
+{
+    if (q->way == WAY_SCALAR)
+        return;
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pp = (const int *)(const void *)p;
+    __m256i hA = _mm256_add_epi32(_mm256_and_si256(q->h0, ff), q->Y);
+    __m256i hB = _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(q->h0, 8), ff), q->Y);
+    q->h0 = _mm256_i32gather_epi32(pp, hA, 1);
+    q->h1 = _mm256_i32gather_epi32(pp, hB, 1);
+}
+
+/* stage three: the corner pairs' gradient numbers and the coefficients */
+ALWAYS_INLINE void stage3_avx2(const uint8_t *p, group8 *q)
+{
+    if (q->way == WAY_SCALAR)
+        return;
+    const __m256i ff = _mm256_set1_epi32(255);
+    const int *pg = (const int *)(const void *)(p + 512 - 3);
+    __m256i hA = q->h0, hB = q->h1, Z = q->Z, hq[4];
+    hq[0] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hA, ff), Z), 1);
+    hq[1] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(hB, ff), Z), 1);
+    hq[2] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hA, 8), ff), Z), 1);
+    hq[3] = _mm256_i32gather_epi32(pg, _mm256_add_epi32(_mm256_and_si256(_mm256_srli_epi32(hB, 8), ff), Z), 1);
+    coef8_avx2(hq, q->cf);
+}
+
+/* stage four: the arithmetic of a group, into out[0..7] */
+ALWAYS_INLINE void stage4_avx2(const uint8_t *p, const group8 *q, const double *xs, const double *ys,
+                               const double *zs, double s, double a, int mode, double *out)
+{
+    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+    if (q->way == WAY_SCALAR) {
+        kernel_scalar(p, 8, xs, ys, zs, s, a, mode, out);
+        return;
+    }
+    v4d ra, rb;
+    if (q->way == WAY_EXACT) {
+        exact8_avx2(q->cf, q->fr, &ra, &rb);
+    } else {
+        ra = half4(q->cf, 0, q->fr[0][0], q->fr[1][0], q->fr[2][0], 0);
+        rb = half4(q->cf, 1, q->fr[0][1], q->fr[1][1], q->fr[2][1], 0);
+    }
+    if (mode == NOISE_SET) {
+        st4(out, ra), st4(out + 4, rb);
+        return;
+    }
+    if (mode == NOISE_ADD_ABS) {
+        ra = (v4d)((v4l)ra & ~sign), rb = (v4d)((v4l)rb & ~sign); /* fabs */
+    }
+    st4(out, ld4(out) + a * ra);
+    st4(out + 4, ld4(out + 4) + a * rb);
+}
+
+/* Software-pipelined over the groups: iteration j runs stage one of group
+ * j, two of j - D, three of j - 2D and four of j - 3D (R slots hold the
+ * groups in flight). Each stage starts from gathers issued D iterations
+ * (several hundred instructions) earlier, so their long latency overlaps
+ * the other groups' arithmetic instead of stalling it; D = 2 measured
+ * better than 1 and 3 (bench/README_field.md). Stage one also prefetches
+ * the inputs (and out) PF doubles ahead: on arrays larger than the caches
+ * the hardware prefetcher alone left the kernel waiting for memory. */
+enum { D = 2, R = 8, PF = 64 };
+
 ALWAYS_INLINE void kernel8_avx2(const uint8_t *p, size_t n, const double *xs, const double *ys,
                                 const double *zs, double s, double a, int mode, double *out)
 {
-    const v4d big = {1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
-    const v4l sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
-    int8_t cf[CHUNK][4][3][16];
-    __m256i X[CHUNK], Y[CHUNK], Z[CHUNK], hq[CHUNK][4];
-    v4d fr[CHUNK][3][2]; /* the fractions of x, y, z, points 0..3 and 4..7 */
-    size_t i = 0;
-    while (i + 8 <= n) {
-        size_t ng = (n - i) / 8;
-        ng = ng < CHUNK ? ng : CHUNK;
-        unsigned okm = 0;
-        for (size_t g = 0; g < ng; g++) {
-            size_t j = i + 8 * g;
-            v4d xa = ld4(xs + j), xb = ld4(xs + j + 4), ya = ld4(ys + j), yb = ld4(ys + j + 4);
-            v4d za = ld4(zs + j), zb = ld4(zs + j + 4);
-            if (mode != NOISE_SET) {
-                xa *= s, xb *= s, ya *= s, yb *= s, za *= s, zb *= s;
+    group8 q[R];
+    size_t ng = n / 8;
+    for (size_t j = 0; j < ng + 3 * D; j++) {
+        if (j < ng) {
+            if (8 * j + PF < n) {
+                _mm_prefetch((const char *)(xs + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(ys + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(zs + 8 * j + PF), _MM_HINT_T0);
+                _mm_prefetch((const char *)(out + 8 * j + PF), _MM_HINT_T0);
             }
-#define IN(v) ((v4d)((v4l)(v) & ~sign) < big) /* |v| < 2^30, false for NaN */
-            v4l ok = IN(xa) & IN(xb) & IN(ya) & IN(yb) & IN(za) & IN(zb);
-#undef IN
-            if (_mm256_movemask_pd((__m256d)ok) == 15) {
-                X[g] = cell8_avx2(xa, xb, fr[g][0]), Y[g] = cell8_avx2(ya, yb, fr[g][1]);
-                Z[g] = cell8_avx2(za, zb, fr[g][2]);
-                okm |= 1u << g;
-            }
+            stage1_avx2(p, xs + 8 * j, ys + 8 * j, zs + 8 * j, s, mode, &q[j % R]);
         }
-        hash_avx2(p, ng, okm, X, Y, Z, hq);
-        for (size_t g = 0; g < ng; g++)
-            if (okm >> g & 1)
-                coef8_avx2(hq[g], cf[g]);
-        for (size_t g = 0; g < ng; g++, i += 8) {
-            if (!(okm >> g & 1)) {
-                kernel_scalar(p, 8, xs + i, ys + i, zs + i, s, a, mode, out + i);
-                continue;
-            }
-            v4d ra = half4(cf[g], 0, fr[g][0][0], fr[g][1][0], fr[g][2][0]);
-            v4d rb = half4(cf[g], 1, fr[g][0][1], fr[g][1][1], fr[g][2][1]);
-            if (mode == NOISE_SET) {
-                st4(out + i, ra), st4(out + i + 4, rb);
-                continue;
-            }
-            if (mode == NOISE_ADD_ABS) {
-                ra = (v4d)((v4l)ra & ~sign), rb = (v4d)((v4l)rb & ~sign); /* fabs */
-            }
-            st4(out + i, ld4(out + i) + a * ra);
-            st4(out + i + 4, ld4(out + i + 4) + a * rb);
+        if (j >= D && j - D < ng)
+            stage2_avx2(p, &q[(j - D) % R]);
+        if (j >= 2 * D && j - 2 * D < ng)
+            stage3_avx2(p, &q[(j - 2 * D) % R]);
+        if (j >= 3 * D && j - 3 * D < ng) {
+            size_t k = j - 3 * D;
+            stage4_avx2(p, &q[k % R], xs + 8 * k, ys + 8 * k, zs + 8 * k, s, a, mode, out + 8 * k);
         }
     }
 }
@@ -364,6 +480,12 @@ static void kernel_avx512(const uint8_t *p, size_t n, const double *xs, const do
                      1073741824.0, 1073741824.0, 1073741824.0, 1073741824.0};
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
+        if (i + PF < n) { /* as kernel8_avx2 */
+            _mm_prefetch((const char *)(xs + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(ys + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(zs + i + PF), _MM_HINT_T0);
+            _mm_prefetch((const char *)(out + i + PF), _MM_HINT_T0);
+        }
         v8d x = (v8d)_mm512_loadu_pd(xs + i), y = (v8d)_mm512_loadu_pd(ys + i);
         v8d z = (v8d)_mm512_loadu_pd(zs + i);
         if (mode != NOISE_SET)

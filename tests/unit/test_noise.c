@@ -206,10 +206,33 @@ static void test_blocks(void)
 /* Every SIMD level this machine runs (noise_simd_best and below) against the
  * scalar functions, bit for bit: coherent and scattered points, negative
  * ones, lattice points and half-integers, values near ±2^30 (the fast
- * lattice path's bound), huge, infinite and NaN coordinates, in runs of one
- * kind and mixed into the same groups, block lengths that leave a tail of
- * 1..7. */
+ * lattice path's bound), huge, infinite and NaN coordinates, fractions
+ * near the AVX2 kernel's 2^-30 bound and tiny or subnormal ones, in runs of
+ * one kind and mixed into the same groups, block lengths that leave a tail
+ * of 1..7. */
 static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* A coordinate whose fraction is at the AVX2 kernel's fast-way bound 2^-30
+ * (noise_simd.c) or just either side of it, tiny or subnormal, or 1 (the
+ * fraction of -1e-300 rounds to 1), or an ordinary one. In every other
+ * group of eight only the kinds the fast way takes (fraction >= 2^-30), so
+ * that some groups go the fast way right at the bound and the rest the
+ * exact way. */
+static double near_lattice(double u, size_t i)
+{
+    static const int fast[5] = {0, 2, 4, 6, 7};
+    double cell = floor(u * 64) - 32; /* |cell| <= 32: ulp <= 2^-47 */
+    switch ((i / 8) % 2 ? (int)(i % 8) : fast[i % 5]) {
+    case 0: return cell + 0x1p-30;
+    case 1: return cell + (0x1p-30 - 0x1p-47);
+    case 2: return cell + (0x1p-30 + 0x1p-47);
+    case 3: return cell == 0 ? 4.9e-324 * (1 + floor(u * 1000)) : cell + 1e-300;
+    case 4: return -1e-300 * (u + 0.5);
+    case 5: return cell - 0x1p-60;
+    case 6: return cell + (u + 1) * 0x1p-20;
+    default: return u * 7 - 3;
+    }
+}
 
 static void test_simd_levels(void)
 {
@@ -221,13 +244,17 @@ static void test_simd_levels(void)
         double u = rng_uniform(&r), v = rng_uniform(&r), w = rng_uniform(&r);
         /* the first half in runs of 16 of one kind (whole groups of the 8-point
          * kernels take the vector path), the second half mixed point by point */
-        switch (i < N / 2 ? i / 16 % 8 : i % 8) {
+        switch (i < N / 2 ? i / 16 % 9 : i % 9) {
         case 0: x[i] = u * 10, y[i] = v * 10, z[i] = w * 10; break;           /* coherent-ish */
         case 1: x[i] = (u - .5) * 1e6, y[i] = (v - .5) * 1e6, z[i] = w * -3e5; break; /* scattered */
         case 2: x[i] = floor(u * 40) - 20, y[i] = floor(v * 40) * 0.5, z[i] = -0.0; break; /* lattice */
         case 3: x[i] = 1073741824.0 * (u < .5 ? 1 : -1) - (v - .5) * 4, y[i] = w, z[i] = u; break; /* ±2^30 */
         case 4: x[i] = u * 1e300, y[i] = v, z[i] = w; break;
         case 5: x[i] = u < .3 ? INFINITY : u < .6 ? -INFINITY : NAN, y[i] = v, z[i] = w; break;
+        case 7: /* fractions at and around the AVX2 fast way's 2^-30 bound, subnormal
+                 * and tiny ones, fractions that round to 1 (noise_simd.c) */
+            x[i] = near_lattice(u, i), y[i] = near_lattice(v, i + 1), z[i] = near_lattice(w, i + 2);
+            break;
         default: x[i] = (u - .5) * 300, y[i] = (v - .5) * 300, z[i] = (w - .5) * 300; break;
         }
     }
@@ -239,8 +266,9 @@ static void test_simd_levels(void)
     CHECK(bl == (best >= NOISE_LEVEL_AVX2 ? best : NOISE_LEVEL_SCALAR),
           "the blocks use the best level but SSE2 (per-point loop instead): %d of best %d", bl, best);
     for (int level = NOISE_LEVEL_SCALAR; level <= best; level++) {
-        size_t lens[5] = {N, N - 1, N - 2, N - 5, 5};
-        for (int li = 0; li < 5; li++) {
+        /* 8, 23, 47, 57: fewer groups than the AVX2 pipeline is deep (noise_simd.c) */
+        size_t lens[9] = {N, N - 1, N - 2, N - 5, 5, 8, 23, 47, 57};
+        for (int li = 0; li < 9; li++) {
             size_t n = lens[li];
             long bad = 0;
             noise_perlin3_block_at(level, &np, n, x, y, z, out);
