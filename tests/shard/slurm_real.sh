@@ -47,6 +47,16 @@ case $ping in
    exit 0 ;;
 esac
 recipe_setup slurm-real
+# a cluster that answers but cannot run a job here (a container without what
+# slurmd needs) says nothing about the recipe: a trivial job first, skipped
+# when it does not complete within 40 s
+probe=$(cd / && timeout 40 sbatch --wait --parsable -o /dev/null --wrap true </dev/null 2>&1) # not in $wd: jobs_here counts those
+rc=$?
+case $rc in
+0) ;;
+*) say "skipped (the controller answers but a trivial job did not complete: sbatch --wait --wrap true exited $rc, $(echo "$probe" | tail -n 1 | cut -c 1-120))"
+   exit 0 ;;
+esac
 wd=$(pwd -P)
 # a task sees Slurm's variables only, as in a job (none of another launcher's)
 unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
