@@ -126,8 +126,8 @@ $(BUILD)/tests/test_fuzz_script: tests/unit/test_fuzz_script.c tests/fuzz/fuzz_s
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) \
 	    -Wl,--wrap=fileio_write_atomic,--wrap=fileio_read_all -o $@
-# test_interp_counts runs scripts in the interpreter (linked as the fuzz harness is).
-$(BUILD)/tests/test_interp_counts: tests/unit/test_interp_counts.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a \
+# test_interp_counts and test_pending_image run scripts in the interpreter (linked as the fuzz harness is).
+$(BUILD)/tests/test_interp_counts $(BUILD)/tests/test_pending_image: $(BUILD)/tests/%: tests/unit/%.c $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a \
                                    tests/unit/check.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests/unit $< $(FUZZ_SCRIPT_OBJ) $(BUILD)/libfracrt.a $(LDLIBS) -o $@

@@ -254,7 +254,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
         return lang_rt_error(I, c, &e, "superifs_image");
     c = superifs_render(&s->st, (int)buf - 1, &hs, &e);
     if (!c && !lang_image_new(I, w, h, &im))
-        c = tonemap_apply(&hs, &t, im, &e);
+        c = tonemap_defer(&hs, &t, im, &e); /* pixels pending until read (tonemap.h) */
     hist2_free(&hs);
     if (c || !im) {
         lang_image_discard(im);
