@@ -5,7 +5,8 @@
  * For every registered builtin that can take an image — a parameter typed
  * `image` or `any`, or variadic — the table below must hold at least one
  * case (a new builtin fails the test until it has one). Each case runs
- * twice per producer (chaos, chaos_fset, superifs_image), in one REPL-like
+ * twice per producer (chaos, plain and with colour and supersampling;
+ * chaos_fset; superifs_image), in one REPL-like
  * session: the producer's render is bound to IM, then
  *   - pending: the case runs on IM as it is;
  *   - ready:   the harness first fills IM's pixels itself from the source's
@@ -101,6 +102,7 @@ static const char *const no_image[] = {"polygon", "polyline", "pointset"};
 
 static const char *const producers[] = {
     "let IM = chaos(sierpinski, points: 4e4, size: 24, window: [0, 1, 0, 1], background: [0, 0, 1, 1], seed: 3)",
+    "let IM = chaos(sierpinski, points: 4e4, size: 24, window: [0, 1, 0, 1], colour: \"blend\", supersample: 2, seed: 4)",
     "let IM = chaos_fset(sierpinski, points: 4e4, size: 24, window: [-0.1, 1.1, -0.1, 1.1], gamma: 0.7, seed: 3)",
     "let F2 = ifs {\n  1/3 0 0 1/3 0 0\n  1/3 0 0 1/3 2/3 0\n  1/3 0 0 1/3 1/3 2/3\n}\n"
     "let IM = superifs_image(superifs([sierpinski, F2], V: 2, points: 2000, steps: 12, seed: 3), size: 24, "
