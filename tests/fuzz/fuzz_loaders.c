@@ -71,7 +71,7 @@ static void check_image(const image *im)
     bytebuf b;
     bytebuf_init(&b);
     rt_error e;
-    image back = {0, 0, NULL, NULL};
+    image back = {0, 0, NULL, NULL, NULL};
     if (png_encode(im, 16, 4, &b, &e) == RT_OK) {
         if (png_decode(b.data, b.len, &back, NULL, &e) != RT_OK)
             fail("16-bit PNG of a decoded image does not decode");
