@@ -103,6 +103,17 @@ static void kernel_scalar(const uint8_t *p, size_t n, const double *xs, const do
  * |u (b - a)| >= 2^-172 and
  * the values after them multiples of 2^-224, the second products
  * >= 2^-314, multiples of 2^-366 after, the last >= 2^-456: all normal.
+ * (The same chain with 2^-m gives 2^-(10m + 156): any bound up to 2^-86
+ * would do; 2^-30 costs nothing more, since only coordinates within 2^-30
+ * above a lattice point have such fractions.) The guard is necessary, for
+ * two reasons each caught by test_noise: the fast way's fractions of -0 are
+ * +0 (cell8_avx2), and a subnormal fade makes the doubled computation round
+ * differently — at (0.5, 1.25·2^-356, -0.5) with Perlin's table perlin()
+ * halves an odd multiple of 2^-1074 where the doubled values halve exactly
+ * and the final halving rounds instead, one unit apart (worked out in
+ * test_subnormal_halving; with the guard off, a search of 2·10^8 stressed
+ * and random inputs found differences only with a -0 coordinate or a
+ * fraction below 2^-265; with it, none).
  * Other groups (lattice points, -0, tiny coordinates; rare on scattered
  * points) multiply the shuffled coefficients by 0.5 first — exactly ±1, +0,
  * the scalar's own coefficients — and compute perlin()'s operations as they

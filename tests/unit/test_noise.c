@@ -302,6 +302,46 @@ static void test_simd_levels(void)
     }
 }
 
+/* Why the AVX2 kernel's fast way needs its fraction guard (noise_simd.c): it
+ * computes twice perlin()'s values and halves at the end, which is exact
+ * only while no operation rounds in the subnormal range. By hand, with
+ * Perlin's table at (0.5, y, -0.5), y = 1.25·2^-356 = 5·2^-358 (cell
+ * X = Y = 0, Z = 255; fractions 0.5, y, 0.5; u = w = fade(0.5) = 0.5,
+ * v = fade(y) = 125·2^-1074 · 10 = 1250·2^-1074 exactly, a subnormal): the
+ * gradients are, at z, 12 (x + y), 15 (-y - z), 2 (x - y), 13 (-y + z) and
+ * at z - 1, 4 (x + z), 6 (x - z), 12, 0 (x + y), so with y absorbed into
+ * 0.5 and 1: g = 0.5, -0.5, 1.5, 1.5 and 0, 0, -0.5, -1.5; the x lerps give
+ * 0 and 1.5, 0 and -1; c0 = 1.5 v = 1875·2^-1074, c1 = -v = -1250·2^-1074,
+ * and n = c0 + 0.5 (c1 - c0) = 1875 - 1562.5 -> 313 (the half rounds to
+ * even, 1562) times 2^-1074. The doubled computation halves -6250 exactly
+ * to -3125, gets 625, and its final halving rounds 312.5 to 312: wrong by
+ * one unit. Every level must give 313·2^-1074, alone in a group and mixed
+ * with ordinary points. */
+static void test_subnormal_halving(void)
+{
+    const double y = 0x1.4p-356, want = 0x139p-1074;
+    CHECK(noise_reference3(0.5, y, -0.5) == want, "ref(0.5, 1.25*2^-356, -0.5) = %a, want %a",
+          noise_reference3(0.5, y, -0.5), want);
+    noise_perm np;
+    noise_perm_reference(&np);
+    CHECK(noise_perlin3(&np, 0.5, y, -0.5) == want, "ours(0.5, 1.25*2^-356, -0.5) = %a",
+          noise_perlin3(&np, 0.5, y, -0.5));
+    double xs[16], ys[16], zs[16], out[16];
+    for (int i = 0; i < 16; i++) { /* a group of the point alone, one with it in lane 3 */
+        int it = i < 8 || i == 11;
+        xs[i] = it ? 0.5 : 0.3 + i, ys[i] = it ? y : 1.7 * i, zs[i] = it ? -0.5 : 2.9 - i;
+    }
+    for (int level = NOISE_LEVEL_SCALAR; level <= noise_simd_best(); level++) {
+        noise_perlin3_block_at(level, &np, 16, xs, ys, zs, out);
+        int bad = 0;
+        for (int i = 0; i < 16; i++)
+            bad += !same_bits(out[i], noise_perlin3(&np, xs[i], ys[i], zs[i]));
+        CHECK(bad == 0 && out[0] == want && out[7] == want && out[11] == want,
+              "level %d: n(0.5, 1.25*2^-356, -0.5) = %a, %a, %a (want %a); %d differ", level, out[0],
+              out[7], out[11], want, bad);
+    }
+}
+
 /* The fast path of perlin() (paired lanes, pair loads, the coefficient pair
  * table) against noise_perlin_far, the point-by-point reference order with
  * 16-entry gradient tables and the general floor, bit for bit, including
@@ -355,5 +395,6 @@ int main(void)
     test_blocks();
     test_fast_path();
     test_simd_levels();
+    test_subnormal_halving();
     return check_done("test_noise");
 }
