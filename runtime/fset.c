@@ -10,6 +10,7 @@
 
 #include "par.h"
 #include "rng.h"
+#include "tails.h"
 
 #define CHAOS_CHUNK ((uint64_t)1 << 16) /* plotted points per ORBIT chunk */
 
@@ -886,6 +887,33 @@ rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opt
     return RT_OK;
 }
 
+enum { BOX_TAIL = FSET_BOX_POINTS / 1000 + 1 };
+
+/* Per axis the (cut+1)-th smallest and largest of the box pass's points
+ * (tails.h): what sorting them gives. 0 when their sum is not finite (a
+ * NaN, an infinity, or finite values too large to add; the caller sorts). */
+static int box_tails(const double *pts, size_t cut, double lo[3], double hi[3])
+{
+    double hl[3][BOX_TAIL], hh[3][BOX_TAIL], sum = 0;
+    size_t k = cut + 1;
+    for (size_t i = 0; i < k; i++)
+        for (int a = 0; a < 3; a++) {
+            double v = pts[3 * i + (size_t)a];
+            sum += v;
+            tails_heap_offer(hl[a], i, k, v);
+            tails_heap_offer(hh[a], i, k, -v);
+        }
+    for (int a = 0; a < 3; a++) {
+        lo[a] = hl[a][0], hi[a] = -hh[a][0];
+        for (size_t i = k; i < FSET_BOX_POINTS; i++) {
+            double v = pts[3 * i + (size_t)a];
+            sum += v;
+            tails_offer(hl[a], hh[a], k, v, &lo[a], &hi[a]);
+        }
+    }
+    return isfinite(sum);
+}
+
 rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
                        rt_error *e)
 {
@@ -914,12 +942,17 @@ rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opt
         code = rt_fail(e, RT_ENOMEM, "out of memory fitting the view");
         goto done;
     }
+    size_t cut = FSET_BOX_POINTS / 1000;
+    double tl[3], tu[3];
+    int tails_ok = box_tails(c.pts, cut, tl, tu);
     for (int a = 0; a < 3; a++) {
-        for (size_t i = 0; i < FSET_BOX_POINTS; i++)
-            ax[i] = c.pts[3 * i + (size_t)a];
-        qsort(ax, FSET_BOX_POINTS, sizeof *ax, cmp_dbl);
-        size_t cut = FSET_BOX_POINTS / 1000;
-        double l = ax[cut], u = ax[FSET_BOX_POINTS - 1 - cut];
+        double l = tl[a], u = tu[a];
+        if (!tails_ok || l == 0 || u == 0) { /* as defined: sort (+0 and -0 as the sort leaves them) */
+            for (size_t i = 0; i < FSET_BOX_POINTS; i++)
+                ax[i] = c.pts[3 * i + (size_t)a];
+            qsort(ax, FSET_BOX_POINTS, sizeof *ax, cmp_dbl);
+            l = ax[cut], u = ax[FSET_BOX_POINTS - 1 - cut];
+        }
         if (!isfinite(l) || !isfinite(u)) {
             code = rt_fail(e, RT_EINVAL, "the chaos game left every bound (a map is not contractive?)");
             goto done;
