@@ -360,9 +360,18 @@ static size_t chunk_count(const fset_chaos_opts *opts)
     return (size_t)((opts->points + per - 1) / per);
 }
 
-static void chaos_step(const chaos_ctx *c, uint64_t k, rng *r, double *x, double *y)
+/* Step k of an orbit; *at is k mod the order's length, kept by a counter
+ * rather than a division (the set fset_order_at gives). */
+INLINE void chaos_step(const chaos_ctx *c, uint64_t k, uint64_t *at, rng *r, double *x, double *y)
 {
-    int s = fset_order_at(c->o, c->fs->n, k);
+    const fset_order *o = c->o;
+    int s;
+    if (o->kind == FSET_RANDOM) {
+        s = fset_order_at(o, c->fs->n, k);
+    } else {
+        s = o->seq[*at];
+        *at = *at + 1 == (uint64_t)o->len ? 0 : *at + 1;
+    }
     const fset_ifs *w = &c->fs->sets[s];
     int m = fset_pick(c->cum + (size_t)s * FSET_MAX_MAPS, w->n, rng_uniform(r));
     fset_apply2(&w->maps[m], x, y);
@@ -394,15 +403,16 @@ INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, uint64_t *cnt, extreme
     rng r;
     rng_init(&r, op->seed, chunk);
     double x = op->start[0], y = op->start[1];
-    uint64_t k = 0;
+    uint64_t k = 0, at = 0;
     for (; k < op->burn; k++)
-        chaos_step(c, k, &r, &x, &y);
+        chaos_step(c, k, &at, &r, &x, &y);
     /* Plot after complete periods counted from the orbit's start. */
     while (k % period)
-        chaos_step(c, k++, &r, &x, &y);
-    for (uint64_t done = 0; done < npts;) {
-        chaos_step(c, k++, &r, &x, &y);
-        if (k % period == 0) {
+        chaos_step(c, k++, &at, &r, &x, &y);
+    for (uint64_t done = 0, ph = 0; done < npts;) { /* ph: k mod period */
+        chaos_step(c, k++, &at, &r, &x, &y);
+        ph = ph + 1 == period ? 0 : ph + 1;
+        if (ph == 0) {
             if (cnt) {
                 long b = fset_hist_bin(c->hs, x, y);
                 if (b >= 0)
