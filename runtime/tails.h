@@ -17,13 +17,15 @@
 
 #if defined(__GNUC__)
 #define TAILS_INLINE static inline __attribute__((always_inline))
+#define TAILS_CALL static __attribute__((noinline, unused)) /* rare: out of the hot loop */
 #else
 #define TAILS_INLINE static inline
+#define TAILS_CALL static inline
 #endif
 
 /* Offer v to a max-heap h of at most k values (n of them now): it keeps
  * the k smallest values offered, the k-th smallest on top. */
-static inline void tails_heap_offer(double *h, size_t n, size_t k, double v)
+TAILS_CALL void tails_heap_offer(double *h, size_t n, size_t k, double v)
 {
     size_t i;
     if (n < k) {
