@@ -14,6 +14,7 @@
 
 #include "par.h"
 #include "rng.h"
+#include "tails.h"
 
 #if defined(__GNUC__)
 #define INLINE static inline __attribute__((always_inline))
@@ -701,33 +702,6 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Offer v to a max-heap h of at most k values (n of them now): it keeps
- * the k smallest values offered, the k-th smallest on top. */
-static void heap_offer(double *h, size_t n, size_t k, double v)
-{
-    size_t i;
-    if (n < k) {
-        for (i = n; i > 0 && h[(i - 1) / 2] < v; i = (i - 1) / 2)
-            h[i] = h[(i - 1) / 2];
-        h[i] = v;
-        return;
-    }
-    if (!(v < h[0]))
-        return;
-    for (i = 0;;) {
-        size_t c = 2 * i + 1;
-        if (c >= k)
-            break;
-        if (c + 1 < k && h[c + 1] > h[c])
-            c++;
-        if (!(h[c] > v))
-            break;
-        h[i] = h[c];
-        i = c;
-    }
-    h[i] = v;
-}
-
 enum { FIT_TAIL = CHAOS_FIT_POINTS / 1000 + 1 };
 
 /* The tails of one run of the pre-pass, per axis: hl keeps the cut+1
@@ -747,21 +721,6 @@ INLINE void fit_step(rng *r, const sysdata *d, uint32_t *st, uint32_t *cur, doub
         step_map3(d->m + 12 * (size_t)m, x, y, z);
 }
 
-/* Offer v to axis a's tails once both heaps are full; *lo and *hi hold the
- * heaps' tops (hl[a][0] and -hh[a][0]) in registers. The tests are
- * heap_offer's own (v < hl[a][0], and -v < hh[a][0]), made before the call. */
-INLINE void tail_offer(tails *t, int a, size_t k, double v, double *lo, double *hi)
-{
-    if (v < *lo) {
-        heap_offer(t->hl[a], k, k, v);
-        *lo = t->hl[a][0];
-    }
-    if (v > *hi) {
-        heap_offer(t->hh[a], k, k, -v);
-        *hi = -t->hh[a][0];
-    }
-}
-
 /* The pre-pass without storing its points: per axis the (cut+1)-th smallest
  * and largest coordinate (as floats, what a stored point cloud holds) in
  * two heaps of cut+1 values — the same order statistics a selection over
@@ -770,7 +729,7 @@ INLINE void tail_offer(tails *t, int a, size_t k, double v, double *lo, double *
  * heaps are full a value is compared with the heap's top first: after the
  * first few thousand points almost none enters a 0.1 % tail, so a point
  * costs its orbit step and two comparisons an axis; what enters does so
- * exactly as heap_offer would have it, so the heaps hold the same values.
+ * exactly as tails_heap_offer would have it, so the heaps hold the same values.
  * Non-finite values are not tested point by point: sum adds every value,
  * and a sum of at most 3·2^16 floats cannot overflow a double, so it is
  * finite exactly when every value is (an infinity or NaN makes it infinite
@@ -792,8 +751,8 @@ INLINE int fit_tails_run(const job *j, size_t cut, tails *t, const int dim, cons
         double v[3] = {(float)x, (float)y, (float)z};
         for (int a = 0; a < dim; a++) {
             sum += v[a];
-            heap_offer(t->hl[a], i, k, v[a]);
-            heap_offer(t->hh[a], i, k, -v[a]);
+            tails_heap_offer(t->hl[a], i, k, v[a]);
+            tails_heap_offer(t->hh[a], i, k, -v[a]);
         }
     }
     double lx = t->hl[0][0], hx = -t->hh[0][0], ly = t->hl[1][0], hy = -t->hh[1][0];
@@ -802,12 +761,12 @@ INLINE int fit_tails_run(const job *j, size_t cut, tails *t, const int dim, cons
         fit_step(&r, d, &st, &cur, &x, &y, &z, dim, kind);
         double vx = (float)x, vy = (float)y;
         sum += vx + vy;
-        tail_offer(t, 0, k, vx, &lx, &hx);
-        tail_offer(t, 1, k, vy, &ly, &hy);
+        tails_offer(t->hl[0], t->hh[0], k, vx, &lx, &hx);
+        tails_offer(t->hl[1], t->hh[1], k, vy, &ly, &hy);
         if (dim == 3) {
             double vz = (float)z;
             sum += vz;
-            tail_offer(t, 2, k, vz, &lz, &hz);
+            tails_offer(t->hl[2], t->hh[2], k, vz, &lz, &hz);
         }
     }
     return isfinite(sum);

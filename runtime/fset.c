@@ -10,8 +10,15 @@
 
 #include "par.h"
 #include "rng.h"
+#include "tails.h"
 
 #define CHAOS_CHUNK ((uint64_t)1 << 16) /* plotted points per ORBIT chunk */
+
+#if defined(__GNUC__)
+#define INLINE static inline __attribute__((always_inline))
+#else
+#define INLINE static inline
+#endif
 
 /* ---- validation ---------------------------------------------------- */
 
@@ -353,40 +360,75 @@ static size_t chunk_count(const fset_chaos_opts *opts)
     return (size_t)((opts->points + per - 1) / per);
 }
 
-static void chaos_step(const chaos_ctx *c, uint64_t k, rng *r, double *x, double *y)
+/* Step k of an orbit; *at is k mod the order's length, kept by a counter
+ * rather than a division (the set fset_order_at gives). */
+INLINE void chaos_step(const chaos_ctx *c, uint64_t k, uint64_t *at, rng *r, double *x, double *y)
 {
-    int s = fset_order_at(c->o, c->fs->n, k);
+    const fset_order *o = c->o;
+    int s;
+    if (o->kind == FSET_RANDOM) {
+        s = fset_order_at(o, c->fs->n, k);
+    } else {
+        s = o->seq[*at];
+        *at = *at + 1 == (uint64_t)o->len ? 0 : *at + 1;
+    }
     const fset_ifs *w = &c->fs->sets[s];
     int m = fset_pick(c->cum + (size_t)s * FSET_MAX_MAPS, w->n, rng_uniform(r));
     fset_apply2(&w->maps[m], x, y);
 }
 
-static void chaos_orbit(void *p, size_t chunk, int worker)
+/* The plotted points' extremes and sum (ext: min x, max x, min y, max y). */
+typedef struct extremes {
+    double ext[4], sum;
+} extremes;
+
+static inline void extremes_add(extremes *x, double px, double py)
 {
-    chaos_ctx *c = p;
+    x->ext[0] = px < x->ext[0] ? px : x->ext[0];
+    x->ext[1] = px > x->ext[1] ? px : x->ext[1];
+    x->ext[2] = py < x->ext[2] ? py : x->ext[2];
+    x->ext[3] = py > x->ext[3] ? py : x->ext[3];
+    x->sum += px + py;
+}
+
+/* One chunk of an orbit: its plotted points binned into cnt, or (cnt NULL,
+ * the window's pre-pass) added to xt. Inlined into both callers, so the test
+ * on cnt is made at compile time. */
+INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, uint64_t *cnt, extremes *xt)
+{
     const fset_chaos_opts *op = c->opts;
-    uint64_t *cnt = c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h;
     uint64_t first = (uint64_t)chunk * CHAOS_CHUNK;
     uint64_t npts = op->points - first < CHAOS_CHUNK ? op->points - first : CHAOS_CHUNK;
     uint64_t period = (op->plot_period && c->o->kind != FSET_RANDOM) ? (uint64_t)c->o->len : 1;
     rng r;
     rng_init(&r, op->seed, chunk);
     double x = op->start[0], y = op->start[1];
-    uint64_t k = 0;
+    uint64_t k = 0, at = 0;
     for (; k < op->burn; k++)
-        chaos_step(c, k, &r, &x, &y);
+        chaos_step(c, k, &at, &r, &x, &y);
     /* Plot after complete periods counted from the orbit's start. */
     while (k % period)
-        chaos_step(c, k++, &r, &x, &y);
-    for (uint64_t done = 0; done < npts;) {
-        chaos_step(c, k++, &r, &x, &y);
-        if (k % period == 0) {
-            long b = fset_hist_bin(c->hs, x, y);
-            if (b >= 0)
-                cnt[b]++;
+        chaos_step(c, k++, &at, &r, &x, &y);
+    for (uint64_t done = 0, ph = 0; done < npts;) { /* ph: k mod period */
+        chaos_step(c, k++, &at, &r, &x, &y);
+        ph = ph + 1 == period ? 0 : ph + 1;
+        if (ph == 0) {
+            if (cnt) {
+                long b = fset_hist_bin(c->hs, x, y);
+                if (b >= 0)
+                    cnt[b]++;
+            } else {
+                extremes_add(xt, x, y);
+            }
             done++;
         }
     }
+}
+
+static void chaos_orbit(void *p, size_t chunk, int worker)
+{
+    chaos_ctx *c = p;
+    orbit_chunk(c, chunk, c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h, NULL);
 }
 
 /* The end points of one chunk's walks (dim doubles each, *n of them; rt_free
@@ -442,8 +484,8 @@ static void chaos_walk(void *p, size_t chunk, int worker)
     rt_free(pt);
 }
 
-rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, hist2 *hs,
-                   const rt_run *run, rt_error *e)
+/* What a 2-D game checks before it runs, but its histogram. */
+static rt_code game_check(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, rt_error *e)
 {
     rt_code code = fset_validate(fs, e);
     if (code)
@@ -455,12 +497,21 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
             return rt_fail(e, RT_EINVAL,
                            "chaos game with a function set needs 2-D maps (W%d is %d-D)", s + 1,
                            fs->sets[s].maps[0].dim);
+    if (opts->mode == FSET_WALK && opts->depth < 1)
+        return rt_fail(e, RT_EINVAL, "chaos game walk depth is 0 (expected at least 1)");
+    return RT_OK;
+}
+
+rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, hist2 *hs,
+                   const rt_run *run, rt_error *e)
+{
+    rt_code code = game_check(fs, o, opts, e);
+    if (code)
+        return code;
     if (!hs->count || hs->w < 1 || hs->h < 1)
         return rt_fail(e, RT_EINVAL, "chaos game: the histogram is not allocated");
     if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
         return rt_fail(e, RT_EINVAL, "chaos game: the histogram window is empty");
-    if (opts->mode == FSET_WALK && opts->depth < 1)
-        return rt_fail(e, RT_EINVAL, "chaos game walk depth is 0 (expected at least 1)");
     if (opts->points == 0)
         return RT_OK;
 
@@ -710,35 +761,33 @@ void fset_fit_aspect(double lo[2], double hi[2], int w, int h, double margin)
     }
 }
 
-/* The window of a function-set chaos game: a bound from the maps'
- * contractions, narrowed by three coarse histogram passes. */
-rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
-                       double hi[2], const rt_run *run, rt_error *e)
+enum { FIT_GRID = 256, FIT_PASSES = 4 };
+
+/* One pass's narrowing: the occupied cells x0..x1, y0..y1 (y0 the top row)
+ * of the FIT_GRID² histogram of lo..hi, plus one cell on each side. */
+static void fit_narrow(double lo[2], double hi[2], int x0, int x1, int y0, int y1)
 {
-    double R = 0;
-    int contractive = 1;
-    for (int s = 0; s < fs->n; s++)
-        for (int m = 0; m < fs->sets[s].n; m++) {
-            const affine *a = &fs->sets[s].maps[m];
-            double c = affine_contraction(a);
-            if (!(c < 0.999))
-                contractive = 0;
-            else
-                R = fmax(R, hypot(a->t[0], a->t[1]) / (1 - c));
-        }
-    R = contractive ? R + hypot(opts->start[0], opts->start[1]) + 1e-9 : 1e6;
-    lo[0] = lo[1] = -R;
-    hi[0] = hi[1] = R;
-    fset_chaos_opts fo = *opts;
-    fo.points = opts->points < 50000 ? opts->points : 50000;
-    for (int pass = 0; pass < 4; pass++) {
+    double bx = (hi[0] - lo[0]) / FIT_GRID, by = (hi[1] - lo[1]) / FIT_GRID;
+    double nlo0 = lo[0] + (x0 - 1) * bx, nhi0 = lo[0] + (x1 + 2) * bx;
+    double nhi1 = hi[1] - (y0 - 1) * by, nlo1 = hi[1] - (y1 + 2) * by;
+    lo[0] = nlo0;
+    hi[0] = nhi0;
+    lo[1] = nlo1;
+    hi[1] = nhi1;
+}
+
+/* The passes as defined: the game into a histogram each time. */
+static rt_code fit_by_histograms(const fset *fs, const fset_order *o, const fset_chaos_opts *fo, double lo[2],
+                                 double hi[2], const rt_run *run, rt_error *e)
+{
+    for (int pass = 0; pass < FIT_PASSES; pass++) {
         hist2 hs;
-        const int G = 256;
+        const int G = FIT_GRID;
         rt_code c = hist2_init(&hs, G, G, lo, hi, 0, e);
         if (c)
             return c;
         rt_sharder *sv = par_set_sharder(NULL); /* a pre-pass: in full in every shard (par.h) */
-        c = fset_chaos(fs, o, &fo, &hs, run, e);
+        c = fset_chaos(fs, o, fo, &hs, run, e);
         par_set_sharder(sv);
         if (c) {
             hist2_free(&hs);
@@ -760,16 +809,119 @@ rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opt
         hist2_free(&hs);
         if (x1 < 0)
             return rt_fail(e, RT_EINVAL, "no point of the chaos game fell near the origin; give window: [xmin, xmax, ymin, ymax]");
-        double bx = (hi[0] - lo[0]) / G, by = (hi[1] - lo[1]) / G;
-        double nlo0 = lo[0] + (x0 - 1) * bx, nhi0 = lo[0] + (x1 + 2) * bx;
-        double nhi1 = hi[1] - (y0 - 1) * by, nlo1 = hi[1] - (y1 + 2) * by;
-        lo[0] = nlo0;
-        hi[0] = nhi0;
-        lo[1] = nlo1;
-        hi[1] = nhi1;
+        fit_narrow(lo, hi, x0, x1, y0, y1);
     }
+    return RT_OK;
+}
+
+/* The passes from the game's extremes, run once: every pass plays the same
+ * game (same seed, same points), and fset_hist_bin's cell is monotone in x
+ * and in y (a difference, a quotient and a product by positive numbers,
+ * each correctly rounded, then a truncation). So when the cells of (min x,
+ * max y) and (max x, min y) both lie in a pass's grid, every point does,
+ * and those two cells are the corners of the occupied cells: the pass's
+ * result without its histogram. 0 when that does not hold for some pass
+ * (a point outside the window, a NaN, an infinity, no point at all): the
+ * caller then runs the passes as defined. lo and hi are changed only on 1. */
+static int fit_by_extremes(const fset *fs, const fset_order *o, const fset_chaos_opts *fo, double lo[2],
+                           double hi[2])
+{
+    if (fo->points == 0)
+        return 0;
+    extremes xt = {{INFINITY, -INFINITY, INFINITY, -INFINITY}, 0};
+    chaos_ctx c = {fs, o, fo, NULL, cumulative_tables(fs), NULL, 0};
+    if (!c.cum)
+        return 0;
+    for (size_t ch = 0; ch < chunk_count(fo); ch++) {
+        if (fo->mode != FSET_WALK) {
+            orbit_chunk(&c, ch, NULL, &xt);
+            continue;
+        }
+        size_t n;
+        double *pt = walk_chunk(fs, o, c.cum, fo, ch, 2, &n);
+        if (!pt) {
+            rt_free(c.cum);
+            return 0;
+        }
+        for (size_t i = 0; i < n; i++)
+            extremes_add(&xt, pt[2 * i], pt[2 * i + 1]);
+        rt_free(pt);
+    }
+    rt_free(c.cum);
+    if (!isfinite(xt.sum)) /* a NaN would be dropped from the cells, not from the extremes */
+        return 0;
+    double wlo[2] = {lo[0], lo[1]}, whi[2] = {hi[0], hi[1]};
+    for (int pass = 0; pass < FIT_PASSES; pass++) {
+        hist2 hs = {FIT_GRID, FIT_GRID, {wlo[0], wlo[1]}, {whi[0], whi[1]}, NULL, NULL, NULL, NULL};
+        if (!(whi[0] > wlo[0]) || !(whi[1] > wlo[1]))
+            return 0;
+        long b0 = fset_hist_bin(&hs, xt.ext[0], xt.ext[3]), b1 = fset_hist_bin(&hs, xt.ext[1], xt.ext[2]);
+        if (b0 < 0 || b1 < 0)
+            return 0;
+        fit_narrow(wlo, whi, (int)(b0 % FIT_GRID), (int)(b1 % FIT_GRID), (int)(b0 / FIT_GRID),
+                   (int)(b1 / FIT_GRID));
+    }
+    memcpy(lo, wlo, sizeof wlo);
+    memcpy(hi, whi, sizeof whi);
+    return 1;
+}
+
+/* The window of a function-set chaos game: a bound from the maps'
+ * contractions, narrowed by four coarse histogram passes (fit_by_extremes
+ * gives their result without the histograms when it can). */
+rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
+                       double hi[2], const rt_run *run, rt_error *e)
+{
+    double R = 0;
+    int contractive = 1;
+    for (int s = 0; s < fs->n; s++)
+        for (int m = 0; m < fs->sets[s].n; m++) {
+            const affine *a = &fs->sets[s].maps[m];
+            double c = affine_contraction(a);
+            if (!(c < 0.999))
+                contractive = 0;
+            else
+                R = fmax(R, hypot(a->t[0], a->t[1]) / (1 - c));
+        }
+    R = contractive ? R + hypot(opts->start[0], opts->start[1]) + 1e-9 : 1e6;
+    lo[0] = lo[1] = -R;
+    hi[0] = hi[1] = R;
+    fset_chaos_opts fo = *opts;
+    fo.points = opts->points < 50000 ? opts->points : 50000;
+    rt_code code = game_check(fs, o, &fo, e);
+    if (code)
+        return code;
+    if (!fit_by_extremes(fs, o, &fo, lo, hi) && (code = fit_by_histograms(fs, o, &fo, lo, hi, run, e)))
+        return code;
     fset_fit_aspect(lo, hi, w, h, 0.03);
     return RT_OK;
+}
+
+enum { BOX_TAIL = FSET_BOX_POINTS / 1000 + 1 };
+
+/* Per axis the (cut+1)-th smallest and largest of the box pass's points
+ * (tails.h): what sorting them gives. 0 when their sum is not finite (a
+ * NaN, an infinity, or finite values too large to add; the caller sorts). */
+static int box_tails(const double *pts, size_t cut, double lo[3], double hi[3])
+{
+    double hl[3][BOX_TAIL], hh[3][BOX_TAIL], sum = 0;
+    size_t k = cut + 1;
+    for (size_t i = 0; i < k; i++)
+        for (int a = 0; a < 3; a++) {
+            double v = pts[3 * i + (size_t)a];
+            sum += v;
+            tails_heap_offer(hl[a], i, k, v);
+            tails_heap_offer(hh[a], i, k, -v);
+        }
+    for (int a = 0; a < 3; a++) {
+        lo[a] = hl[a][0], hi[a] = -hh[a][0];
+        for (size_t i = k; i < FSET_BOX_POINTS; i++) {
+            double v = pts[3 * i + (size_t)a];
+            sum += v;
+            tails_offer(hl[a], hh[a], k, v, &lo[a], &hi[a]);
+        }
+    }
+    return isfinite(sum);
 }
 
 rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
@@ -800,12 +952,17 @@ rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opt
         code = rt_fail(e, RT_ENOMEM, "out of memory fitting the view");
         goto done;
     }
+    size_t cut = FSET_BOX_POINTS / 1000;
+    double tl[3], tu[3];
+    int tails_ok = box_tails(c.pts, cut, tl, tu);
     for (int a = 0; a < 3; a++) {
-        for (size_t i = 0; i < FSET_BOX_POINTS; i++)
-            ax[i] = c.pts[3 * i + (size_t)a];
-        qsort(ax, FSET_BOX_POINTS, sizeof *ax, cmp_dbl);
-        size_t cut = FSET_BOX_POINTS / 1000;
-        double l = ax[cut], u = ax[FSET_BOX_POINTS - 1 - cut];
+        double l = tl[a], u = tu[a];
+        if (!tails_ok || l == 0 || u == 0) { /* as defined: sort (+0 and -0 as the sort leaves them) */
+            for (size_t i = 0; i < FSET_BOX_POINTS; i++)
+                ax[i] = c.pts[3 * i + (size_t)a];
+            qsort(ax, FSET_BOX_POINTS, sizeof *ax, cmp_dbl);
+            l = ax[cut], u = ax[FSET_BOX_POINTS - 1 - cut];
+        }
         if (!isfinite(l) || !isfinite(u)) {
             code = rt_fail(e, RT_EINVAL, "the chaos game left every bound (a map is not contractive?)");
             goto done;

@@ -160,7 +160,9 @@ rt_code fset_chaos_view(const fset *fs, const fset_order *o, const fset_chaos_op
 /* The box of a 3-D function set's chaos game for framing: FSET_BOX_POINTS
  * plotted points of the same game (the first chunks of a game on a stream
  * independent of the picture's), per axis the 0.1 % and 99.9 % quantiles widened by 5 % of
- * the extent on each side (chaos_fit's rule for IFSs). */
+ * the extent on each side (chaos_fit's rule for IFSs). The quantiles come
+ * from two heaps per axis (tails.h); the points are sorted only when their
+ * sum is not finite or a quantile is 0 (the sort's sign of zero). */
 #define FSET_BOX_POINTS 16384
 rt_code fset_chaos_box(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, double lo[3], double hi[3],
                        rt_error *e);
@@ -177,7 +179,10 @@ void fset_fit_aspect(double lo[2], double hi[2], int w, int h, double margin);
  * every shard) into a 256×256 histogram of the window each narrow it to the
  * occupied cells plus one cell on each side, and
  * fset_fit_aspect with a 3 % margin ends it. RT_EINVAL when no point falls
- * in the first window. */
+ * in the first window. The passes play the same game, so when every point
+ * lies in every window the cells of its extremes give each pass's result:
+ * one game and no histograms (the passes as defined otherwise, e.g. for a
+ * point beyond the first window or a NaN; tests/unit/test_fset_fit.c). */
 rt_code fset_chaos_fit(const fset *fs, const fset_order *o, const fset_chaos_opts *opts, int w, int h, double lo[2],
                        double hi[2], const rt_run *run, rt_error *e);
 
