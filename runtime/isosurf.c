@@ -43,6 +43,10 @@
 
 #include "par.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #define SLAB 4
 #if defined(__GNUC__)
 #define INLINE static inline __attribute__((always_inline))
@@ -433,7 +437,24 @@ static void pass_classify(void *ctx, size_t c, int worker)
         for (int w = 0; 64 * w < n0; w++) {
             int x0 = 64 * w, xa = x0, xe = x0 + 64 < n0 ? x0 + 64 : n0;
             uint64_t v = 0;
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#if defined(__SSE2__)
+            if (xe - x0 == 64) {
+                /* 16 comparisons at a time (x86-64's baseline SSE2: cmpps
+                 * is false for NaN, as >= is), narrowed to 16 bytes and
+                 * their signs gathered into 16 bits */
+                __m128 l4 = _mm_set1_ps(lv);
+                for (int k = 0; k < 4; k++) {
+                    const float *r = row + x0 + 16 * k;
+                    __m128i a = _mm_castps_si128(_mm_cmpge_ps(_mm_loadu_ps(r), l4));
+                    __m128i b2 = _mm_castps_si128(_mm_cmpge_ps(_mm_loadu_ps(r + 4), l4));
+                    __m128i c2 = _mm_castps_si128(_mm_cmpge_ps(_mm_loadu_ps(r + 8), l4));
+                    __m128i d2 = _mm_castps_si128(_mm_cmpge_ps(_mm_loadu_ps(r + 12), l4));
+                    __m128i m = _mm_packs_epi16(_mm_packs_epi32(a, b2), _mm_packs_epi32(c2, d2));
+                    v |= (uint64_t)(unsigned)_mm_movemask_epi8(m) << (16 * k);
+                }
+                xa = xe;
+            }
+#elif defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
             if (xe - x0 == 64) {
                 /* 64 comparisons into bytes (vectorised), each 8 bytes of 0/1
                  * gathered into 8 bits by one multiplication */
