@@ -710,6 +710,7 @@ static const mc_case *cell_case(const iso_job *j, int x, int y, int z, int mask)
 typedef struct cell_acc {
     size_t ntri, ncen;
     uint32_t *T, *CR, **ids;
+    const uint32_t *eb[12]; /* per cube edge: its id for the cell at layer index 0 (idx * 3 on) */
     size_t cen0;
 } cell_acc;
 
@@ -725,11 +726,11 @@ INLINE void count_cell(cell_acc *a, const mc_case *K)
  * (each with a fan of triangles around it) */
 INLINE void build_cell(iso_job *j, cell_acc *a, size_t idx, const mc_case *K)
 {
-    uint32_t *T = a->T, *const *ids = a->ids;
+    uint32_t *T = a->T;
     for (int ti = 0; ti < K->nt; ti++, T += 3)
         for (int r = 0; r < 3; r++) {
             int e = K->e[ti][r];
-            T[r] = ids[j->tb->elo[e] >> 2][idx * 3 + j->eoff[e]];
+            T[r] = a->eb[e][idx * 3];
         }
     for (int k = 0, at = 0; k < K->nc; at += K->ck[k++]) {
         uint32_t *rec = a->CR;
@@ -739,7 +740,7 @@ INLINE void build_cell(iso_job *j, cell_acc *a, size_t idx, const mc_case *K)
         rec[1] = (uint32_t)n;
         for (int r = 0; r < n; r++) {
             int e = K->ce[at + r];
-            rec[2 + r] = ids[j->tb->elo[e] >> 2][idx * 3 + j->eoff[e]];
+            rec[2 + r] = a->eb[e][idx * 3];
         }
         for (int r = 0; r < n; r++, T += 3) {
             T[0] = rec[2 + r];
@@ -756,6 +757,9 @@ INLINE void build_cell(iso_job *j, cell_acc *a, size_t idx, const mc_case *K)
 INLINE void walk_cells(iso_job *j, int z, cell_acc *a, const int build)
 {
     int W = j->W;
+    if (build)
+        for (int e = 0; e < 12; e++)
+            a->eb[e] = a->ids[j->tb->elo[e] >> 2] + j->eoff[e];
     for (int y = -1; y < j->n[1]; y++) {
         const uint64_t *R[4];
         if (!cell_rows(j, y, z, R))
