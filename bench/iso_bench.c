@@ -3,7 +3,7 @@
  *
  * Reports, best of R runs each:
  *   - field sampling of an n³ grid, and the marching-cubes extractor on it,
- *     for n = 128 and 256, with 1 and 2 threads, against VTK's
+ *     for n = 64, 128 and 256, with 1 and 2 threads, against VTK's
  *     vtkFlyingEdges3D on the same samples (one thread, bench/iso_vtk.py,
  *     when python3-vtk9 is installed), a plain marching-cubes loop (below:
  *     unwelded triangle soup, one thread) and, with the argument `tets`,
@@ -223,14 +223,14 @@ static void flying_edges(const char *argv0, const volume *v, double level, int r
         printf("  FlyingEdges    skipped: %s\n", line[0] ? line : "iso_vtk.py printed nothing");
         return;
     }
-    printf("  VTK FlyingEdges 1 thr (%s) CPU %.3f s wall %.3f s   %ld triangles, %ld points\n", backend, cpu, wall,
+    printf("  VTK FlyingEdges 1 thr (%s) CPU %.4f s wall %.4f s   %ld triangles, %ld points\n", backend, cpu, wall,
            tris, pts);
     printf("  ours / FlyingEdges: time %.2f (1 thr CPU), %.2f (1 thr wall); triangles %.3f\n", ours_cpu / cpu,
            ours_wall / wall, (double)ours_nt / (double)tris);
     if (warm_cpu < 1e9)
         printf("  ours / FlyingEdges, both on a warm heap: time %.2f (1 thr CPU), %.2f (1 thr wall)\n",
                warm_cpu / cpu, warm_wall / wall);
-    printf("  first call of each (fresh memory): ours CPU %.3f s, FlyingEdges CPU %.3f s, ratio %.2f\n", first_cpu,
+    printf("  first call of each (fresh memory): ours CPU %.4f s, FlyingEdges CPU %.4f s, ratio %.2f\n", first_cpu,
            fe_first, first_cpu / fe_first);
 }
 
@@ -248,8 +248,8 @@ int main(int argc, char **argv)
     o.level = 0.3;
     o.normals = 1;
     printf("iso_bench: best of %d runs\n", runs);
-    int sizes[2] = {128, 256};
-    for (int si = 0; si < 2 && strcmp(only, "rm") != 0; si++) {
+    int sizes[3] = {64, 128, 256};
+    for (int si = 0; si < 3 && strcmp(only, "rm") != 0; si++) {
         int n = sizes[si];
         volume v;
         if (volume_init(&v, n, n, n, lo, hi, &e))
@@ -343,10 +343,10 @@ int main(int argc, char **argv)
         printf("%3d^3: %zu vertices, %zu triangles (sink %zu)\n", n, nv, nt, sink % 7);
         printf("  sample field   1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx\n", tsample[1], tsample[2],
                tsample[1] / tsample[2]);
-        printf("  marching cubes 1 thr %7.3f s   2 thr %7.3f s   speed-up %.2fx   (1 thr CPU %.3f s)\n",
+        printf("  marching cubes 1 thr %7.4f s   2 thr %7.4f s   speed-up %.2fx   (1 thr CPU %.4f s)\n",
                tiso[1], tiso[2], tiso[1] / tiso[2], ciso);
         if (twarm < 1e9)
-            printf("  marching cubes 1 thr, warm heap %7.3f s   (CPU %.3f s)\n", twarm, cwarm);
+            printf("  marching cubes 1 thr, warm heap %7.4f s   (CPU %.4f s)\n", twarm, cwarm);
         if (tets)
             printf("  old tets       1 thr %7.3f s   2 thr %7.3f s   %zu triangles; new/old time %.2f (1 thr) %.2f (2 thr)\n",
                    ttet[1], ttet[2], tet_nt, tiso[1] / ttet[1], tiso[2] / ttet[2]);
