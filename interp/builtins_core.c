@@ -727,7 +727,7 @@ static const bparam p_random[] = {{"i", "int[0,9007199254740992]", NULL}, {"seed
 static const bparam p_randoms[] = {{"n", "int>=0", NULL}, {"seed", "int", "nil"}};
 
 static const builtin core[] = {
-    BUILTIN("sqrt", b_sqrt, p_x, "Square root; element-wise on lists, symbolic on fields."),
+    BUILTIN("sqrt", b_sqrt, p_x, "Square root; element-wise on lists, per colour channel on images, symbolic on fields."),
     BUILTIN("exp", b_exp, p_x, "e^x."),
     BUILTIN("log", b_log, p_x, "Natural logarithm."),
     BUILTIN("sin", b_sin, p_x, "Sine (radians)."),

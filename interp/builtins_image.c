@@ -164,9 +164,55 @@ static float fop(int op, float x, float y)
     }
 }
 
+static double u_round(double v) { return floor(v + 0.5); } /* as round() of a number */
+static double u_sign(double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; }
+
+/* The math function of one argument that op names (sqrt … sign), NULL for
+ * any other op. */
+static double (*unary_fn(int op))(double)
+{
+    switch (op) {
+    case OP_SQRT: return sqrt;
+    case OP_EXP: return exp;
+    case OP_LOG: return log;
+    case OP_SIN: return sin;
+    case OP_COS: return cos;
+    case OP_TAN: return tan;
+    case OP_ASIN: return asin;
+    case OP_ACOS: return acos;
+    case OP_ATAN: return atan;
+    case OP_ABS: return fabs;
+    case OP_FLOOR: return floor;
+    case OP_CEIL: return ceil;
+    case OP_ROUND: return u_round;
+    case OP_SIGN: return u_sign;
+    default: return NULL;
+    }
+}
+
+/* sqrt(im) … sign(im): the function of each colour channel, computed as for
+ * a number (in double) and rounded to the pixel's float; alpha is kept, as
+ * the operators keep the first image's. */
+static int image_unary(interp *I, double (*f)(double), const image *x, value *out)
+{
+    image *r;
+    if (lang_image_new(I, x->w, x->h, &r))
+        return -1;
+    size_t n = (size_t)x->w * (size_t)x->h * 4;
+    for (size_t i = 0; i < n; i += 4) {
+        for (int c = 0; c < 3; c++)
+            r->px[i + c] = (float)f((double)x->px[i + c]);
+        r->px[i + 3] = x->px[i + 3];
+    }
+    return lang_image_value(I, r, out) ? -1 : 1;
+}
+
 static int image_arith(interp *I, int op, value a, value b, value *out)
 {
     image *x = lang_as_image(a), *y = lang_as_image(b);
+    double (*f)(double) = unary_fn(op);
+    if (f && x && b.k == V_NIL)
+        return image_unary(I, f, x, out);
     int binary = op == T_PLUS || op == T_MINUS || op == T_STAR || op == T_SLASH || op == T_CARET ||
                  op == OP_MAX || op == OP_MIN;
     if (op == OP_NEG && x && b.k == V_NIL) {
