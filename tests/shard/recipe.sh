@@ -46,3 +46,19 @@ recipe_same() {
         cmp -s "$1/$f" "$2/$f" || { echo "$f differs"; return 1; }
     done
 }
+
+# The Slurm recipe in the current folder (slurm.sh emulated, slurm_real.sh
+# real): scene.frac and its single run in single/, render.sbatch and
+# submit.sh as docs/scale.md writes them; sets n, the array's size (the
+# recipe's N). On a doc without them, the caller's fail.
+recipe_slurm_files() {
+    cp "$here/small.frac" scene.frac || exit 1
+    frac -q -o single scene.frac || exit 1
+    recipe_block "tests/shard/slurm.sh runs this block as render.sbatch" >render.sbatch
+    recipe_block "tests/shard/slurm.sh runs these two lines" >submit.sh
+    grep -q '^#SBATCH --array=' render.sbatch || fail "no job array script in docs/scale.md"
+    grep -q '^sbatch ' submit.sh || fail "no sbatch lines in docs/scale.md"
+    range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\)$/\1/p' render.sbatch)
+    [ -n "$range" ] || fail "the array is not A-B"
+    n=$((${range#*-} - ${range%-*} + 1))
+}

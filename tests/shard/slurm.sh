@@ -25,16 +25,7 @@ export FAKE_SLURM_STATE
 # a task sees Slurm's variables only, as in a job (none of another launcher's)
 unset SLURM_ARRAY_TASK_ID SLURM_ARRAY_TASK_COUNT SLURM_ARRAY_TASK_MIN SLURM_PROCID SLURM_NTASKS
 unset SLURM_CPUS_PER_TASK OMPI_COMM_WORLD_RANK OMPI_COMM_WORLD_SIZE PMI_RANK PMI_SIZE
-cp "$here/small.frac" scene.frac || exit 1
-frac -q -o single scene.frac || exit 1
-recipe_block "tests/shard/slurm.sh runs this block as render.sbatch" >render.sbatch
-recipe_block "tests/shard/slurm.sh runs these two lines" >submit.sh
-grep -q '^#SBATCH --array=' render.sbatch || fail "no job array script in docs/scale.md"
-grep -q '^sbatch ' submit.sh || fail "no sbatch lines in docs/scale.md"
-# the array's size from its --array=A-B line: the recipe's N
-range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\)$/\1/p' render.sbatch)
-[ -n "$range" ] || fail "the array is not A-B"
-n=$((${range#*-} - ${range%-*} + 1))
+recipe_slurm_files
 sh -e submit.sh </dev/null >submit.out 2>&1 || fail "the submission: $(tail -n 3 submit.out)"
 # the emulated cluster runs the queue: the merge job first if it could
 "$here/fake_sbatch.sh" --run-queue || fail "the queue"

@@ -74,15 +74,7 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 1' INT TERM HUP
-cp "$here/small.frac" scene.frac || exit 1
-frac -q -o single scene.frac || exit 1
-recipe_block "tests/shard/slurm.sh runs this block as render.sbatch" >render.sbatch
-recipe_block "tests/shard/slurm.sh runs these two lines" >submit.sh
-grep -q '^#SBATCH --array=' render.sbatch || fail "no job array script in docs/scale.md"
-grep -q '^sbatch ' submit.sh || fail "no sbatch lines in docs/scale.md"
-range=$(sed -n 's/^#SBATCH --array=\([0-9]*-[0-9]*\)$/\1/p' render.sbatch)
-[ -n "$range" ] || fail "the array is not A-B"
-n=$((${range#*-} - ${range%-*} + 1))
+recipe_slurm_files
 # On a cluster of tools/slurm_local.sh (ClusterName frac-local, nobody
 # else's) the test makes the merge job free to start before the array, as
 # the emulation does: the partition is DOWN during the submission, then the
