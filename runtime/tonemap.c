@@ -177,15 +177,6 @@ static rt_code plan_init(tm_plan *p, const hist2 *hs, const tonemap_opts *o, con
     return RT_OK;
 }
 
-/* The pixel of count c with a ramp. */
-static inline void ramp_px(const tm_plan *p, uint64_t c, float *px)
-{
-    if (c < p->nv) /* c = 0 (then also when M = 0): the background */
-        memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
-    else
-        ramp_eval(&p->rp, density(p->curve, c, p->mx, p->lmx, p->gamma, p->bright), px);
-}
-
 /* Image rows [y0, y1) into out (image_src.rows). */
 static void plan_rows(const image_src *s, int y0, int y1, float *out)
 {
@@ -195,13 +186,30 @@ static void plan_rows(const image_src *s, int y0, int y1, float *out)
     uint64_t mx = p->mx;
     size_t nv = p->nv;
     if (k == 1 && p->colour == TONEMAP_RAMP) { /* the common case, straight along the bins */
+        /* one loop per count width; every value the loop reads in a local
+         * (the build's -fno-strict-aliasing: a store into out would
+         * otherwise reload p's fields) */
         size_t b0 = (size_t)y0 * (size_t)w, n = (size_t)(y1 - y0) * (size_t)w;
-        if (hs->count32)
-            for (size_t b = 0; b < n; b++)
-                ramp_px(p, hs->count32[b0 + b], out + 4 * b);
-        else
-            for (size_t b = 0; b < n; b++)
-                ramp_px(p, hs->count[b0 + b], out + 4 * b);
+        float *px = out;
+        if (hs->count32) {
+            const uint32_t *cnt = hs->count32 + b0;
+            for (size_t b = 0; b < n; b++, px += 4) {
+                uint32_t c = cnt[b];
+                if (c < nv) /* c = 0 (then also when M = 0): the background */
+                    memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
+                else
+                    ramp_eval(&p->rp, density(p->curve, c, mx, p->lmx, p->gamma, p->bright), px);
+            }
+        } else {
+            const uint64_t *cnt = hs->count + b0;
+            for (size_t b = 0; b < n; b++, px += 4) {
+                uint64_t c = cnt[b];
+                if (c < nv)
+                    memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
+                else
+                    ramp_eval(&p->rp, density(p->curve, c, mx, p->lmx, p->gamma, p->bright), px);
+            }
+        }
         return;
     }
     for (int y = y0; y < y1; y++)
