@@ -400,7 +400,12 @@ static inline int sum_add(void *acc, size_t unit, uint64_t n, uint64_t v)
  * of zeros adds nothing. Numbers of one or two bytes (nearly all: values
  * below 2^14, runs shorter than 129) are taken whole by the first loop;
  * the second reads any number byte by byte, across blocks too. */
-static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc)
+#if defined(__GNUC__)
+#define SUM_INLINE static inline __attribute__((always_inline))
+#else
+#define SUM_INLINE static inline
+#endif
+SUM_INLINE void sum_decode_as(sum_dec *d, const unsigned char *p, size_t len, void *acc, const size_t unit)
 {
     /* locals: the stores into acc could alias d's fields */
     uint64_t v = d->v, n = d->n, want = d->want;
@@ -411,7 +416,7 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc
         while (shift == 0 && !run && len - i >= 2 && n < want) {
             unsigned c = p[i], c1 = p[i + 1];
             if (c - 1 < 0x7f) { /* 1 … 127 */
-                if (acc && sum_add(acc, d->unit, n, c)) {
+                if (acc && sum_add(acc, unit, n, c)) {
                     bad = 1;
                     break;
                 }
@@ -423,7 +428,7 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc
                 }
                 n += c1 + 1u, i += 2;
             } else if (c >= 0x80 && c1 - 1 < 0x7f) { /* 128 … 16383 */
-                if (acc && sum_add(acc, d->unit, n, (c & 0x7fu) | (uint64_t)c1 << 7)) {
+                if (acc && sum_add(acc, unit, n, (c & 0x7fu) | (uint64_t)c1 << 7)) {
                     bad = 1;
                     break;
                 }
@@ -459,7 +464,7 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc
             }
             if (!v)
                 run = 1;
-            else if (acc && sum_add(acc, d->unit, n, v)) {
+            else if (acc && sum_add(acc, unit, n, v)) {
                 bad = 1;
                 break;
             }
@@ -468,6 +473,15 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc
         v = 0;
     }
     d->v = v, d->n = n, d->shift = shift, d->run = run, d->bad = bad;
+}
+
+/* one copy of the decoder per width (the width a constant in the loop) */
+static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc)
+{
+    if (d->unit == 4)
+        sum_decode_as(d, p, len, acc, 4);
+    else
+        sum_decode_as(d, p, len, acc, 8);
 }
 
 static int sum_done(const sum_dec *d) { return !d->bad && d->shift == 0 && !d->run && d->n == d->want; }
