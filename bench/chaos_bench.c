@@ -410,8 +410,8 @@ int main(int argc, char **argv)
         memset(cnt, 0, 1024 * 1024 * 4);
         TIME_BEST(best_plain, 1, sink += plain2(N, &g_fern.alias, lo, hi, cnt));
         TIME_BEST(q_plain, 1, sink += plain2(Nq, &g_fern.alias, lo, hi, cnt));
-        hist2 hs;
-        hist2_init(&hs, 1024, 1024, lo, hi, 1, &e);
+        hist2 hs; /* every call below adds into it: 32-bit counts while their points total < 2^32 */
+        hist2_init_for(&hs, 1024, 1024, lo, hi, 1, 3 * N + Nq, &e);
         o.colour = CHAOS_COLOUR_NONE;
         TIME_BEST(best_eng, 1, chaos_hist2(&s, &o, &hs, NULL, &r1, &e));
         o.points = Nq;
