@@ -6,7 +6,9 @@
  * colour, 1 to 3 threads; fset_chaos; superifs_render) and reader (the tone
  * map, chaos_measure2) must give the same counts and the same pixels. The
  * fixed facts: the counts sum to the points inside (chaos_stats), and a
- * histogram of 32-bit counts refuses a call of 2^32 points or more. */
+ * histogram of 32-bit counts refuses a call of 2^32 points or more, and a
+ * shard hands the same numbers to its part from either width (a fake sharder
+ * records them and a merge of them gives the single run's counts). */
 #include <string.h>
 
 #include "check.h"
@@ -14,6 +16,7 @@
 #include "fset.h"
 #include "hist.h"
 #include "image.h"
+#include "par.h"
 #include "superifs.h"
 #include "tonemap.h"
 
@@ -217,10 +220,110 @@ static void test_fset_widths(void)
     superifs_free(&st);
 }
 
+/* A sharder that records a shard's sums as numbers and adds them back in a
+ * merge, whatever the width (unit 8: uint64, unit 4: uint32). */
+typedef struct rec_sharder {
+    rt_sharder rt;
+    int mode, sec;
+    size_t n[4], unit[4];
+    uint64_t *v[4];
+} rec_sharder;
+
+static int rs_begin(rt_sharder *s, const char *kind, size_t nchunks, size_t *lo, size_t *hi)
+{
+    rec_sharder *r = (rec_sharder *)s;
+    (void)kind;
+    *lo = 0;
+    *hi = nchunks;
+    r->sec = 0;
+    return r->mode;
+}
+
+static rt_code rs_section(rt_sharder *s, par_part_op op, void *buf, size_t total, size_t unit, par_combine_fn fn,
+                          void *ctx, rt_error *e)
+{
+    rec_sharder *r = (rec_sharder *)s;
+    (void)fn, (void)ctx, (void)e;
+    int k = r->sec++;
+    if (op != PAR_OP_SUM || k >= 4 || (unit != 4 && unit != 8))
+        return RT_EINVAL;
+    size_t n = total / unit;
+    if (r->mode == PAR_SHARD) {
+        r->n[k] = n;
+        r->unit[k] = unit;
+        r->v[k] = calloc(n ? n : 1, sizeof *r->v[k]);
+        for (size_t i = 0; i < n; i++)
+            r->v[k][i] = unit == 4 ? ((uint32_t *)buf)[i] : ((uint64_t *)buf)[i];
+    } else {
+        if (n != r->n[k])
+            return RT_EINVAL;
+        for (size_t i = 0; i < n; i++) {
+            if (unit == 4)
+                ((uint32_t *)buf)[i] += (uint32_t)r->v[k][i];
+            else
+                ((uint64_t *)buf)[i] += r->v[k][i];
+        }
+    }
+    return RT_OK;
+}
+
+static void test_shard_widths(void)
+{
+    rt_error e;
+    ifs f;
+    affine tri[3] = {affine_from_2d(0.5, 0, 0, 0.5, 0, 0), affine_from_2d(0.5, 0, 0, 0.5, 0.5, 0),
+                     affine_from_2d(0.5, 0, 0, 0.5, 0.25, 0.5)};
+    CHECK(ifs_build(&f, tri, 3, NULL, 0, &e) == RT_OK, "ifs");
+    chaos_sys s = {&f, NULL};
+    chaos_opts o = {0};
+    o.points = 2000000; /* 123 chunks: both workers get some */
+    o.seed = 4;
+    o.chunk = 1 << 14;
+    double lo[2] = {0, 0}, hi[2] = {0.9, 0.9};
+    rt_run r2 = {2, NULL, 0};
+    hist2 full;
+    chaos_stats st;
+    CHECK(hist2_init(&full, W, H, lo, hi, 0, &e) == RT_OK, "hist");
+    CHECK(chaos_hist2(&s, &o, &full, &st, &r2, &e) == RT_OK, "full run: %s", e.msg);
+    uint64_t shard_vals[2][W * H];
+    for (int narrow = 0; narrow < 2; narrow++) {
+        rec_sharder rs;
+        memset(&rs, 0, sizeof rs);
+        rs.rt.begin = rs_begin;
+        rs.rt.section = rs_section;
+        rt_sharder *old = par_set_sharder(&rs.rt);
+        hist2 a, m;
+        rs.mode = PAR_SHARD;
+        CHECK(hist2_init_for(&a, W, H, lo, hi, 0, narrow ? o.points : UINT64_MAX, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s, &o, &a, NULL, &r2, &e) == RT_OK, "shard: %s", e.msg);
+        CHECK(rs.sec == 2 && rs.n[0] == W * H && rs.unit[0] == (narrow ? 4u : 8u) && rs.n[1] == 2 && rs.unit[1] == 8,
+              "narrow %d: sections of %zu (unit %zu) and %zu counts", narrow, rs.n[0], rs.unit[0], rs.n[1]);
+        for (size_t i = 0; rs.v[0] && i < W * H; i++)
+            shard_vals[narrow][i] = rs.v[0][i];
+        rs.mode = PAR_MERGE;
+        chaos_stats sm;
+        CHECK(hist2_init_for(&m, W, H, lo, hi, 0, narrow ? o.points : UINT64_MAX, &e) == RT_OK, "hist");
+        CHECK(chaos_hist2(&s, &o, &m, &sm, &r2, &e) == RT_OK, "merge: %s", e.msg);
+        uint64_t sum;
+        CHECK(same_counts(&m, &full, &sum) == 0 && sum == st.inside, "narrow %d: the merge has the single run's counts",
+              narrow);
+        CHECK(sm.plotted == st.plotted && sm.inside == st.inside, "narrow %d: the merge's stats", narrow);
+        par_set_sharder(old);
+        for (int k = 0; k < 4; k++)
+            free(rs.v[k]);
+        hist2_free(&a);
+        hist2_free(&m);
+    }
+    CHECK(memcmp(shard_vals[0], shard_vals[1], sizeof shard_vals[0]) == 0, "a shard's sums: the same numbers from either width");
+    hist2_free(&full);
+    ifs_free(&f);
+}
+
 int main(void)
 {
     test_choice();
     test_chaos_widths();
     test_fset_widths();
+    test_shard_widths();
     return check_done("test_hist_width");
 }
