@@ -234,7 +234,7 @@ static void render2(int colour, int then)
     image im;
     tonemap_opts t = {0};
     t.colour = colour ? TONEMAP_MEAN : TONEMAP_RAMP;
-    if (chaos_fit(&s, &o, 1024, 1024, lo, hi, &e) || hist2_init(&hs, 1024, 1024, lo, hi, colour, &e) ||
+    if (chaos_fit(&s, &o, 1024, 1024, lo, hi, &e) || hist2_init_for(&hs, 1024, 1024, lo, hi, colour, o.points, &e) ||
         chaos_hist2(&s, &o, &hs, NULL, &r1, &e) || image_init(&im, 1024, 1024, &e) || tonemap_defer(&hs, &t, &im, &e))
         _exit(1);
     hist2_free(&hs);
@@ -327,12 +327,12 @@ static void fresh_report(void)
     fresh base = run_fresh_best(job_empty, &base_med);
     struct { const char *what; void (*job)(void); double data_mb; } jobs[] = {
         {"plain 2-D loop (1024^2 uint32 counts)", job_plain2, 4},
-        {"chaos render 1024^2 (fit, counts, tone map*)", job_render2, 8},
-        {"  ... pixels made ready (float image written)", job_render2_ready, 24},
+        {"chaos render 1024^2 (fit, counts, tone map*)", job_render2, 4},
+        {"  ... pixels made ready (float image written)", job_render2_ready, 20},
         {"  the window pre-pass alone (chaos_fit)", job_fit, 0},
         {"plain 2-D loop + PNG of its counts", job_plain2_png, 8},
-        {"chaos render 1024^2 + PNG encode (RGBA 8-bit)", job_render2_png, 16},
-        {"chaos render 1024^2, colour blend", job_render2_colour, 36},
+        {"chaos render 1024^2 + PNG encode (RGBA 8-bit)", job_render2_png, 12},
+        {"chaos render 1024^2, colour blend", job_render2_colour, 32},
         {"plain 3-D loop (256^3 uint32, prefetch ring)", job_plain3, 64},
         {"chaos measure 256^3 (counts, float volume)", job_measure3, 64},
     };
@@ -356,10 +356,11 @@ static void fresh_report(void)
     printf("  (* as chaos() returns it: the maximum found, the pixels pending (tonemap_defer); the\n"
            "   float image is written only when a script reads it (made ready) and a PNG save\n"
            "   tone-maps in bands instead)\n");
-    printf("  (data: what the job must hold at once. 2-D render: 8 B/px counts (the pixels pending: the\n"
+    printf("  (data: what the job must hold at once. 2-D render: 4 B/px counts (uint32: fewer than 2^32\n"
+           "   points; the pixels pending: the\n"
            "   image's 16 B/px are allocated, not touched); made ready: + the 16 B/px float RGBA image;\n"
            "   + PNG: the counts, 4 B/px samples and 4 B/px filtered rows; plain + PNG: samples and filtered\n"
-           "   rows (its counts are freed first); colour: 20 B/px histogram + the worker's 16 B/px cells;\n"
+           "   rows (its counts are freed first); colour: 16 B/px histogram + the worker's 16 B/px cells;\n"
            "   3-D: the 4 B/voxel float volume)\n");
     printf("  fixed cost of a 1024^2 chaos render (fit, counts, tone map*) vs the plain loop: %.2fx CPU,"
            " best of %d each (goal <= 2x); without the pre-pass %.2fx\n", cpu[1] / cpu[0], FRESH_REPS,
@@ -409,8 +410,8 @@ int main(int argc, char **argv)
         memset(cnt, 0, 1024 * 1024 * 4);
         TIME_BEST(best_plain, 1, sink += plain2(N, &g_fern.alias, lo, hi, cnt));
         TIME_BEST(q_plain, 1, sink += plain2(Nq, &g_fern.alias, lo, hi, cnt));
-        hist2 hs;
-        hist2_init(&hs, 1024, 1024, lo, hi, 1, &e);
+        hist2 hs; /* every call below adds into it: 32-bit counts while their points total < 2^32 */
+        hist2_init_for(&hs, 1024, 1024, lo, hi, 1, 3 * N + Nq, &e);
         o.colour = CHAOS_COLOUR_NONE;
         TIME_BEST(best_eng, 1, chaos_hist2(&s, &o, &hs, NULL, &r1, &e));
         o.points = Nq;

@@ -558,7 +558,7 @@ static int b_chaos_fset(interp *I, value *a, int n, value *out)
         goto done;
     hist2 hs;
     image *im = NULL;
-    c = hist2_init(&hs, w, h, lo, hi, 0, &e);
+    c = hist2_init_for(&hs, w, h, lo, hi, 0, co.points, &e);
     if (!c) {
         double t0 = report_clock();
         c = fset_chaos(&f->fs, &o, &co, &hs, &run, &e);

@@ -655,7 +655,7 @@ static int b_chaos(interp *I, value *a, int n, value *out)
     if (mem_precheck(I, bytes, "chaos: the histograms"))
         return -1;
     hist2 hs;
-    c = hist2_init(&hs, w * (int)ss, h * (int)ss, lo, hi, o.colour != CHAOS_COLOUR_NONE, &e);
+    c = hist2_init_for(&hs, w * (int)ss, h * (int)ss, lo, hi, o.colour != CHAOS_COLOUR_NONE, o.points, &e);
     if (c) {
         return lang_rt_error(I, c, &e, "chaos");
     }
@@ -754,7 +754,7 @@ static int b_measure(interp *I, value *a, int n, value *out)
         lang_image_discard(im);
         return -1;
     }
-    c = hist2_init(&hs, w, h, lo, hi, 0, &e);
+    c = hist2_init_for(&hs, w, h, lo, hi, 0, o.points, &e);
     if (!c) {
         double t0 = report_clock();
         c = chaos_hist2(&s, &o, &hs, &st, &run, &e);
@@ -893,7 +893,7 @@ static int sys_preview(interp *I, chaos_sys *s, image **out)
     } else {
         hist2 hs;
         double lo[2], hi[2];
-        if ((c = lang_chaos_fit(I, s, &o, 256, 256, lo, hi, &e)) || (c = hist2_init(&hs, 256, 256, lo, hi, 0, &e)))
+        if ((c = lang_chaos_fit(I, s, &o, 256, 256, lo, hi, &e)) || (c = hist2_init_for(&hs, 256, 256, lo, hi, 0, o.points, &e)))
             goto fail;
         chaos_stats st;
         c = chaos_hist2(s, &o, &hs, &st, &run, &e);

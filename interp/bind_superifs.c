@@ -249,7 +249,7 @@ static int b_superifs_image(interp *I, value *a, int n, value *out)
     }
     hist2 hs;
     image *im = NULL;
-    c = hist2_init(&hs, w, h, lo, hi, 0, &e);
+    c = hist2_init_for(&hs, w, h, lo, hi, 0, s->st.points, &e); /* one buffer's points */
     if (c)
         return lang_rt_error(I, c, &e, "superifs_image");
     c = superifs_render(&s->st, (int)buf - 1, &hs, &e);

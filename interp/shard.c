@@ -326,8 +326,14 @@ static int reserve(bytebuf *b, size_t n)
  * followed by a second number, how many more zeros follow it (a run of L
  * zeros is 0, L - 1): most bins of a render's histogram are empty (85 % of
  * the 1024² fern's), and they lie in long runs beside and between the
- * attractor's arms. Returns the bytes added. */
-static uint64_t put_sums(bytebuf *b, const uint64_t *a, size_t n)
+ * attractor's arms. Returns the bytes added. a holds n uint64 (unit 8) or
+ * uint32 (unit 4, par_part_sum32): the same values give the same bytes. */
+static inline uint64_t sum_at(const void *a, size_t unit, size_t i)
+{
+    return unit == 4 ? ((const uint32_t *)a)[i] : ((const uint64_t *)a)[i];
+}
+
+static uint64_t put_sums(bytebuf *b, const void *a, size_t unit, size_t n)
 {
     size_t start = b->len;
     for (size_t i = 0; i < n;) {
@@ -337,12 +343,19 @@ static uint64_t put_sums(bytebuf *b, const uint64_t *a, size_t n)
         unsigned char *o = b->data + b->len;
         size_t end = i + m;
         while (i < end) {
-            uint64_t v = a[i];
+            uint64_t v = sum_at(a, unit, i);
             if (!v) { /* a run, however long (past the block: its bytes fit) */
                 size_t j = i + 1;
-                while (n - j >= 8 && !(a[j] | a[j + 1] | a[j + 2] | a[j + 3] | a[j + 4] | a[j + 5] | a[j + 6] | a[j + 7]))
-                    j += 8;
-                while (j < n && !a[j])
+                if (unit == 4) {
+                    const uint32_t *a4 = a;
+                    while (n - j >= 8 && !(a4[j] | a4[j + 1] | a4[j + 2] | a4[j + 3] | a4[j + 4] | a4[j + 5] | a4[j + 6] | a4[j + 7]))
+                        j += 8;
+                } else {
+                    const uint64_t *a8 = a;
+                    while (n - j >= 8 && !(a8[j] | a8[j + 1] | a8[j + 2] | a8[j + 3] | a8[j + 4] | a8[j + 5] | a8[j + 6] | a8[j + 7]))
+                        j += 8;
+                }
+                while (j < n && !sum_at(a, unit, j))
                     j++;
                 *o++ = 0;
                 v = j - i - 1;
@@ -366,14 +379,33 @@ typedef struct sum_dec {
     uint64_t v, n, want; /* value so far; values done; values expected */
     unsigned shift;
     int run; /* the number being read is a run's count (a 0 came before it) */
-    int bad; /* more than 64 bits, more values than expected */
+    int bad; /* more than 64 bits, more values than expected, a uint32 sum past 2^32 - 1 */
+    size_t unit; /* acc holds uint64 (8) or uint32 (4) */
 } sum_dec;
+
+/* acc[n] += v for a uint64 or uint32 acc; 1 if a uint32 sum would wrap. */
+static inline int sum_add(void *acc, size_t unit, uint64_t n, uint64_t v)
+{
+    if (unit != 4) {
+        ((uint64_t *)acc)[n] += v;
+        return 0;
+    }
+    uint32_t *a = acc;
+    uint64_t t = a[n] + v;
+    a[n] = (uint32_t)t;
+    return t > UINT32_MAX;
+}
 
 /* acc: add each value into acc[n] (NULL: only check the structure); a run
  * of zeros adds nothing. Numbers of one or two bytes (nearly all: values
  * below 2^14, runs shorter than 129) are taken whole by the first loop;
  * the second reads any number byte by byte, across blocks too. */
-static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t *acc)
+#if defined(__GNUC__)
+#define SUM_INLINE static inline __attribute__((always_inline))
+#else
+#define SUM_INLINE static inline
+#endif
+SUM_INLINE void sum_decode_as(sum_dec *d, const unsigned char *p, size_t len, void *acc, const size_t unit)
 {
     /* locals: the stores into acc could alias d's fields */
     uint64_t v = d->v, n = d->n, want = d->want;
@@ -384,8 +416,10 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t 
         while (shift == 0 && !run && len - i >= 2 && n < want) {
             unsigned c = p[i], c1 = p[i + 1];
             if (c - 1 < 0x7f) { /* 1 … 127 */
-                if (acc)
-                    acc[n] += c;
+                if (acc && sum_add(acc, unit, n, c)) {
+                    bad = 1;
+                    break;
+                }
                 n++, i++;
             } else if (c == 0 && c1 < 0x80) { /* 0 and a one-byte count: c1 + 1 zeros */
                 if (c1 >= want - n) {
@@ -394,8 +428,10 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t 
                 }
                 n += c1 + 1u, i += 2;
             } else if (c >= 0x80 && c1 - 1 < 0x7f) { /* 128 … 16383 */
-                if (acc)
-                    acc[n] += (c & 0x7fu) | (uint64_t)c1 << 7;
+                if (acc && sum_add(acc, unit, n, (c & 0x7fu) | (uint64_t)c1 << 7)) {
+                    bad = 1;
+                    break;
+                }
                 n++, i += 2;
             } else {
                 break;
@@ -428,13 +464,24 @@ static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, uint64_t 
             }
             if (!v)
                 run = 1;
-            else if (acc)
-                acc[n] += v;
+            else if (acc && sum_add(acc, unit, n, v)) {
+                bad = 1;
+                break;
+            }
             n++;
         }
         v = 0;
     }
     d->v = v, d->n = n, d->shift = shift, d->run = run, d->bad = bad;
+}
+
+/* one copy of the decoder per width (the width a constant in the loop) */
+static void sum_decode(sum_dec *d, const unsigned char *p, size_t len, void *acc)
+{
+    if (d->unit == 4)
+        sum_decode_as(d, p, len, acc, 4);
+    else
+        sum_decode_as(d, p, len, acc, 8);
 }
 
 static int sum_done(const sum_dec *d) { return !d->bad && d->shift == 0 && !d->run && d->n == d->want; }
@@ -559,7 +606,8 @@ static int cb_begin(rt_sharder *rs, const char *kind, size_t nchunks, size_t *lo
     return PAR_SHARD;
 }
 
-static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e);
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, size_t unit, par_combine_fn fn, void *ctx,
+                            rt_error *e);
 
 static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t total, size_t chunk_bytes,
                           par_combine_fn fn, void *ctx, rt_error *e)
@@ -573,7 +621,8 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     r.sub = s->sub++;
     r.op = op;
     r.nchunks = s->cur_nchunks;
-    r.total = total;
+    size_t unit = op == PAR_OP_SUM && chunk_bytes == 4 ? 4 : 8; /* SUM: its integers' width */
+    r.total = op == PAR_OP_SUM ? total / unit * 8 : total; /* a record counts 8 bytes a sum */
     r.chunk_bytes = op == PAR_OP_SUM ? 0 : chunk_bytes;
     if (s->merging) {
         if (s->next_rec >= s->nrecs)
@@ -583,7 +632,7 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
         if (p->seq != r.seq || p->sub != r.sub || p->op != r.op || p->total != r.total || p->chunk_bytes != r.chunk_bytes)
             return rt_fail(e, RT_EFORMAT, "merge: engine call %u section %u: the parts hold %llu bytes (op %u), this run needs %llu (op %u)",
                            r.seq, r.sub, (unsigned long long)p->total, p->op, (unsigned long long)r.total, r.op);
-        rt_code c = merge_section(s, p, buf, fn, ctx, e);
+        rt_code c = merge_section(s, p, buf, unit, fn, ctx, e);
         s->next_rec++;
         return c;
     }
@@ -595,7 +644,7 @@ static rt_code cb_section(rt_sharder *rs, par_part_op op, void *buf, size_t tota
     size_t start = s->part.len;
     rec_head(&s->part, &r, lo, hi, len);
     if (op == PAR_OP_SUM) { /* LEB128, 7 bits a byte: most sums are small */
-        len = put_sums(&s->part, buf, total / 8);
+        len = put_sums(&s->part, buf, unit, total / unit);
         for (int q = 0; !s->part.failed && q < 8; q++) /* the length field, the head's last */
             s->part.data[start + REC_HEAD - 8 + q] = (unsigned char)(len >> 8 * q);
     } else {
@@ -928,7 +977,7 @@ static int check_part(shard *s, const char *path, int first, int *index, int *co
             break;
         }
         uint64_t left = len;
-        sum_dec sd = {0, 0, h.total / 8, 0, 0, 0};
+        sum_dec sd = {0, 0, h.total / 8, 0, 0, 0, 8};
         while (left) {
             size_t n = left < (1u << 16) ? (size_t)left : 1u << 16;
             if (rd(&r, blk, n))
@@ -1053,8 +1102,10 @@ static int merge_open(shard *s)
     return rc;
 }
 
-/* Fill buf from every part's record `want` (the next one in each part). */
-static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_combine_fn fn, void *ctx, rt_error *e)
+/* Fill buf from every part's record `want` (the next one in each part);
+ * unit: a SUM's integer width in buf (8 or 4). */
+static rt_code merge_section(shard *s, const shard_rec *want, void *buf, size_t unit, par_combine_fn fn, void *ctx,
+                            rt_error *e)
 {
     unsigned char blk[1 << 14];
     size_t step = sizeof blk;
@@ -1086,7 +1137,7 @@ static rt_code merge_section(shard *s, const shard_rec *want, void *buf, par_com
                     fn(ctx, (unsigned char *)buf + k, blk, n / want->chunk_bytes);
             }
         } else if (want->op == PAR_OP_SUM) {
-            sum_dec sd = {0, 0, want->total / 8, 0, 0, 0};
+            sum_dec sd = {0, 0, want->total / 8, 0, 0, 0, unit};
             for (uint64_t k = 0; k < len && !c; k += sizeof blk) {
                 size_t n = len - k < sizeof blk ? (size_t)(len - k) : sizeof blk;
                 if (rd(&r, blk, n))

@@ -284,7 +284,8 @@ typedef struct job {
     size_t nchunks;
     worker *w;
     size_t nbins; /* bins/voxels/pixels */
-    uint64_t *direct; /* 2-D counts: worker 0 adds its hits here (the histogram) */
+    uint64_t *direct;   /* 2-D counts: worker 0 adds its hits here (the histogram), */
+    uint32_t *direct32; /* or here when the histogram's counts are 32-bit */
     /* 2-D window */
     int hw, hh;
     double lox, hiy, sx, sy;
@@ -442,6 +443,7 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     const size_t nbins = j->nbins;
     uint32_t *const cnt = w->cnt, *const out = w->cnt + 4 * nbins; /* colour: the outside cell */
     uint64_t *const cnt64 = j->direct;
+    uint32_t *const cnt32 = j->direct32;
     rng r = ob.r;
     uint32_t st = ob.s, cur = ob.cur;
     double x = ob.x, y = ob.y, c = ob.c;
@@ -474,10 +476,14 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
             }
             size_t slot = (size_t)(i % RING), old = ring[slot];
             ring[slot] = b;
-            if (wide) {
+            if (wide == 1) {
                 PREFETCHW(cnt64 + b);
                 if (old != j->nbins)
                     cnt64[old]++;
+            } else if (wide == 2) { /* fewer than 2^32 points: no bin wraps */
+                PREFETCHW(cnt32 + b);
+                if (old != j->nbins)
+                    cnt32[old]++;
             } else {
                 PREFETCHW(cnt + b);
                 if (old != j->nbins)
@@ -499,8 +505,10 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     for (int q = 0; q < RING; q++) {
         if (colour != CHAOS_COLOUR_NONE)
             add_cell(w, cnt, ringp[q], pal[ringe[q]], nbins);
-        else if (ring[q] != j->nbins && wide)
+        else if (ring[q] != j->nbins && wide == 1)
             cnt64[ring[q]]++;
+        else if (ring[q] != j->nbins && wide == 2)
+            cnt32[ring[q]]++;
         else if (ring[q] != j->nbins)
             bump(w, cnt, ring[q], j->nbins);
     }
@@ -510,14 +518,17 @@ INLINE void hist_chunk(const job *j, size_t chunk, int wid, const int kind, cons
     w->plotted += count;
 }
 
-/* Counts only: worker 0 adds straight into the histogram's 64-bit counts
- * (no private array, no merge pass, no carry); the others count privately. */
+/* Counts only: worker 0 adds straight into the histogram's counts, 64-bit
+ * (wide 1) or 32-bit (wide 2: the call plots fewer than 2^32 points) — no
+ * private array, no merge pass, no carry; the others count privately. */
 #define HIST_FN(name, kind, colour)                                                              \
     static void name(void *ctx, size_t chunk, int wid)                                           \
     {                                                                                            \
         const job *j = ctx;                                                                      \
         if (colour == CHAOS_COLOUR_NONE && wid == 0 && j->direct)                                \
             hist_chunk(j, chunk, wid, kind, colour, 1);                                          \
+        else if (colour == CHAOS_COLOUR_NONE && wid == 0 && j->direct32)                         \
+            hist_chunk(j, chunk, wid, kind, colour, 2);                                          \
         else                                                                                     \
             hist_chunk(j, chunk, wid, kind, colour, 0);                                          \
     }
@@ -959,6 +970,9 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         st->plotted = st->inside = 0;
     if (o->colour != CHAOS_COLOUR_NONE && !hs->csum)
         return rt_fail(e, RT_EINVAL, "colouring needs a histogram with colour sums");
+    if (hs->count32 && !hist2_narrow(o->points))
+        return rt_fail(e, RT_EINVAL, "a histogram with 32-bit counts cannot take %llu points",
+                       (unsigned long long)o->points);
     if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
         return rt_fail(e, RT_EINVAL, "histogram window [%g, %g] x [%g, %g] is empty", hs->lo[0],
                        hs->hi[0], hs->lo[1], hs->hi[1]);
@@ -991,9 +1005,12 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         sys_free(d);
         return rt_fail(e, RT_ENOMEM, "out of memory for the chaos game's sums");
     }
-    if (!colour && pp.mode != PAR_MERGE)
+    if (!colour && pp.mode != PAR_MERGE) {
         j.direct = hs->count;
-    rc = alloc_workers(&j.w, nw, j.nbins, pp.mode == PAR_MERGE ? 0 : j.direct ? 2 : 1, colour, 0, e);
+        j.direct32 = hs->count32;
+    }
+    int direct = j.direct || j.direct32;
+    rc = alloc_workers(&j.w, nw, j.nbins, pp.mode == PAR_MERGE ? 0 : direct ? 2 : 1, colour, 0, e);
     if (rc) {
         rt_free(tot);
         sys_free(d);
@@ -1003,12 +1020,12 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
     rc = finish_par(rc, j.w, nw, e);
     if (!rc && pp.mode != PAR_FULL && !colour) {
         for (size_t b = 0; b < j.nbins && nw > 1 && pp.mode == PAR_SHARD; b++)
-            hs->count[b] += total_count(j.w, nw, b); /* worker 0's are there already */
+            hist2_add(hs, b, total_count(j.w, nw, b)); /* worker 0's are there already */
         for (int i = 0; i < nw; i++) {
             tot[0] += j.w[i].plotted;
             tot[1] += j.w[i].inside;
         }
-        rc = par_part_sum(&pp, hs->count, j.nbins, e);
+        rc = hs->count32 ? par_part_sum32(&pp, hs->count32, j.nbins, e) : par_part_sum(&pp, hs->count, j.nbins, e);
         if (!rc)
             rc = par_part_sum(&pp, tot, 2, e);
         if (!rc && st) {
@@ -1019,7 +1036,7 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
         rc = shard_sums(&pp, j.w, nw, j.nbins, colour, tot, ntot, e);
         /* a shard's histogram is never used (its result is a partial value) */
         for (size_t b = 0; !rc && pp.mode == PAR_MERGE && b < j.nbins; b++) {
-            hs->count[b] += tot[4 * b];
+            hist2_add(hs, b, tot[4 * b]);
             for (int ch = 0; ch < 3; ch++)
                 hs->csum[3 * b + ch] += (float)((double)tot[4 * b + ch + 1] / 65535.0);
         }
@@ -1028,10 +1045,10 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
             st->inside = tot[ntot - 1];
         }
     } else if (!rc) {
-        size_t merge = j.direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
+        size_t merge = direct && nw == 1 ? 0 : j.nbins; /* worker 0 alone: nothing to add */
         for (size_t b = 0; b < merge; b++) {
             if (o->colour == CHAOS_COLOUR_NONE) {
-                hs->count[b] += total_count(j.w, nw, b);
+                hist2_add(hs, b, total_count(j.w, nw, b));
                 continue;
             }
             uint64_t t[4] = {0, 0, 0, 0};
@@ -1042,7 +1059,7 @@ rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_st
             for (int i = 0; i < nw; i++)
                 for (int q = 1; q < 4; q++)
                     t[q] += j.w[i].cnt[4 * b + q] + (j.w[i].carry ? j.w[i].carry[4 * b + q] : 0);
-            hs->count[b] += t[0];
+            hist2_add(hs, b, t[0]);
             for (int ch = 0; ch < 3; ch++)
                 hs->csum[3 * b + ch] += (float)((double)t[ch + 1] / 65535.0);
         }
@@ -1294,13 +1311,13 @@ rt_code chaos_measure2(const hist2 *hs, chaos_norm norm, uint64_t total, image *
     size_t nb = (size_t)hs->w * (size_t)hs->h;
     uint64_t mx = 0;
     for (size_t b = 0; b < nb; b++)
-        if (hs->count[b] > mx)
-            mx = hs->count[b];
+        if (hist2_get(hs, b) > mx)
+            mx = hist2_get(hs, b);
     double den = norm == CHAOS_NORM_TOTAL ? (double)total : norm == CHAOS_NORM_MAX ? (double)mx : 1;
     if (!(den > 0))
         den = 1;
     for (size_t b = 0; b < nb; b++) {
-        float v = (float)((double)hs->count[b] / den);
+        float v = (float)((double)hist2_get(hs, b) / den);
         float *px = im->px + 4 * b;
         px[0] = px[1] = px[2] = v;
         px[3] = 1;

@@ -115,8 +115,10 @@ typedef struct chaos_stats {
 rt_code chaos_fit(const chaos_sys *s, const chaos_opts *o, int w, int h, double *lo, double *hi,
                   rt_error *e);
 
-/* 2-D chaos game into hs (2-D maps). Counts are ADDED to hs->count; with a
- * colour mode hs->csum must exist and colour sums are added to it. */
+/* 2-D chaos game into hs (2-D maps). Counts are ADDED to hs's counts (64-
+ * or 32-bit, hist.h; 32-bit needs o->points < 2^32, and the caller keeps the
+ * sum of its calls' points below that); with a colour mode hs->csum must
+ * exist and colour sums are added to it. */
 rt_code chaos_hist2(const chaos_sys *s, const chaos_opts *o, hist2 *hs, chaos_stats *st,
                     const rt_run *run, rt_error *e);
 

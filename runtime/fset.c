@@ -328,9 +328,22 @@ typedef struct chaos_ctx {
     const fset_chaos_opts *opts;
     const hist2 *hs;
     double *cum;      /* fs->n * FSET_MAX_MAPS */
-    uint64_t *count;  /* per worker: worker i's w × h counts at count + i w h */
+    uint64_t *count;  /* per worker: worker i's w × h counts at count + i w h, */
+    uint32_t *count32; /* or here, 32-bit, when hs's counts are (fewer than 2^32 points) */
     int failed;       /* a worker could not allocate */
 } chaos_ctx;
+
+/* A hit of bin b (>= 0: inside) by worker wid. */
+static void plot_hit(const chaos_ctx *c, int wid, long b)
+{
+    if (b < 0)
+        return;
+    size_t at = (size_t)wid * (size_t)c->hs->w * (size_t)c->hs->h + (size_t)b;
+    if (c->count32)
+        c->count32[at]++;
+    else
+        c->count[at]++;
+}
 
 /* What a parallel game ends with: interrupted, a worker out of memory, or
  * the code par_for gave. */
@@ -391,10 +404,10 @@ static inline void extremes_add(extremes *x, double px, double py)
     x->sum += px + py;
 }
 
-/* One chunk of an orbit: its plotted points binned into cnt, or (cnt NULL,
- * the window's pre-pass) added to xt. Inlined into both callers, so the test
- * on cnt is made at compile time. */
-INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, uint64_t *cnt, extremes *xt)
+/* One chunk of an orbit: its plotted points binned into worker's counts, or
+ * (xt not NULL, the window's pre-pass) added to xt. Inlined into both
+ * callers, so the test on xt is made at compile time. */
+INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, int worker, extremes *xt)
 {
     const fset_chaos_opts *op = c->opts;
     uint64_t first = (uint64_t)chunk * CHAOS_CHUNK;
@@ -413,13 +426,10 @@ INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, uint64_t *cnt, extreme
         chaos_step(c, k++, &at, &r, &x, &y);
         ph = ph + 1 == period ? 0 : ph + 1;
         if (ph == 0) {
-            if (cnt) {
-                long b = fset_hist_bin(c->hs, x, y);
-                if (b >= 0)
-                    cnt[b]++;
-            } else {
+            if (!xt)
+                plot_hit(c, worker, fset_hist_bin(c->hs, x, y));
+            else
                 extremes_add(xt, x, y);
-            }
             done++;
         }
     }
@@ -428,7 +438,7 @@ INLINE void orbit_chunk(const chaos_ctx *c, size_t chunk, uint64_t *cnt, extreme
 static void chaos_orbit(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
-    orbit_chunk(c, chunk, c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h, NULL);
+    orbit_chunk(c, chunk, worker, NULL);
 }
 
 /* The end points of one chunk's walks (dim doubles each, *n of them; rt_free
@@ -469,18 +479,14 @@ static double *walk_chunk(const fset *fs, const fset_order *o, const double *cum
 static void chaos_walk(void *p, size_t chunk, int worker)
 {
     chaos_ctx *c = p;
-    uint64_t *cnt = c->count + (size_t)worker * (size_t)c->hs->w * (size_t)c->hs->h;
     size_t n;
     double *pt = walk_chunk(c->fs, c->o, c->cum, c->opts, chunk, 2, &n);
     if (!pt) {
         c->failed = 1;
         return;
     }
-    for (size_t i = 0; i < n; i++) {
-        long b = fset_hist_bin(c->hs, pt[2 * i], pt[2 * i + 1]);
-        if (b >= 0)
-            cnt[b]++;
-    }
+    for (size_t i = 0; i < n; i++)
+        plot_hit(c, worker, fset_hist_bin(c->hs, pt[2 * i], pt[2 * i + 1]));
     rt_free(pt);
 }
 
@@ -508,20 +514,27 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
     rt_code code = game_check(fs, o, opts, e);
     if (code)
         return code;
-    if (!hs->count || hs->w < 1 || hs->h < 1)
+    if ((!hs->count && !hs->count32) || hs->w < 1 || hs->h < 1)
         return rt_fail(e, RT_EINVAL, "chaos game: the histogram is not allocated");
+    if (hs->count32 && !hist2_narrow(opts->points))
+        return rt_fail(e, RT_EINVAL, "chaos game: a histogram with 32-bit counts cannot take %llu points",
+                       (unsigned long long)opts->points);
     if (!(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
         return rt_fail(e, RT_EINVAL, "chaos game: the histogram window is empty");
     if (opts->points == 0)
         return RT_OK;
 
-    chaos_ctx c = {fs, o, opts, hs, NULL, NULL, 0};
+    chaos_ctx c = {fs, o, opts, hs, NULL, NULL, NULL, 0};
     size_t nchunks = chunk_count(opts);
     int nw = par_workers(run, nchunks);
     size_t nbins = (size_t)hs->w * (size_t)hs->h;
     c.cum = cumulative_tables(fs);
-    c.count = rt_calloc((size_t)nw * nbins, sizeof *c.count);
-    if (!c.cum || !c.count) {
+    int narrow = hs->count32 != NULL;
+    if (narrow)
+        c.count32 = rt_calloc((size_t)nw * nbins, sizeof *c.count32);
+    else
+        c.count = rt_calloc((size_t)nw * nbins, sizeof *c.count);
+    if (!c.cum || (narrow ? !c.count32 : !c.count)) {
         code = rt_fail(e, RT_ENOMEM, "out of memory for %d per-thread histograms", nw);
         goto done;
     }
@@ -533,15 +546,21 @@ rt_code fset_chaos(const fset *fs, const fset_order *o, const fset_chaos_opts *o
     if ((code = workers_done(code, c.failed, e)))
         goto done;
     for (int i = 1; pp.mode != PAR_FULL && i < nw; i++) /* the shard's sums into worker 0's */
-        for (size_t b = 0; b < nbins; b++)
-            c.count[b] += c.count[(size_t)i * nbins + b];
-    if (pp.mode != PAR_FULL && (code = par_part_sum(&pp, c.count, nbins, e)))
+        for (size_t b = 0; b < nbins; b++) {
+            if (narrow)
+                c.count32[b] += c.count32[(size_t)i * nbins + b];
+            else
+                c.count[b] += c.count[(size_t)i * nbins + b];
+        }
+    if (pp.mode != PAR_FULL &&
+        (code = narrow ? par_part_sum32(&pp, c.count32, nbins, e) : par_part_sum(&pp, c.count, nbins, e)))
         goto done;
     for (int i = 0; i < (pp.mode != PAR_FULL ? 1 : nw); i++)
         for (size_t b = 0; b < nbins; b++)
-            hs->count[b] += c.count[(size_t)i * nbins + b];
+            hist2_add(hs, b, narrow ? c.count32[(size_t)i * nbins + b] : c.count[(size_t)i * nbins + b]);
 done:
     rt_free(c.count);
+    rt_free(c.count32);
     rt_free(c.cum);
     return code;
 }
@@ -783,7 +802,7 @@ static rt_code fit_by_histograms(const fset *fs, const fset_order *o, const fset
     for (int pass = 0; pass < FIT_PASSES; pass++) {
         hist2 hs;
         const int G = FIT_GRID;
-        rt_code c = hist2_init(&hs, G, G, lo, hi, 0, e);
+        rt_code c = hist2_init_for(&hs, G, G, lo, hi, 0, fo->points, e);
         if (c)
             return c;
         rt_sharder *sv = par_set_sharder(NULL); /* a pre-pass: in full in every shard (par.h) */
@@ -796,7 +815,7 @@ static rt_code fit_by_histograms(const fset *fs, const fset_order *o, const fset
         int x0 = G, x1 = -1, y0 = G, y1 = -1;
         for (int j = 0; j < G; j++)
             for (int i = 0; i < G; i++)
-                if (hs.count[(size_t)j * G + i]) {
+                if (hist2_get(&hs, (size_t)j * G + i)) {
                     if (i < x0)
                         x0 = i;
                     if (i > x1)
@@ -829,12 +848,12 @@ static int fit_by_extremes(const fset *fs, const fset_order *o, const fset_chaos
     if (fo->points == 0)
         return 0;
     extremes xt = {{INFINITY, -INFINITY, INFINITY, -INFINITY}, 0};
-    chaos_ctx c = {fs, o, fo, NULL, cumulative_tables(fs), NULL, 0};
+    chaos_ctx c = {.fs = fs, .o = o, .opts = fo, .cum = cumulative_tables(fs)};
     if (!c.cum)
         return 0;
     for (size_t ch = 0; ch < chunk_count(fo); ch++) {
         if (fo->mode != FSET_WALK) {
-            orbit_chunk(&c, ch, NULL, &xt);
+            orbit_chunk(&c, ch, 0, &xt);
             continue;
         }
         size_t n;
@@ -852,7 +871,7 @@ static int fit_by_extremes(const fset *fs, const fset_order *o, const fset_chaos
         return 0;
     double wlo[2] = {lo[0], lo[1]}, whi[2] = {hi[0], hi[1]};
     for (int pass = 0; pass < FIT_PASSES; pass++) {
-        hist2 hs = {FIT_GRID, FIT_GRID, {wlo[0], wlo[1]}, {whi[0], whi[1]}, NULL, NULL, NULL, NULL};
+        hist2 hs = {.w = FIT_GRID, .h = FIT_GRID, .lo = {wlo[0], wlo[1]}, .hi = {whi[0], whi[1]}};
         if (!(whi[0] > wlo[0]) || !(whi[1] > wlo[1]))
             return 0;
         long b0 = fset_hist_bin(&hs, xt.ext[0], xt.ext[3]), b1 = fset_hist_bin(&hs, xt.ext[1], xt.ext[2]);

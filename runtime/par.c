@@ -151,7 +151,14 @@ rt_code par_part_sum(const par_part *p, uint64_t *acc, size_t n, rt_error *e)
 {
     if (p->mode == PAR_FULL)
         return RT_OK;
-    return p->sharder->section(p->sharder, PAR_OP_SUM, acc, n * sizeof *acc, 0, NULL, NULL, e);
+    return p->sharder->section(p->sharder, PAR_OP_SUM, acc, n * sizeof *acc, sizeof *acc, NULL, NULL, e);
+}
+
+rt_code par_part_sum32(const par_part *p, uint32_t *acc, size_t n, rt_error *e)
+{
+    if (p->mode == PAR_FULL)
+        return RT_OK;
+    return p->sharder->section(p->sharder, PAR_OP_SUM, acc, n * sizeof *acc, sizeof *acc, NULL, NULL, e);
 }
 
 rt_code par_part_rows(const par_part *p, void *buf, size_t total_bytes, size_t chunk_bytes, rt_error *e)

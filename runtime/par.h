@@ -68,9 +68,10 @@ typedef struct rt_sharder {
      * returns its mode, and for PAR_SHARD the chunk range in *lo, *hi; -1
      * stops the engine (RT_ECANCEL): the evaluation is being abandoned. */
     int (*begin)(struct rt_sharder *s, const char *kind, size_t nchunks, size_t *lo, size_t *hi);
-    /* One section: op, the buffer of total bytes (SUM: total/8 uint64);
-     * unit: chunk_bytes for ROWS, the element size for COMBINE (with fn,
-     * ctx). Record it (PAR_SHARD) or fill it (PAR_MERGE). */
+    /* One section: op, the buffer of total bytes (SUM: total/unit
+     * integers, uint64 for unit 8, uint32 for unit 4 — the same record
+     * either way, its values are numbers); unit: chunk_bytes for ROWS, the
+     * element size for COMBINE (with fn, ctx). Record it (PAR_SHARD) or fill it (PAR_MERGE). */
     rt_code (*section)(struct rt_sharder *s, par_part_op op, void *buf, size_t total, size_t unit,
                        par_combine_fn fn, void *ctx, rt_error *e);
 } rt_sharder;
@@ -93,6 +94,9 @@ rt_code par_part_begin(par_part *p, const rt_run *run, const char *kind, size_t 
 rt_code par_part_for(const par_part *p, const char *label, par_fn fn, void *ctx);
 /* Section of n exact integer sums. */
 rt_code par_part_sum(const par_part *p, uint64_t *acc, size_t n, rt_error *e);
+/* The same for uint32 sums whose totals stay below 2^32 (a merge that would
+ * wrap fails); a part is the same as par_part_sum's of the same values. */
+rt_code par_part_sum32(const par_part *p, uint32_t *acc, size_t n, rt_error *e);
 /* Section of a buffer filled chunk by chunk (the last chunk may be shorter). */
 rt_code par_part_rows(const par_part *p, void *buf, size_t total_bytes, size_t chunk_bytes, rt_error *e);
 /* Section of n elements of elem bytes, merged with fn (order-free). */

@@ -155,13 +155,13 @@ rt_code superifs_render(const superifs_state *s, int v, hist2 *hs, rt_error *e)
     if (v < 0 || v >= s->V)
         return rt_fail(e, RT_EINVAL, "super IFS buffer %d does not exist (expected 1 to %d)", v + 1,
                        s->V);
-    if (!hs->count || !(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
+    if ((!hs->count && !hs->count32) || !(hs->hi[0] > hs->lo[0]) || !(hs->hi[1] > hs->lo[1]))
         return rt_fail(e, RT_EINVAL, "super IFS render: the histogram is not allocated or empty");
     const double *p = s->pts + 2 * (size_t)v * s->points;
     for (size_t i = 0; i < s->points; i++) {
         long b = fset_hist_bin(hs, p[2 * i], p[2 * i + 1]);
         if (b >= 0)
-            hs->count[b]++;
+            hist2_add(hs, (size_t)b, 1);
     }
     return RT_OK;
 }

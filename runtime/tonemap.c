@@ -11,11 +11,11 @@
 static uint64_t pixel_count(const hist2 *hs, int k, int x, int y)
 {
     if (k == 1)
-        return hs->count[(size_t)y * hs->w + (size_t)x];
+        return hist2_get(hs, (size_t)y * hs->w + (size_t)x);
     uint64_t c = 0;
     for (int dy = 0; dy < k; dy++)
         for (int dx = 0; dx < k; dx++)
-            c += hs->count[(size_t)(y * k + dy) * hs->w + (size_t)(x * k + dx)];
+            c += hist2_get(hs, (size_t)(y * k + dy) * hs->w + (size_t)(x * k + dx));
     return c;
 }
 
@@ -86,6 +86,24 @@ static uint64_t max_count(const uint64_t *c, size_t n)
     return mx;
 }
 
+/* The same for 32-bit counts (the compiler vectorises the plain OR loop). */
+static uint32_t max_count32(const uint32_t *c, size_t n)
+{
+    uint32_t mx = 0;
+    size_t b = 0;
+    for (; b + 64 <= n; b += 64) {
+        uint32_t o = 0;
+        for (int i = 0; i < 64; i++)
+            o |= c[b + i];
+        if (o > mx)
+            for (int i = 0; i < 64; i++)
+                mx = c[b + i] > mx ? c[b + i] : mx;
+    }
+    for (; b < n; b++)
+        mx = c[b] > mx ? c[b] : mx;
+    return mx;
+}
+
 /* Everything the pixels depend on besides the bins, found once: the
  * checked options, k, M and the tables of small counts. tonemap_apply fills
  * every row from it at once; tonemap_defer keeps it (and the histogram) as
@@ -127,7 +145,7 @@ static rt_code plan_init(tm_plan *p, const hist2 *hs, const tonemap_opts *o, con
     size_t npx = (size_t)im->w * (size_t)im->h;
     uint64_t mx = 0;
     if (k == 1) {
-        mx = max_count(hs->count, npx);
+        mx = hs->count32 ? max_count32(hs->count32, npx) : max_count(hs->count, npx);
     } else {
         for (int y = 0; y < im->h; y++)
             for (int x = 0; x < im->w; x++) {
@@ -168,15 +186,29 @@ static void plan_rows(const image_src *s, int y0, int y1, float *out)
     uint64_t mx = p->mx;
     size_t nv = p->nv;
     if (k == 1 && p->colour == TONEMAP_RAMP) { /* the common case, straight along the bins */
-        const uint64_t *cnt = hs->count + (size_t)y0 * (size_t)w;
-        size_t n = (size_t)(y1 - y0) * (size_t)w;
+        /* one loop per count width; every value the loop reads in a local
+         * (the build's -fno-strict-aliasing: a store into out would
+         * otherwise reload p's fields) */
+        size_t b0 = (size_t)y0 * (size_t)w, n = (size_t)(y1 - y0) * (size_t)w;
         float *px = out;
-        for (size_t b = 0; b < n; b++, px += 4) {
-            uint64_t c = cnt[b];
-            if (c < nv) /* c = 0 (then also when M = 0): the background */
-                memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
-            else
-                ramp_eval(&p->rp, density(p->curve, c, mx, p->lmx, p->gamma, p->bright), px);
+        if (hs->count32) {
+            const uint32_t *cnt = hs->count32 + b0;
+            for (size_t b = 0; b < n; b++, px += 4) {
+                uint32_t c = cnt[b];
+                if (c < nv) /* c = 0 (then also when M = 0): the background */
+                    memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
+                else
+                    ramp_eval(&p->rp, density(p->curve, c, mx, p->lmx, p->gamma, p->bright), px);
+            }
+        } else {
+            const uint64_t *cnt = hs->count + b0;
+            for (size_t b = 0; b < n; b++, px += 4) {
+                uint64_t c = cnt[b];
+                if (c < nv)
+                    memcpy(px, c ? p->ct[c] : p->bg, sizeof p->bg);
+                else
+                    ramp_eval(&p->rp, density(p->curve, c, mx, p->lmx, p->gamma, p->bright), px);
+            }
         }
         return;
     }
@@ -247,6 +279,7 @@ rt_code tonemap_defer(hist2 *hs, const tonemap_opts *o, image *im, rt_error *e)
     p->src.destroy = plan_destroy;
     im->src = &p->src;
     hs->count = NULL; /* the plan owns the arrays now */
+    hs->count32 = NULL;
     hs->csum = NULL;
     hs->mem_count = hs->mem_csum = NULL;
     hs->w = hs->h = 0;
