@@ -8,6 +8,7 @@
 
 #include "chaos.h"
 #include "check.h"
+#include "fern.h"
 #include "rng.h"
 #include "tonemap.h"
 
@@ -303,11 +304,7 @@ static void test_threads(void)
 {
     rt_error e;
     ifs f;
-    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
-                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
-                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
-    double p[4] = {0.01, 0.85, 0.07, 0.07};
-    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    fern_build(&f);
     chaos_sys s = {&f, NULL};
     ramp rp = ramp_grey();
     rp.rgba[1][0] = 0.2f;
@@ -598,11 +595,7 @@ static void test_hist_adds(void)
 {
     rt_error e;
     ifs f;
-    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
-                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
-                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
-    double p[4] = {0.01, 0.85, 0.07, 0.07};
-    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    fern_build(&f);
     chaos_sys s = {&f, NULL};
     chaos_opts o = {0};
     o.points = 200000;
@@ -647,11 +640,7 @@ static void test_fit_quantiles(void)
 {
     rt_error e;
     ifs f;
-    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
-                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
-                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
-    double p[4] = {0.01, 0.85, 0.07, 0.07};
-    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    fern_build(&f);
     chaos_sys s = {&f, NULL};
     chaos_opts o = {0};
     o.seed = 31;
@@ -766,11 +755,7 @@ static void test_fit_tails(void)
 {
     rt_error e;
     ifs f;
-    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
-                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
-                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
-    double pf[4] = {0.01, 0.85, 0.07, 0.07};
-    CHECK(ifs_build(&f, fern, 4, pf, 0, &e) == RT_OK, "fern");
+    fern_build(&f);
     chaos_sys s = {&f, NULL};
     check_fit("fern", &s, 0, 2, 300, 200, NULL, NULL);
     check_fit("fern, 2 points", &s, 2, 2, 64, 64, NULL, NULL); /* the tails: 1 point each */

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "fern.h"
 #include "chaos.h"
 #include "fset.h"
 #include "hist.h"
@@ -97,11 +98,7 @@ static void test_chaos_widths(void)
 {
     rt_error e;
     ifs f;
-    affine fern[4] = {affine_from_2d(0, 0, 0, 0.16, 0, 0), affine_from_2d(0.85, 0.04, -0.04, 0.85, 0, 1.6),
-                      affine_from_2d(0.2, -0.26, 0.23, 0.22, 0, 1.6),
-                      affine_from_2d(-0.15, 0.28, 0.26, 0.24, 0, 0.44)};
-    double p[4] = {0.01, 0.85, 0.07, 0.07};
-    CHECK(ifs_build(&f, fern, 4, p, 0, &e) == RT_OK, "fern");
+    fern_build(&f);
     chaos_sys s = {&f, NULL};
     chaos_opts o = {0};
     o.points = 300000;

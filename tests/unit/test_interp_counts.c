@@ -23,6 +23,7 @@
 #include "check.h"
 #include "session.h"
 #include "state.h"
+#include "test_session.h"
 
 typedef struct run {
     interp_counts d; /* the counts the program's run added */
@@ -46,16 +47,10 @@ static void run_inputs(run *r, int repl, const char *const *texts, int n)
 {
     memset(r, 0, sizeof *r);
     interp st;
-    interp_init(&st);
-    st.threads = 1;
-    st.quiet = 1;
-    st.is_repl = repl;
-    FILE *f = tmpfile();
-    CHECK(f != NULL, "tmpfile");
+    FILE *f;
+    r->rc = test_session(&st, repl, &f);
     if (!f)
         return;
-    st.out = f;
-    r->rc = session_setup(&st);
     CHECK(r->rc == 0, "session_setup");
     for (int i = 0; i < n && r->rc == 0; i++) {
         interp_counts before = st.count;

@@ -29,6 +29,7 @@
 #include "lang_image.h"
 #include "session.h"
 #include "state.h"
+#include "test_session.h"
 
 typedef struct pcase {
     const char *builtin; /* the builtin the case is for */
@@ -253,16 +254,10 @@ static void run_case(const char *dir, const char *producer, const pcase *c, int 
 {
     memset(r, 0, sizeof *r);
     interp st;
-    interp_init(&st);
-    st.threads = 1;
-    st.quiet = 1;
-    st.is_repl = 1;
-    FILE *f = tmpfile();
-    CHECK(f != NULL, "tmpfile");
+    FILE *f;
+    r->rc = test_session(&st, 1, &f);
     if (!f)
         return;
-    st.out = f;
-    r->rc = session_setup(&st);
     char pre[2048];
     snprintf(pre, sizeof pre,
              "import \"ifs\"\nlet DIR = \"%s\"\n%s\nlet J = gradient(24, [1, 0, 0, 1], [0, 1, 0, 0.5], 30)\n"
